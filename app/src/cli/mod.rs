@@ -1,0 +1,90 @@
+//! Argument parsing and dispatch for the `tetlab` subcommands.
+//!
+//! Every error a user can cause ends here as one line on stderr naming the offending input, and
+//! exit status 2; nothing is written to stdout.
+
+mod args;
+mod check_gradients;
+mod gradient;
+
+use clap::{Parser, Subcommand};
+use std::io::Write;
+use std::process::ExitCode;
+
+/// tetlab: a workbench for position-based dynamics on tetrahedra.
+#[derive(Debug, Parser)]
+#[command(name = "tetlab", version, about, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Evaluate one constraint and its gradient at given points, checked by finite differences.
+    Gradient(gradient::Args),
+    /// Compare every analytic gradient with central differences on random configurations.
+    CheckGradients(check_gradients::Args),
+}
+
+/// An error caused by the user's input: printed as `error: <message>`, exit status 2.
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl<T: std::fmt::Display> From<T> for UsageError {
+    fn from(message: T) -> Self {
+        UsageError(message.to_string())
+    }
+}
+
+/// Parses the command line, runs the subcommand and turns its outcome into an exit status.
+pub fn main() -> ExitCode {
+    let argv = args::attach_values(std::env::args_os(), "--points");
+    let cli = match Cli::try_parse_from(argv) {
+        Ok(cli) => cli,
+        Err(err) => return report_clap_error(err),
+    };
+    let mut stdout = std::io::stdout().lock();
+    let outcome = match cli.command {
+        Command::Gradient(args) => gradient::run(&args, &mut stdout),
+        Command::CheckGradients(args) => check_gradients::run(&args, &mut stdout),
+    };
+    match outcome.and_then(|()| {
+        stdout
+            .flush()
+            .map_err(|e| UsageError(format!("stdout: {e}")))
+    }) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(UsageError(message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Help and version go to stdout with status 0; a parse error becomes one line on stderr.
+fn report_clap_error(err: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    match err.kind() {
+        ErrorKind::DisplayHelp
+        | ErrorKind::DisplayVersion
+        | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            // Printing help can only fail if stdout is gone; there is nobody left to tell.
+            let _ = err.print();
+            if err.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                ExitCode::from(2)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        _ => {
+            // clap's first paragraph says what is wrong and names the argument, sometimes on a
+            // second line ("required arguments were not provided:\n  --constraint <..>").
+            let rendered = err.render().to_string();
+            let first_paragraph = rendered.split("\n\n").next().unwrap_or_default();
+            let one_line: Vec<&str> = first_paragraph.split_whitespace().collect();
+            eprintln!("{} (see --help)", one_line.join(" "));
+            ExitCode::from(2)
+        }
+    }
+}

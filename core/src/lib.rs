@@ -1,0 +1,14 @@
+//! tetlab-core: the simulation side of tetlab, with no GUI dependencies.
+//!
+//! - [`constraints`]: the edge-distance, height-above-face ("plane") and signed-volume
+//!   constraints, their values and analytic gradients, written once for f32 and f64.
+//! - [`finite_difference`]: numerical gradients to check the analytic ones against.
+//! - [`verify`]: analytic gradients against finite differences on random configurations.
+//! - [`random`]: a seeded generator, so random inputs are the same everywhere.
+//! - [`vector`]: the small vector trait the formulas are generic over.
+
+pub mod constraints;
+pub mod finite_difference;
+pub mod random;
+pub mod vector;
+pub mod verify;

@@ -1,0 +1,150 @@
+//! The small vector vocabulary the constraint formulas are written in.
+//!
+//! Every formula in [`crate::constraints`] is generic over [`Vector3`], so one implementation
+//! serves the f64 path used for checking and teaching ([`glam::DVec3`]) and the f32 path of a
+//! fast solver ([`glam::Vec3`], [`glam::Vec3A`]).
+
+use std::fmt::Debug;
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
+
+/// A floating-point scalar: `f32` or `f64`.
+pub trait Real:
+    Copy
+    + Debug
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// Machine epsilon: the gap between 1 and the next representable number.
+    const EPSILON: Self;
+    /// The smallest positive normal number.
+    const MIN_POSITIVE: Self;
+    /// The nearest value of this type to `x`.
+    fn from_f64(x: f64) -> Self;
+    /// This value widened (or kept) to f64.
+    fn to_f64(self) -> f64;
+    /// √self.
+    fn sqrt(self) -> Self;
+    /// |self|.
+    fn abs(self) -> Self;
+    /// Neither infinite nor NaN.
+    fn is_finite(self) -> bool;
+}
+
+macro_rules! impl_real {
+    ($t:ty) => {
+        impl Real for $t {
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            const EPSILON: Self = <$t>::EPSILON;
+            const MIN_POSITIVE: Self = <$t>::MIN_POSITIVE;
+            #[inline]
+            fn from_f64(x: f64) -> Self {
+                x as $t
+            }
+            #[inline]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline]
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            #[inline]
+            fn abs(self) -> Self {
+                <$t>::abs(self)
+            }
+            #[inline]
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+        }
+    };
+}
+impl_real!(f32);
+impl_real!(f64);
+
+/// A 3-vector with the operations the constraint formulas use.
+pub trait Vector3:
+    Copy
+    + Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Neg<Output = Self>
+    + Mul<<Self as Vector3>::Real, Output = Self>
+    + Div<<Self as Vector3>::Real, Output = Self>
+    + AddAssign
+    + SubAssign
+{
+    /// The scalar type of the components.
+    type Real: Real;
+    /// The zero vector.
+    const ZERO: Self;
+    /// a·b.
+    fn dot(self, rhs: Self) -> Self::Real;
+    /// a×b.
+    fn cross(self, rhs: Self) -> Self;
+    /// |a|² = a·a.
+    #[inline]
+    fn length_squared(self) -> Self::Real {
+        self.dot(self)
+    }
+    /// |a|.
+    #[inline]
+    fn length(self) -> Self::Real {
+        self.length_squared().sqrt()
+    }
+    /// The vector built from f64 components (rounded to the component type).
+    fn from_f64s(x: f64, y: f64, z: f64) -> Self;
+    /// The components widened to f64.
+    fn to_dvec3(self) -> glam::DVec3;
+}
+
+macro_rules! impl_vector3 {
+    ($v:ty, $t:ty) => {
+        impl Vector3 for $v {
+            type Real = $t;
+            const ZERO: Self = <$v>::ZERO;
+            #[inline]
+            fn dot(self, rhs: Self) -> $t {
+                <$v>::dot(self, rhs)
+            }
+            #[inline]
+            fn cross(self, rhs: Self) -> Self {
+                <$v>::cross(self, rhs)
+            }
+            #[inline]
+            fn from_f64s(x: f64, y: f64, z: f64) -> Self {
+                <$v>::new(x as $t, y as $t, z as $t)
+            }
+            #[inline]
+            fn to_dvec3(self) -> glam::DVec3 {
+                glam::DVec3::new(self.x as f64, self.y as f64, self.z as f64)
+            }
+        }
+    };
+}
+impl_vector3!(glam::Vec3, f32);
+impl_vector3!(glam::Vec3A, f32);
+impl_vector3!(glam::DVec3, f64);
+
+/// Whether `a` and `b` span no plane at working precision: |a×b| ≤ ε·|a|·|b|.
+///
+/// True when either vector is zero or the sine of the angle between them is below machine
+/// epsilon; the normal `a×b/|a×b|` is then meaningless.
+#[inline]
+pub fn spans_no_plane<V: Vector3>(a: V, b: V, a_cross_b: V) -> bool {
+    let lhs = a_cross_b.length();
+    let rhs = V::Real::EPSILON * a.length() * b.length();
+    // Anything but "greater" (also NaN from overflowing inputs) means no plane.
+    lhs.partial_cmp(&rhs) != Some(std::cmp::Ordering::Greater)
+}

@@ -1,0 +1,116 @@
+//! Checks of the analytic gradients against central finite differences on random configurations.
+//!
+//! The same routine backs the test suite (which asserts the bound) and `tetlab check-gradients`
+//! (which prints the figures quoted in `docs/gradients.md`).
+
+use crate::constraints::Family;
+use crate::finite_difference::central_difference;
+use crate::random::SplitMix64;
+use glam::DVec3;
+
+/// Below this sine of the angle between two edges, or this fraction of the configuration's size
+/// for an edge length, a random configuration counts as near-degenerate and is not compared.
+pub const CONDITIONING: f64 = 0.05;
+
+/// The error of an analytic gradient against central differences, relative to the gradient's size:
+/// maxᵢ |∇ₚᵢC − ∇ₚᵢC_fd|∞ / maxᵢ |∇ₚᵢC|.
+pub fn relative_error(analytic: &[DVec3], numeric: &[DVec3]) -> f64 {
+    let scale = analytic.iter().map(|g| g.length()).fold(0.0, f64::max);
+    let error = max_abs_error(analytic, numeric);
+    if scale > 0.0 { error / scale } else { error }
+}
+
+/// maxᵢ |∇ₚᵢC − ∇ₚᵢC_fd|∞, the largest difference of any one component.
+pub fn max_abs_error(analytic: &[DVec3], numeric: &[DVec3]) -> f64 {
+    analytic
+        .iter()
+        .zip(numeric)
+        .map(|(a, n)| (*a - *n).abs().max_element())
+        .fold(0.0, f64::max)
+}
+
+/// The analytic gradient of `family` at `points` and the central-difference one, in f64.
+pub fn analytic_and_numeric(
+    family: Family,
+    points: &[DVec3],
+    rest: f64,
+) -> (Vec<DVec3>, Vec<DVec3>) {
+    let analytic = family.evaluate(points, rest).gradients[..points.len()].to_vec();
+    let numeric = central_difference(points, |p| family.evaluate(p, rest).value);
+    (analytic, numeric)
+}
+
+/// Whether a configuration is far enough from degeneracy for a finite-difference comparison:
+/// no edge shorter than [`CONDITIONING`] times the longest, and for the height constraint a face
+/// (p0, p2, p3) whose edges meet at a sine of at least [`CONDITIONING`].
+pub fn well_conditioned(family: Family, points: &[DVec3]) -> bool {
+    let mut lengths = Vec::new();
+    for i in 0..points.len() {
+        for j in i + 1..points.len() {
+            lengths.push(points[i].distance(points[j]));
+        }
+    }
+    let longest = lengths.iter().copied().fold(0.0, f64::max);
+    if lengths.iter().any(|&l| l < CONDITIONING * longest) || longest == 0.0 {
+        return false;
+    }
+    match family {
+        Family::Plane => {
+            let (e2, e3) = (points[2] - points[0], points[3] - points[0]);
+            e2.cross(e3).length() >= CONDITIONING * e2.length() * e3.length()
+        }
+        Family::Distance | Family::Volume => true,
+    }
+}
+
+/// The outcome of [`random_check`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    /// The family checked.
+    pub family: Family,
+    /// Configurations compared.
+    pub compared: usize,
+    /// Configurations drawn but skipped as near-degenerate.
+    pub skipped: usize,
+    /// The largest [`relative_error`] seen.
+    pub max_relative_error: f64,
+    /// The mean [`relative_error`].
+    pub mean_relative_error: f64,
+}
+
+/// Draws configurations until `samples` well-conditioned ones have been compared: points uniform
+/// in a cube of random size 10^U(−2, 2) around a random centre, rest value random in the range of
+/// the constraint's own values. Returns the error statistics.
+pub fn random_check(family: Family, samples: usize, seed: u64) -> Report {
+    let mut rng = SplitMix64::new(seed);
+    let (mut compared, mut skipped) = (0, 0);
+    let (mut max_error, mut sum_error) = (0.0_f64, 0.0);
+    while compared < samples {
+        let size = 10f64.powf(rng.range(-2.0, 2.0));
+        let centre = rng.in_cube(size);
+        let points: Vec<DVec3> = (0..family.arity())
+            .map(|_| centre + rng.in_cube(size))
+            .collect();
+        if !well_conditioned(family, &points) {
+            skipped += 1;
+            continue;
+        }
+        let rest = family.rest_value(&points) * rng.range(-1.5, 1.5);
+        let (analytic, numeric) = analytic_and_numeric(family, &points, rest);
+        let error = relative_error(&analytic, &numeric);
+        max_error = max_error.max(error);
+        sum_error += error;
+        compared += 1;
+    }
+    Report {
+        family,
+        compared,
+        skipped,
+        max_relative_error: max_error,
+        mean_relative_error: if compared > 0 {
+            sum_error / compared as f64
+        } else {
+            0.0
+        },
+    }
+}

@@ -1,0 +1,299 @@
+//! `tetlab gradient` and `tetlab check-gradients`, run as a user would, checked against values
+//! computed by hand.
+
+mod support;
+
+use serde_json::Value;
+use support::{assert_usage_error, stderr, stdout, tetlab};
+
+fn json(args: &[&str]) -> Value {
+    let output = tetlab(args);
+    assert!(output.status.success(), "{args:?}: {}", stderr(&output));
+    serde_json::from_str(&stdout(&output)).expect("one JSON object")
+}
+
+fn vectors(value: &Value) -> Vec<[f64; 3]> {
+    value
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| {
+            let a: Vec<f64> = v
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            [a[0], a[1], a[2]]
+        })
+        .collect()
+}
+
+fn assert_close(actual: &[[f64; 3]], expected: &[[f64; 3]], tolerance: f64) {
+    assert_eq!(actual.len(), expected.len());
+    for (a, e) in actual.iter().zip(expected) {
+        for k in 0..3 {
+            assert!(
+                (a[k] - e[k]).abs() <= tolerance,
+                "{actual:?} != {expected:?}"
+            );
+        }
+    }
+}
+
+/// A 3-4-5 triangle: |p0 − p1| = 5, so C = 5 − 4 = 1 and ∇ₚ₀C = (p0 − p1)/5.
+#[test]
+fn distance_by_hand() {
+    let v = json(&[
+        "gradient",
+        "--constraint",
+        "distance",
+        "--points",
+        "-1,0,0.5",
+        "2,4,0.5",
+        "--rest",
+        "4",
+        "--json",
+    ]);
+    assert_eq!(v["constraint"], "distance");
+    assert_eq!(v["value"], 1.0);
+    assert_eq!(v["rest"], 4.0);
+    assert_eq!(v["degenerate"], false);
+    assert_close(
+        &vectors(&v["gradients"]),
+        &[[-0.6, -0.8, 0.0], [0.6, 0.8, 0.0]],
+        1e-15,
+    );
+    assert_close(
+        &vectors(&v["finite_difference"]),
+        &[[-0.6, -0.8, 0.0], [0.6, 0.8, 0.0]],
+        1e-9,
+    );
+    assert!(v["max_abs_error"].as_f64().unwrap() < 1e-9);
+}
+
+/// Face p0 = 0, p2 = x̂, p3 = ŷ (normal ẑ), p1 = (−0.2, 0.3, 2): height 2.
+/// Raising p2 by δ tilts the plane to z = δx, which at p1 (x = −0.2) lowers the plane by 0.2δ:
+/// ∂C/∂p2z = +0.2. Likewise ∂C/∂p3z = −0.3 and ∂C/∂p0z = −(1 + 0.2 − 0.3) = −0.9.
+#[test]
+fn plane_by_hand() {
+    let v = json(&[
+        "gradient",
+        "--constraint",
+        "plane",
+        "--points",
+        "0,0,0",
+        "-0.2,0.3,2",
+        "1,0,0",
+        "0,1,0",
+        "--rest",
+        "-1.5",
+        "--json",
+    ]);
+    assert_eq!(v["value"], 3.5);
+    assert_close(
+        &vectors(&v["gradients"]),
+        &[
+            [0.0, 0.0, -0.9],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, 0.2],
+            [0.0, 0.0, -0.3],
+        ],
+        1e-15,
+    );
+    assert!(v["max_abs_error"].as_f64().unwrap() < 1e-8);
+}
+
+/// The unit right-angle tet has volume 1/6; ∇ₚᵢC is a sixth of the face normal opposite pᵢ.
+#[test]
+fn volume_by_hand() {
+    let v = json(&[
+        "gradient",
+        "--constraint",
+        "volume",
+        "--points",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0,0,1",
+        "--rest",
+        "0.1",
+        "--json",
+    ]);
+    assert!((v["value"].as_f64().unwrap() - (1.0 / 6.0 - 0.1)).abs() < 1e-15);
+    let s = 1.0 / 6.0;
+    assert_close(
+        &vectors(&v["gradients"]),
+        &[[-s, -s, -s], [s, 0.0, 0.0], [0.0, s, 0.0], [0.0, 0.0, s]],
+        1e-15,
+    );
+}
+
+#[test]
+fn degenerate_input_is_flagged_and_finite() {
+    let v = json(&[
+        "gradient",
+        "--constraint",
+        "plane",
+        "--points",
+        "0,0,0",
+        "0,0,1",
+        "1,0,0",
+        "2,0,0",
+        "--rest",
+        "0.5",
+        "--json",
+    ]);
+    assert_eq!(v["degenerate"], true);
+    assert_eq!(v["value"], -0.5);
+    assert_close(&vectors(&v["gradients"]), &[[0.0; 3]; 4], 0.0);
+
+    let v = json(&[
+        "gradient",
+        "--constraint",
+        "distance",
+        "--points",
+        "1,1,1",
+        "1,1,1",
+        "--json",
+    ]);
+    assert_eq!(v["degenerate"], true);
+    assert_eq!(v["value"], 0.0);
+}
+
+#[test]
+fn the_table_shows_every_particle_and_the_error() {
+    let output = tetlab(&[
+        "gradient",
+        "--constraint",
+        "volume",
+        "--points",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0,0,1",
+    ]);
+    assert!(output.status.success());
+    let text = stdout(&output);
+    for needle in [
+        "constraint  volume",
+        "p0",
+        "p1",
+        "p2",
+        "p3",
+        "max |analytic - central",
+    ] {
+        assert!(text.contains(needle), "missing {needle:?} in\n{text}");
+    }
+}
+
+#[test]
+fn bad_input_is_one_line_naming_the_argument_with_status_2() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["--constraint", "bend", "--points", "0,0,0", "1,0,0"],
+            "--constraint",
+        ),
+        (
+            &[
+                "--constraint",
+                "distance",
+                "--points",
+                "0,0,0",
+                "1,0,0",
+                "2,0,0",
+            ],
+            "--points",
+        ),
+        (
+            &["--constraint", "plane", "--points", "0,0,0", "1,0,0"],
+            "takes 4 points, got 2",
+        ),
+        (
+            &["--constraint", "distance", "--points", "0,0,0", "1,x,0"],
+            "'x' is not a number",
+        ),
+        (
+            &["--constraint", "distance", "--points", "0,0,0", "1,nan,0"],
+            "not a finite number",
+        ),
+        (
+            &["--constraint", "distance", "--points", "0,0,0", "inf,0,0"],
+            "not a finite number",
+        ),
+        (
+            &["--constraint", "distance", "--points", "0,0,0", "1,0"],
+            "--points",
+        ),
+        (
+            &[
+                "--constraint",
+                "distance",
+                "--points",
+                "0,0,0",
+                "1,0,0",
+                "--rest",
+                "x",
+            ],
+            "--rest",
+        ),
+        (
+            &[
+                "--constraint",
+                "distance",
+                "--points",
+                "0,0,0",
+                "1,0,0",
+                "--rest",
+                "nan",
+            ],
+            "--rest",
+        ),
+        (&["--constraint", "distance"], "--points"),
+        (&["--points", "0,0,0", "1,0,0"], "--constraint"),
+        (&["--constraint", "distance", "--points"], "--points"),
+        (
+            &[
+                "--constraint",
+                "volume",
+                "--points",
+                "0,0,0",
+                "1e300,0,0",
+                "0,1e300,0",
+                "0,0,1e300",
+            ],
+            "too large",
+        ),
+    ];
+    for (args, names) in cases {
+        let mut full = vec!["gradient"];
+        full.extend_from_slice(args);
+        assert_usage_error(&tetlab(&full), names);
+    }
+}
+
+#[test]
+fn check_gradients_reports_every_family_within_bound() {
+    let output = tetlab(&[
+        "check-gradients",
+        "--samples",
+        "2000",
+        "--seed",
+        "7",
+        "--json",
+    ]);
+    assert!(output.status.success());
+    let rows: Vec<Value> = stdout(&output)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["constraint"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["distance", "plane", "volume"]);
+    for row in &rows {
+        assert_eq!(row["compared"], 2000);
+        assert!(row["max_relative_error"].as_f64().unwrap() <= 1e-6, "{row}");
+    }
+}
