@@ -9,6 +9,10 @@
 
 pub mod constraints;
 pub mod finite_difference;
+pub mod mesh;
+pub mod metrics;
 pub mod random;
+pub mod scene;
+pub mod solver;
 pub mod vector;
 pub mod verify;

@@ -6,6 +6,8 @@
 mod args;
 mod check_gradients;
 mod gradient;
+mod run;
+mod simulation_args;
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -25,6 +27,8 @@ enum Command {
     Gradient(gradient::Args),
     /// Compare every analytic gradient with central differences on random configurations.
     CheckGradients(check_gradients::Args),
+    /// Run a scene headless and print its metrics per frame (--json) or a summary.
+    Run(run::Args),
 }
 
 /// An error caused by the user's input: printed as `error: <message>`, exit status 2.
@@ -48,6 +52,7 @@ pub fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Gradient(args) => gradient::run(&args, &mut stdout),
         Command::CheckGradients(args) => check_gradients::run(&args, &mut stdout),
+        Command::Run(args) => run::run(&args, &mut stdout),
     };
     match outcome.and_then(|()| {
         stdout

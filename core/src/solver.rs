@@ -1,0 +1,626 @@
+//! The simulation that every front end drives: XPBD (default) or PBD on the three constraint
+//! families, with substeps, gravity, a ground plane, pins and a grab constraint.
+//!
+//! One substep of length h = Δt / substeps:
+//! 1. predict: v += g h, x_prev = x, x += v h; a particle predicted below the ground (y < 0) is put
+//!    back at its previous position, on the ground (sticking friction);
+//! 2. XPBD only: λ = 0 for every constraint;
+//! 3. `iterations` Gauss–Seidel sweeps over the active families in a fixed order (edges, plane,
+//!    volume, then the grab, then the ground y ≥ 0), each constraint projected at once;
+//! 4. v = (x − x_prev) / h, then damped: v *= max(0, 1 − damping · h).
+//!
+//! Projecting one constraint C with particles i, gradients ∇ᵢC and inverse masses wᵢ:
+//! - XPBD: α̃ = α / h², Δλ = (−C − α̃ λ) / (Σ wᵢ|∇ᵢC|² + α̃), λ += Δλ, Δxᵢ = wᵢ ∇ᵢC Δλ;
+//! - PBD: s = −C / Σ wᵢ|∇ᵢC|², Δxᵢ = k′ s wᵢ ∇ᵢC with k′ = 1 − (1 − k)^(1/iterations), so that
+//!   `iterations` sweeps of stiffness k′ compound to k.
+//!
+//! Degenerate evaluations (undefined ∇C) and constraints whose particles are all pinned are
+//! skipped. All state lives in flat arrays, one set per family, allocated once: a step allocates
+//! nothing, and the same inputs give the same bits.
+
+use crate::constraints::{Evaluation, Family, distance, plane, volume};
+use crate::mesh::TetMesh;
+use crate::scene::Scene;
+use glam::DVec3;
+
+/// XPBD or PBD.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Extended PBD: compliance per family, λ accumulated within a substep.
+    Xpbd,
+    /// Müller et al. 2006: stiffness per family, corrected for the iteration count.
+    Pbd,
+}
+
+/// One value per constraint family.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PerFamily<T> {
+    /// Edge distance.
+    pub edges: T,
+    /// The four heights per tet.
+    pub plane: T,
+    /// Signed volume.
+    pub volume: T,
+}
+
+impl<T: Copy> PerFamily<T> {
+    /// The same value for every family.
+    pub const fn splat(value: T) -> Self {
+        Self {
+            edges: value,
+            plane: value,
+            volume: value,
+        }
+    }
+
+    /// The value for `family`.
+    pub fn get(&self, family: Family) -> T {
+        match family {
+            Family::Distance => self.edges,
+            Family::Plane => self.plane,
+            Family::Volume => self.volume,
+        }
+    }
+
+    /// Sets the value for `family`.
+    pub fn set(&mut self, family: Family, value: T) {
+        match family {
+            Family::Distance => self.edges = value,
+            Family::Plane => self.plane = value,
+            Family::Volume => self.volume = value,
+        }
+    }
+}
+
+/// How the simulation runs. Every field may change between steps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// XPBD or PBD.
+    pub method: Method,
+    /// Which families are projected.
+    pub active: PerFamily<bool>,
+    /// XPBD compliance α per family: the inverse of stiffness, 0 is rigid, larger is softer.
+    pub compliance: PerFamily<f64>,
+    /// PBD stiffness k ∈ [0, 1] per family.
+    pub stiffness: PerFamily<f64>,
+    /// Substeps per frame, ≥ 1.
+    pub substeps: u32,
+    /// Gauss–Seidel sweeps per substep, ≥ 1.
+    pub iterations: u32,
+    /// Frame length Δt in seconds.
+    pub dt: f64,
+    /// Gravity along −y in m/s².
+    pub gravity: f64,
+    /// Whether the ground plane y = 0 stops particles.
+    pub ground: bool,
+    /// Velocity damping per second.
+    pub damping: f64,
+    /// Compliance of the grab constraint; 0 moves the grabbed particle with the target exactly.
+    pub grab_compliance: f64,
+}
+
+impl Default for Settings {
+    /// XPBD, edges + volume, rigid, 10 substeps of 1 iteration, Δt = 1/60 s, gravity 9.81 m/s²,
+    /// ground on, no damping.
+    fn default() -> Self {
+        Self {
+            method: Method::Xpbd,
+            active: PerFamily {
+                edges: true,
+                plane: false,
+                volume: true,
+            },
+            compliance: PerFamily::splat(0.0),
+            stiffness: PerFamily::splat(1.0),
+            substeps: 10,
+            iterations: 1,
+            dt: 1.0 / 60.0,
+            gravity: 9.81,
+            ground: true,
+            damping: 0.0,
+            grab_compliance: 0.0,
+        }
+    }
+}
+
+/// Density used to lump masses: 1000 kg/m³.
+pub const DENSITY: f64 = 1000.0;
+
+/// The constraints of one family: particle indices, rest values and XPBD multipliers, one entry
+/// per constraint, in projection order.
+#[derive(Clone, Debug, Default)]
+pub struct ConstraintSet<const N: usize> {
+    /// The particles of each constraint, in the constraint's own order.
+    pub particles: Vec<[u32; N]>,
+    /// The rest value (d or V) of each constraint.
+    pub rest: Vec<f64>,
+    /// The XPBD multiplier λ of each constraint, accumulated within the current substep.
+    pub lambda: Vec<f64>,
+}
+
+impl<const N: usize> ConstraintSet<N> {
+    fn new(
+        particles: Vec<[u32; N]>,
+        positions: &[DVec3],
+        evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
+    ) -> Self {
+        let rest = particles
+            .iter()
+            .map(|idx| evaluate(&idx.map(|i| positions[i as usize]), 0.0).value)
+            .collect();
+        let lambda = vec![0.0; particles.len()];
+        Self {
+            particles,
+            rest,
+            lambda,
+        }
+    }
+
+    /// The number of constraints.
+    pub fn len(&self) -> usize {
+        self.particles.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.particles.is_empty()
+    }
+}
+
+/// The change one projection makes: Δλ (XPBD; the scaled step s for PBD) and Δx per particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Correction<const N: usize> {
+    /// The evaluation the correction was computed from.
+    pub evaluation: Evaluation<DVec3, N>,
+    /// XPBD: Δλ. PBD: k′ s.
+    pub delta_lambda: f64,
+    /// Δx for each particle of the constraint.
+    pub delta_x: [DVec3; N],
+}
+
+/// How a correction is scaled.
+#[derive(Clone, Copy, Debug)]
+enum Rule {
+    Xpbd { alpha_tilde: f64 },
+    Pbd { k: f64 },
+}
+
+/// The correction that projecting one constraint would make, or `None` when it is skipped
+/// (degenerate, or every particle pinned).
+#[inline]
+fn correction<const N: usize>(
+    evaluation: Evaluation<DVec3, N>,
+    weights: [f64; N],
+    lambda: f64,
+    rule: Rule,
+) -> Option<Correction<N>> {
+    if evaluation.degenerate {
+        return None;
+    }
+    let weighted_norm: f64 = weights
+        .iter()
+        .zip(&evaluation.gradients)
+        .map(|(w, g)| w * g.length_squared())
+        .sum();
+    if weighted_norm <= 0.0 || !weighted_norm.is_finite() {
+        return None;
+    }
+    let delta_lambda = match rule {
+        Rule::Xpbd { alpha_tilde } => {
+            (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
+        }
+        Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
+    };
+    let mut delta_x = [DVec3::ZERO; N];
+    for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
+        *dx = *g * (w * delta_lambda);
+    }
+    Some(Correction {
+        evaluation,
+        delta_lambda,
+        delta_x,
+    })
+}
+
+/// A particle held by the user.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grab {
+    /// The particle.
+    pub particle: usize,
+    /// Where the user holds it.
+    pub target: DVec3,
+    target_at_last_step: DVec3,
+    /// How fast the target moved over the last step.
+    pub target_velocity: DVec3,
+    lambda: f64,
+}
+
+/// The soft body in motion.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    settings: Settings,
+    rest_positions: Vec<DVec3>,
+    positions: Vec<DVec3>,
+    previous: Vec<DVec3>,
+    velocities: Vec<DVec3>,
+    /// Inverse masses from the lumped masses, 0 where pinned.
+    inverse_masses: Vec<f64>,
+    pinned: Vec<bool>,
+    lumped_inverse_masses: Vec<f64>,
+    tets: Vec<[u32; 4]>,
+    /// Edge distance constraints.
+    pub edges: ConstraintSet<2>,
+    /// Height constraints: four per tet, tet t's at 4t..4t+4.
+    pub planes: ConstraintSet<4>,
+    /// Signed volume constraints, one per tet, in tet order.
+    pub volumes: ConstraintSet<4>,
+    grab: Option<Grab>,
+    frame: u64,
+    time: f64,
+}
+
+impl Simulation {
+    /// A simulation of `scene` at rest, with masses lumped from density × rest volume / 4 per tet.
+    pub fn new(scene: &Scene, settings: Settings) -> Simulation {
+        let mesh = &scene.mesh;
+        let positions = mesh.positions.clone();
+        let edges = ConstraintSet::new(mesh.edges(), &positions, distance::evaluate);
+        let plane_particles = mesh
+            .tets
+            .iter()
+            .flat_map(|t| plane::tet_vertex_order().map(|order| order.map(|k| t[k])))
+            .collect();
+        let planes = ConstraintSet::new(plane_particles, &positions, plane::evaluate);
+        let volumes = ConstraintSet::new(mesh.tets.clone(), &positions, volume::evaluate);
+        let lumped_inverse_masses = lumped_inverse_masses(mesh, &volumes.rest);
+        let mut pinned = vec![false; positions.len()];
+        for &i in &scene.pinned {
+            pinned[i as usize] = true;
+        }
+        let n = positions.len();
+        let mut simulation = Simulation {
+            settings,
+            rest_positions: positions.clone(),
+            previous: positions.clone(),
+            positions,
+            velocities: vec![DVec3::ZERO; n],
+            inverse_masses: vec![0.0; n],
+            pinned,
+            lumped_inverse_masses,
+            tets: mesh.tets.clone(),
+            edges,
+            planes,
+            volumes,
+            grab: None,
+            frame: 0,
+            time: 0.0,
+        };
+        simulation.update_inverse_masses();
+        simulation
+    }
+
+    /// The settings in force.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Changes the settings; they apply from the next substep.
+    pub fn set_settings(&mut self, settings: Settings) {
+        self.settings = settings;
+    }
+
+    /// Current particle positions.
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// Rest positions (the scene as made).
+    pub fn rest_positions(&self) -> &[DVec3] {
+        &self.rest_positions
+    }
+
+    /// Current particle velocities.
+    pub fn velocities(&self) -> &[DVec3] {
+        &self.velocities
+    }
+
+    /// Inverse masses in use (0 for pinned or grabbed-rigidly particles).
+    pub fn inverse_masses(&self) -> &[f64] {
+        &self.inverse_masses
+    }
+
+    /// The tets, as indices into the positions.
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// Frames stepped since the start.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Simulated time in seconds.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Whether particle `i` is pinned.
+    pub fn is_pinned(&self, i: usize) -> bool {
+        self.pinned[i]
+    }
+
+    /// Pins or frees particle `i`.
+    pub fn set_pinned(&mut self, i: usize, pinned: bool) {
+        self.pinned[i] = pinned;
+        self.update_inverse_masses();
+    }
+
+    /// Applies a perturbation to the current positions and stops all motion.
+    pub fn perturb(&mut self, perturbation: crate::scene::Perturbation) {
+        let mesh = TetMesh {
+            positions: self.rest_positions.clone(),
+            tets: self.tets.clone(),
+        };
+        perturbation.apply(&mut self.positions, &mesh);
+        self.stop();
+    }
+
+    /// Puts particle `i` at `position` at rest (a kinematic move, e.g. a drag while paused).
+    pub fn place(&mut self, i: usize, position: DVec3) {
+        self.positions[i] = position;
+        self.previous[i] = position;
+        self.velocities[i] = DVec3::ZERO;
+    }
+
+    /// Back to the rest shape, at rest, at frame 0.
+    pub fn reset(&mut self) {
+        self.positions.copy_from_slice(&self.rest_positions);
+        self.stop();
+        self.frame = 0;
+        self.time = 0.0;
+    }
+
+    /// Zeroes every velocity and multiplier.
+    fn stop(&mut self) {
+        self.previous.copy_from_slice(&self.positions);
+        self.velocities.fill(DVec3::ZERO);
+        for lambda in [
+            &mut self.edges.lambda,
+            &mut self.planes.lambda,
+            &mut self.volumes.lambda,
+        ] {
+            lambda.fill(0.0);
+        }
+    }
+
+    /// Starts holding particle `i` at `target`. With zero grab compliance the particle follows the
+    /// target exactly (its inverse mass is 0 meanwhile); otherwise a compliant zero-length
+    /// constraint pulls it.
+    pub fn grab(&mut self, i: usize, target: DVec3) {
+        self.release();
+        self.grab = Some(Grab {
+            particle: i,
+            target,
+            target_at_last_step: target,
+            target_velocity: DVec3::ZERO,
+            lambda: 0.0,
+        });
+        self.update_inverse_masses();
+    }
+
+    /// Moves the held target.
+    pub fn move_grab(&mut self, target: DVec3) {
+        if let Some(grab) = &mut self.grab {
+            grab.target = target;
+        }
+    }
+
+    /// The current grab, if any.
+    pub fn grabbed(&self) -> Option<&Grab> {
+        self.grab.as_ref()
+    }
+
+    /// Lets go: the particle's mass comes back, and it keeps the target's velocity over the last
+    /// step so it can be thrown.
+    pub fn release(&mut self) {
+        if let Some(grab) = self.grab.take() {
+            self.velocities[grab.particle] = grab.target_velocity;
+            self.update_inverse_masses();
+        }
+    }
+
+    fn rigid_grab(&self) -> Option<Grab> {
+        self.grab.filter(|_| self.settings.grab_compliance <= 0.0)
+    }
+
+    fn update_inverse_masses(&mut self) {
+        for i in 0..self.positions.len() {
+            self.inverse_masses[i] = if self.pinned[i] {
+                0.0
+            } else {
+                self.lumped_inverse_masses[i]
+            };
+        }
+        if let Some(grab) = self.rigid_grab() {
+            self.inverse_masses[grab.particle] = 0.0;
+        }
+    }
+
+    /// Advances one frame: `substeps` substeps of Δt / substeps.
+    pub fn step(&mut self) {
+        self.update_inverse_masses();
+        for _ in 0..self.settings.substeps.max(1) {
+            self.substep();
+        }
+        if let Some(grab) = &mut self.grab {
+            grab.target_velocity = (grab.target - grab.target_at_last_step) / self.settings.dt;
+            grab.target_at_last_step = grab.target;
+        }
+        self.frame += 1;
+        self.time += self.settings.dt;
+    }
+
+    /// One substep: predict, project every active family `iterations` times, update velocities.
+    pub fn substep(&mut self) {
+        let h = self.settings.dt / self.settings.substeps.max(1) as f64;
+        self.predict(h);
+        for lambda in [
+            &mut self.edges.lambda,
+            &mut self.planes.lambda,
+            &mut self.volumes.lambda,
+        ] {
+            lambda.fill(0.0);
+        }
+        if let Some(grab) = &mut self.grab {
+            grab.lambda = 0.0;
+        }
+        for _ in 0..self.settings.iterations.max(1) {
+            self.sweep(h);
+        }
+        self.update_velocities(h);
+    }
+
+    fn predict(&mut self, h: f64) {
+        let gravity = DVec3::new(0.0, -self.settings.gravity, 0.0);
+        let ground = self.settings.ground;
+        for i in 0..self.positions.len() {
+            self.previous[i] = self.positions[i];
+            if self.inverse_masses[i] == 0.0 {
+                continue;
+            }
+            self.velocities[i] += gravity * h;
+            self.positions[i] += self.velocities[i] * h;
+            if ground && self.positions[i].y < 0.0 {
+                self.positions[i] = self.previous[i];
+                self.positions[i].y = 0.0;
+            }
+        }
+        if let Some(grab) = self.rigid_grab() {
+            self.positions[grab.particle] = grab.target;
+        }
+    }
+
+    fn rule(&self, family: Family, h: f64) -> Rule {
+        match self.settings.method {
+            Method::Xpbd => Rule::Xpbd {
+                alpha_tilde: self.settings.compliance.get(family) / (h * h),
+            },
+            Method::Pbd => {
+                let k = self.settings.stiffness.get(family).clamp(0.0, 1.0);
+                let n = self.settings.iterations.max(1) as f64;
+                Rule::Pbd {
+                    k: 1.0 - (1.0 - k).powf(1.0 / n),
+                }
+            }
+        }
+    }
+
+    /// One Gauss–Seidel sweep over the active families, then the grab, then the ground.
+    fn sweep(&mut self, h: f64) {
+        let active = self.settings.active;
+        if active.edges {
+            let rule = self.rule(Family::Distance, h);
+            project_all(
+                &mut self.edges,
+                &mut self.positions,
+                &self.inverse_masses,
+                rule,
+                distance::evaluate,
+            );
+        }
+        if active.plane {
+            let rule = self.rule(Family::Plane, h);
+            project_all(
+                &mut self.planes,
+                &mut self.positions,
+                &self.inverse_masses,
+                rule,
+                plane::evaluate,
+            );
+        }
+        if active.volume {
+            let rule = self.rule(Family::Volume, h);
+            project_all(
+                &mut self.volumes,
+                &mut self.positions,
+                &self.inverse_masses,
+                rule,
+                volume::evaluate,
+            );
+        }
+        self.project_soft_grab(h);
+        if self.settings.ground {
+            for (p, &w) in self.positions.iter_mut().zip(&self.inverse_masses) {
+                if w > 0.0 && p.y < 0.0 {
+                    p.y = 0.0;
+                }
+            }
+        }
+    }
+
+    fn project_soft_grab(&mut self, h: f64) {
+        let compliance = self.settings.grab_compliance;
+        let Some(grab) = self.grab.as_mut().filter(|_| compliance > 0.0) else {
+            return;
+        };
+        let i = grab.particle;
+        let evaluation = distance::evaluate(&[self.positions[i], grab.target], 0.0);
+        let rule = Rule::Xpbd {
+            alpha_tilde: compliance / (h * h),
+        };
+        if let Some(c) = correction(evaluation, [self.inverse_masses[i], 0.0], grab.lambda, rule) {
+            grab.lambda += c.delta_lambda;
+            self.positions[i] += c.delta_x[0];
+        }
+    }
+
+    fn update_velocities(&mut self, h: f64) {
+        let keep = (1.0 - self.settings.damping * h).max(0.0);
+        for i in 0..self.positions.len() {
+            self.velocities[i] = (self.positions[i] - self.previous[i]) / h * keep;
+        }
+    }
+}
+
+/// Projects every constraint of `set` once, in order (Gauss–Seidel).
+#[inline]
+fn project_all<const N: usize>(
+    set: &mut ConstraintSet<N>,
+    positions: &mut [DVec3],
+    inverse_masses: &[f64],
+    rule: Rule,
+    evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
+) {
+    for c in 0..set.particles.len() {
+        let idx = set.particles[c];
+        let evaluation = evaluate(&idx.map(|i| positions[i as usize]), set.rest[c]);
+        let weights = idx.map(|i| inverse_masses[i as usize]);
+        if let Some(correction) = correction(evaluation, weights, set.lambda[c], rule) {
+            set.lambda[c] += correction.delta_lambda;
+            for k in 0..N {
+                positions[idx[k] as usize] += correction.delta_x[k];
+            }
+        }
+    }
+}
+
+/// 1 / Σ (density × V₀ / 4) over the tets at each particle. A particle whose tets all have zero
+/// rest volume gets the mean mass, so it still moves.
+fn lumped_inverse_masses(mesh: &TetMesh, rest_volumes: &[f64]) -> Vec<f64> {
+    let mut masses = vec![0.0; mesh.positions.len()];
+    for (tet, &v) in mesh.tets.iter().zip(rest_volumes) {
+        for &i in tet {
+            masses[i as usize] += DENSITY * v.abs() / 4.0;
+        }
+    }
+    let positive: Vec<f64> = masses.iter().copied().filter(|&m| m > 0.0).collect();
+    let mean = if positive.is_empty() {
+        1.0
+    } else {
+        positive.iter().sum::<f64>() / positive.len() as f64
+    };
+    masses
+        .iter()
+        .map(|&m| 1.0 / if m > 0.0 { m } else { mean })
+        .collect()
+}

@@ -1,0 +1,394 @@
+//! The solver: what the geometry guarantees about the source note's claims, and the properties the
+//! rest of tetlab relies on (determinism, no allocation per step, pins, grabs, the ground,
+//! masses, XPBD and PBD stiffness).
+
+// A counting global allocator needs `unsafe impl GlobalAlloc`; it only forwards to `System`.
+#![allow(unsafe_code)]
+
+use glam::DVec3;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use tetlab_core::mesh::TetMesh;
+use tetlab_core::metrics::Metrics;
+use tetlab_core::scene::{Builtin, Perturbation, Scene};
+use tetlab_core::solver::{DENSITY, Method, PerFamily, Settings, Simulation};
+
+/// Counts allocations made by this test binary, to check that a step makes none.
+struct CountingAllocator;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+fn families(edges: bool, plane: bool, volume: bool) -> PerFamily<bool> {
+    PerFamily {
+        edges,
+        plane,
+        volume,
+    }
+}
+
+fn run(
+    builtin: Builtin,
+    perturbation: Option<Perturbation>,
+    settings: Settings,
+    frames: usize,
+) -> (Simulation, Metrics) {
+    let scene = Scene::builtin(builtin, 3).unwrap();
+    let mut simulation = Simulation::new(&scene, settings);
+    if let Some(p) = perturbation {
+        simulation.perturb(p);
+    }
+    for _ in 0..frames {
+        simulation.step();
+    }
+    let metrics = Metrics::measure(&simulation);
+    (simulation, metrics)
+}
+
+fn settings(active: PerFamily<bool>, gravity: f64) -> Settings {
+    Settings {
+        active,
+        gravity,
+        ground: gravity != 0.0,
+        ..Settings::default()
+    }
+}
+
+#[test]
+fn an_inverted_tet_stays_inverted_under_edges_alone() {
+    for gravity in [0.0, 9.81] {
+        let (_, m) = run(
+            Builtin::Tet,
+            Some(Perturbation::Invert),
+            settings(families(true, false, false), gravity),
+            300,
+        );
+        assert_eq!(m.inverted_tets, 1, "gravity {gravity}");
+        assert!(
+            m.max_edge_strain < 1e-4,
+            "the edges are satisfied: {}",
+            m.max_edge_strain
+        );
+    }
+}
+
+/// The four heights fix only four of a tet's six shape degrees of freedom: without gravity the
+/// tet comes back to its rest shape, but on the ground under gravity it un-inverts and then drifts
+/// along the two free ones (docs/experiments.md has the numbers).
+#[test]
+fn an_inverted_tet_recovers_under_the_height_constraints_alone() {
+    let (_, m) = run(
+        Builtin::Tet,
+        Some(Perturbation::Invert),
+        settings(families(false, true, false), 0.0),
+        300,
+    );
+    assert_eq!(m.inverted_tets, 0);
+    assert!(
+        (m.min_volume_ratio - 1.0).abs() < 1e-3,
+        "V/V0 = {}",
+        m.min_volume_ratio
+    );
+    let (_, m) = run(
+        Builtin::Tet,
+        Some(Perturbation::Invert),
+        settings(families(false, true, false), 9.81),
+        300,
+    );
+    assert_eq!(m.inverted_tets, 0);
+    assert!(
+        m.residual.plane < 1e-3 * m.residual.edges,
+        "the heights hold while the shape drifts"
+    );
+}
+
+#[test]
+fn an_inverted_tet_recovers_under_edges_and_volume() {
+    for gravity in [0.0, 9.81] {
+        let (_, m) = run(
+            Builtin::Tet,
+            Some(Perturbation::Invert),
+            settings(families(true, false, true), gravity),
+            300,
+        );
+        assert_eq!(m.inverted_tets, 0, "gravity {gravity}");
+        assert!((m.min_volume_ratio - 1.0).abs() < 1e-3);
+        assert!(m.max_edge_strain < 1e-3);
+    }
+}
+
+#[test]
+fn a_mirrored_cube_stays_fully_inverted_under_edges_alone() {
+    let (simulation, m) = run(
+        Builtin::Cube,
+        Some(Perturbation::Mirror),
+        settings(families(true, false, false), 9.81),
+        300,
+    );
+    assert_eq!(m.inverted_tets, simulation.tets().len());
+    assert!(
+        (m.min_volume_ratio + 1.0).abs() < 1e-3,
+        "every tet is its mirror image: {}",
+        m.min_volume_ratio
+    );
+}
+
+#[test]
+fn a_mirrored_cube_recovers_under_edges_and_volume() {
+    let (_, m) = run(
+        Builtin::Cube,
+        Some(Perturbation::Mirror),
+        settings(families(true, false, true), 9.81),
+        300,
+    );
+    assert_eq!(m.inverted_tets, 0);
+}
+
+#[test]
+fn same_inputs_give_the_same_bits() {
+    let settings = settings(families(true, true, true), 9.81);
+    let (a, _) = run(Builtin::Ball, Some(Perturbation::Scramble(5)), settings, 40);
+    let (b, _) = run(Builtin::Ball, Some(Perturbation::Scramble(5)), settings, 40);
+    let bits = |s: &Simulation| {
+        s.positions()
+            .iter()
+            .flat_map(|p| p.to_array())
+            .map(f64::to_bits)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&a), bits(&b));
+}
+
+#[test]
+fn a_step_allocates_nothing() {
+    for method in [Method::Xpbd, Method::Pbd] {
+        let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
+        let mut simulation = Simulation::new(
+            &scene,
+            Settings {
+                method,
+                active: families(true, true, true),
+                ..Settings::default()
+            },
+        );
+        simulation.grab(0, DVec3::new(0.0, 2.0, 0.0));
+        simulation.step();
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..5 {
+            simulation.step();
+        }
+        assert_eq!(ALLOCATIONS.load(Ordering::Relaxed), before, "{method:?}");
+    }
+}
+
+#[test]
+fn masses_are_lumped_from_density_times_rest_volume() {
+    let scene = Scene::builtin(Builtin::Ball, 2).unwrap();
+    let simulation = Simulation::new(&scene, Settings::default());
+    let total_mass: f64 = simulation.inverse_masses().iter().map(|w| 1.0 / w).sum();
+    let total_volume: f64 = simulation.volumes.rest.iter().sum();
+    assert!((total_mass - DENSITY * total_volume).abs() < 1e-9 * total_mass);
+}
+
+#[test]
+fn pinned_particles_stay_put_and_the_beam_sags() {
+    let scene = Scene::builtin(Builtin::Beam, 2).unwrap();
+    assert!(!scene.pinned.is_empty());
+    let mut simulation = Simulation::new(&scene, Settings::default());
+    for _ in 0..60 {
+        simulation.step();
+    }
+    for &i in &scene.pinned {
+        assert_eq!(
+            simulation.positions()[i as usize],
+            scene.mesh.positions[i as usize]
+        );
+    }
+    let tip_drop = (0..scene.mesh.positions.len())
+        .map(|i| scene.mesh.positions[i].y - simulation.positions()[i].y)
+        .fold(0.0, f64::max);
+    assert!(
+        tip_drop > 1e-3,
+        "the free end sags under gravity: {tip_drop}"
+    );
+}
+
+#[test]
+fn the_ground_holds_a_falling_body() {
+    let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
+    let mut simulation = Simulation::new(&scene, Settings::default());
+    simulation.perturb(Perturbation::Scramble(1));
+    for p in 0..simulation.positions().len() {
+        let lifted = simulation.positions()[p] + DVec3::Y;
+        simulation.place(p, lifted);
+    }
+    for _ in 0..120 {
+        simulation.step();
+        let lowest = simulation
+            .positions()
+            .iter()
+            .map(|p| p.y)
+            .fold(f64::INFINITY, f64::min);
+        assert!(lowest > -1e-3, "below the ground: {lowest}");
+    }
+    assert!(Metrics::measure(&simulation).inverted_tets == 0);
+}
+
+#[test]
+fn a_rigid_grab_carries_the_particle_and_release_hands_over_the_velocity() {
+    let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
+    let mut simulation = Simulation::new(
+        &scene,
+        Settings {
+            gravity: 0.0,
+            ground: false,
+            ..Settings::default()
+        },
+    );
+    let start = simulation.positions()[0];
+    simulation.grab(0, start);
+    let step = DVec3::new(0.0, 0.0, -0.01);
+    for k in 1..=10 {
+        simulation.move_grab(start + step * k as f64);
+        simulation.step();
+        assert_eq!(simulation.positions()[0], start + step * k as f64);
+    }
+    let mass_while_held = simulation.inverse_masses()[0];
+    simulation.release();
+    assert_eq!(mass_while_held, 0.0);
+    assert!(
+        simulation.inverse_masses()[0] > 0.0,
+        "release restores the mass"
+    );
+    let expected = step / simulation.settings().dt;
+    assert!(
+        (simulation.velocities()[0] - expected).length() < 1e-9,
+        "{}",
+        simulation.velocities()[0]
+    );
+}
+
+#[test]
+fn a_soft_grab_pulls_toward_the_target() {
+    let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
+    let settings = Settings {
+        gravity: 0.0,
+        ground: false,
+        grab_compliance: 1e-3,
+        ..Settings::default()
+    };
+    let mut simulation = Simulation::new(&scene, settings);
+    let start = simulation.positions()[0];
+    let target = start + DVec3::new(-0.5, 0.0, 0.0);
+    simulation.grab(0, target);
+    simulation.step();
+    let moved = simulation.positions()[0];
+    assert!(moved.distance(target) < start.distance(target));
+    assert!(
+        moved.distance(target) > 1e-6,
+        "a compliant grab does not snap"
+    );
+}
+
+/// One free particle hanging from three pinned ones by three edges: a single tet.
+fn hanging_tet(settings: Settings) -> Simulation {
+    let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+    let apex = 3;
+    let mut flipped = scene.clone();
+    // Hang the apex below the base: reflect it through the base plane y = 0, then lift everything.
+    flipped.mesh.positions[apex].y *= -1.0;
+    for p in &mut flipped.mesh.positions {
+        p.y += 2.0;
+    }
+    let (mesh, _) = TetMesh::new(flipped.mesh.positions.clone(), flipped.mesh.tets.clone());
+    let scene = Scene {
+        mesh,
+        pinned: vec![0, 1, 2],
+        ..flipped
+    };
+    Simulation::new(&scene, settings)
+}
+
+fn sag(settings: Settings) -> f64 {
+    let mut simulation = hanging_tet(settings);
+    let rest = simulation.positions()[3].y;
+    for _ in 0..600 {
+        simulation.step();
+    }
+    rest - simulation.positions()[3].y
+}
+
+#[test]
+fn xpbd_compliance_is_a_spring_whose_stiffness_does_not_depend_on_iterations() {
+    let base = Settings {
+        active: families(true, false, false),
+        ground: false,
+        damping: 5.0,
+        ..Settings::default()
+    };
+    let alpha = 1e-5;
+    let soft = |iterations| {
+        sag(Settings {
+            iterations,
+            compliance: PerFamily::splat(alpha),
+            ..base
+        })
+    };
+    let (one, twenty) = (soft(1), soft(20));
+    assert!(one > 1e-4, "a compliant edge stretches: {one}");
+    assert!(
+        (one - twenty).abs() < 0.02 * one,
+        "1 iteration sags {one}, 20 sag {twenty}"
+    );
+    let softer = sag(Settings {
+        compliance: PerFamily::splat(2.0 * alpha),
+        ..base
+    });
+    assert!(
+        (softer / one - 2.0).abs() < 0.05,
+        "sag ∝ α: {one} then {softer}"
+    );
+}
+
+#[test]
+fn pbd_stiffness_is_corrected_for_the_iteration_count() {
+    // A tet with its base pinned and only the volume constraint: V is linear in the apex, so each
+    // PBD projection removes exactly the fraction k′ of the error, and n iterations of
+    // k′ = 1 − (1 − k)^(1/n) leave 1 − k of it whatever n is.
+    let k = 0.5;
+    for iterations in [1, 4, 16] {
+        let scene = Scene {
+            pinned: vec![0, 1, 2],
+            ..Scene::builtin(Builtin::Tet, 1).unwrap()
+        };
+        let settings = Settings {
+            method: Method::Pbd,
+            active: families(false, false, true),
+            stiffness: PerFamily::splat(k),
+            iterations,
+            substeps: 1,
+            gravity: 0.0,
+            ground: false,
+            ..Settings::default()
+        };
+        let mut simulation = Simulation::new(&scene, settings);
+        let rest = simulation.positions()[3];
+        simulation.place(3, rest - DVec3::new(0.0, 0.3, 0.0));
+        let before = Metrics::measure(&simulation).volume_error;
+        simulation.substep();
+        let remaining = Metrics::measure(&simulation).volume_error / before;
+        assert!(
+            (remaining - (1.0 - k)).abs() < 1e-9,
+            "{iterations} iterations left {remaining} of the error"
+        );
+    }
+}

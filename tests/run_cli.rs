@@ -1,0 +1,167 @@
+//! `tetlab run` as a user runs it: defaults, JSON lines, the summary, the shared meshes, and bad
+//! options.
+
+mod support;
+
+use serde_json::Value;
+use support::{assert_usage_error, stderr, stdout, tetlab};
+
+fn json_lines(args: &[&str]) -> Vec<Value> {
+    let output = tetlab(args);
+    assert!(output.status.success(), "{args:?}: {}", stderr(&output));
+    stdout(&output)
+        .lines()
+        .map(|line| serde_json::from_str(line).expect("each line is one JSON object"))
+        .collect()
+}
+
+fn shared(name: &str) -> String {
+    format!("{}/../../shared/meshes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn json_prints_frame_zero_plus_one_line_per_frame() {
+    let lines = json_lines(&["run", "--frames", "5", "--json"]);
+    assert_eq!(lines.len(), 6);
+    for (i, line) in lines.iter().enumerate() {
+        assert_eq!(line["frame"], i as u64);
+        for key in [
+            "time",
+            "inverted_tets",
+            "min_volume_ratio",
+            "volume_error",
+            "max_edge_strain",
+        ] {
+            assert!(line[key].is_number(), "{key} in {line}");
+        }
+    }
+    assert_eq!(
+        (
+            lines[0]["particles"].as_u64(),
+            lines[0]["tets"].as_u64(),
+            lines[0]["edges"].as_u64()
+        ),
+        (Some(4), Some(1), Some(6))
+    );
+    assert!(lines[1].get("particles").is_none(), "sizes only on frame 0");
+    assert!((lines[5]["time"].as_f64().unwrap() - 5.0 / 60.0).abs() < 1e-12);
+}
+
+#[test]
+fn frames_zero_prints_the_loaded_scene_only() {
+    let lines = json_lines(&[
+        "run",
+        "--scene",
+        "cube",
+        "--resolution",
+        "2",
+        "--frames",
+        "0",
+        "--json",
+    ]);
+    assert_eq!(lines.len(), 1);
+    assert_eq!(lines[0]["tets"], 48);
+    assert_eq!(lines[0]["particles"], 27);
+}
+
+#[test]
+fn the_defaults_are_those_documented() {
+    let lines = json_lines(&["run", "--json"]);
+    assert_eq!(lines.len(), 301, "300 frames by default");
+    let output = tetlab(&["run", "--frames", "1"]);
+    let text = stdout(&output);
+    assert!(
+        text.contains("scene tet: 4 particles, 1 tets, 6 edges"),
+        "{text}"
+    );
+    assert!(
+        text.contains("xpbd, edges+volume, 10 substeps x 1 iteration, dt 0.016667 s, gravity 9.81"),
+        "{text}"
+    );
+}
+
+#[test]
+fn an_inverted_tet_recovers_in_the_summary_and_the_json() {
+    let output = tetlab(&["run", "--perturb", "invert", "--frames", "30"]);
+    assert!(
+        stdout(&output).contains("no inverted tets from frame"),
+        "{}",
+        stdout(&output)
+    );
+    let lines = json_lines(&[
+        "run",
+        "--perturb",
+        "invert",
+        "--constraints",
+        "edges",
+        "--frames",
+        "30",
+        "--json",
+    ]);
+    assert!(
+        lines.iter().all(|l| l["inverted_tets"] == 1),
+        "edges alone never un-invert"
+    );
+}
+
+#[test]
+fn shared_meshes_run_and_report_their_sizes() {
+    for (file, particles, tets) in [
+        ("bunny.node", 333, 1351),
+        ("armadillo_4k.ele", 1180, 3717),
+        ("ball_v22.msh", 470, 1812),
+        ("ball_v41.msh", 470, 1812),
+        ("beam_v41.msh", 423, 1208),
+    ] {
+        let lines = json_lines(&["run", "--scene", &shared(file), "--frames", "1", "--json"]);
+        assert_eq!(
+            (lines[0]["particles"].as_u64(), lines[0]["tets"].as_u64()),
+            (Some(particles), Some(tets)),
+            "{file}"
+        );
+    }
+}
+
+#[test]
+fn bad_options_are_one_line_naming_the_option_with_status_2() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["--scene", "nowhere"], "--scene"),
+        (&["--resolution", "0"], "--resolution"),
+        (&["--resolution", "x"], "--resolution"),
+        (&["--perturb", "twist"], "--perturb"),
+        (&["--perturb", "scramble:x"], "--perturb"),
+        (&["--constraints", "edges,bend"], "--constraints"),
+        (&["--solver", "verlet"], "--solver"),
+        (&["--substeps", "0"], "--substeps"),
+        (&["--iterations", "-1"], "--iterations"),
+        (&["--frames", "-5"], "--frames"),
+        (&["--dt", "0"], "--dt"),
+        (&["--dt", "-0.01"], "--dt"),
+        (&["--dt", "nan"], "--dt"),
+        (&["--gravity", "inf"], "--gravity"),
+        (&["--compliance", "edges"], "--compliance"),
+        (&["--compliance", "edges=-1"], "--compliance"),
+        (&["--stiffness", "volume=2"], "--stiffness"),
+        (&["--damping", "-1"], "--damping"),
+    ];
+    for (args, option) in cases {
+        let mut full = vec!["run"];
+        full.extend_from_slice(args);
+        assert_usage_error(&tetlab(&full), option);
+    }
+}
+
+#[test]
+fn a_broken_mesh_file_is_named_with_its_line() {
+    let dir = std::env::temp_dir().join(format!("tetlab-run-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("broken.msh");
+    std::fs::write(
+        &path,
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 zero 0\n$EndNodes\n",
+    )
+    .unwrap();
+    let output = tetlab(&["run", "--scene", path.to_str().unwrap()]);
+    let line = assert_usage_error(&output, "broken.msh:6: y: 'zero' is not a number");
+    assert!(line.starts_with("error: --scene: "), "{line}");
+}
