@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Everything a fresh machine needs, then every check and test of tetlab:
-# rustfmt and clippy (warnings are errors), then all tests of the workspace (unit, doc,
-# end to end). Exits non-zero on the first failure.
+# rustfmt and clippy (warnings are errors), Rerun's own checker on a recording tetlab writes,
+# then all tests of the workspace (unit, doc, end to end). Exits non-zero on the first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,5 +17,22 @@ echo "== cargo fmt --check"
 cargo fmt --all --check
 echo "== cargo clippy --all-targets -- -D warnings"
 cargo clippy --workspace --all-targets --locked -- -D warnings
+# Rerun's own checker on a recording tetlab writes (rerun-sdk of the same version as the crate).
+rerun_version=0.36.3
+venv="${TETLAB_RERUN_VENV:-/var/tmp/tetlab-rerun-$rerun_version}"
+if ! "$venv/bin/rerun" --version 2>/dev/null | grep -q "$rerun_version"; then
+  echo "== installing rerun-sdk $rerun_version into $venv"
+  python3 -m venv "$venv"
+  "$venv/bin/pip" install --quiet "rerun-sdk==$rerun_version"
+fi
+"$venv/bin/rerun" analytics disable >/dev/null 2>&1 || true
+scene=../shared/meshes/bunny.node
+[ -f "$scene" ] || scene=ball
+recording="$(mktemp -d)/check.rrd"
+echo "== rerun rrd verify (a recording of $scene)"
+cargo run --locked --quiet -- record --scene "$scene" --perturb flatten --gravity 10 \
+  --constraints edges,plane,volume --frames 60 --quiet --out "$recording"
+"$venv/bin/rerun" rrd verify "$recording"
+
 echo "== cargo test --workspace"
 cargo test --workspace --locked

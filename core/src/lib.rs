@@ -16,3 +16,4 @@ pub mod scene;
 pub mod solver;
 pub mod vector;
 pub mod verify;
+pub mod visual;

@@ -10,7 +10,7 @@ use glam::DVec3;
 pub const SLIVER: f64 = 1e-9;
 
 /// Measurements of one state of a simulation. All values are finite.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Metrics {
     /// Tets whose signed volume is negative.
     pub inverted_tets: usize,
@@ -26,6 +26,16 @@ pub struct Metrics {
 }
 
 impl Metrics {
+    /// The four headline measurements, by the names used in JSON, recordings and plots.
+    pub fn headline(&self) -> [(&'static str, f64); 4] {
+        [
+            ("inverted_tets", self.inverted_tets as f64),
+            ("volume_error", self.volume_error),
+            ("max_edge_strain", self.max_edge_strain),
+            ("min_volume_ratio", self.min_volume_ratio),
+        ]
+    }
+
     /// Measures the current state of `simulation`.
     pub fn measure(simulation: &Simulation) -> Metrics {
         let positions = simulation.positions();

@@ -33,7 +33,7 @@ pub enum Method {
 }
 
 /// One value per constraint family.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PerFamily<T> {
     /// Edge distance.
     pub edges: T,

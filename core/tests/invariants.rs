@@ -178,7 +178,7 @@ fn near_degenerate_configurations_stay_finite() {
             let (a, b) = ((v + 1) % 4, (v + 2) % 4);
             let mut q = p.clone();
             let along = q[a].lerp(q[b], rng.range(-1.0, 2.0));
-            let offset = (q[b] - q[a]).any_orthonormal_vector() * 1e-6;
+            let offset = (q[b] - q[a]).normalize().any_orthonormal_vector() * 1e-6;
             q[v] = along + offset;
             for family in [Family::Plane, Family::Volume] {
                 let e = family.evaluate(&q, 0.1);

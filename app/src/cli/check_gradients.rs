@@ -45,7 +45,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             }
         })
         .collect();
-    write(args, &rows, out).map_err(|e| UsageError(format!("stdout: {e}")))
+    write(args, &rows, out).map_err(UsageError::stdout)
 }
 
 fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()> {

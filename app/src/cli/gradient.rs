@@ -84,7 +84,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     } else {
         write_table(&output, out)
     };
-    written.map_err(|e| UsageError(format!("stdout: {e}")))
+    written.map_err(UsageError::stdout)
 }
 
 /// The components with −0 written as 0 (x + 0 is +0 for x = −0 and x otherwise).

@@ -6,6 +6,10 @@
 mod args;
 mod check_gradients;
 mod gradient;
+#[cfg(not(target_arch = "wasm32"))]
+mod inspect;
+#[cfg(not(target_arch = "wasm32"))]
+mod record;
 mod run;
 mod simulation_args;
 
@@ -29,15 +33,27 @@ enum Command {
     CheckGradients(check_gradients::Args),
     /// Run a scene headless and print its metrics per frame (--json) or a summary.
     Run(run::Args),
+    /// Run a scene headless and log it to a Rerun recording (.rrd) or a running viewer.
+    #[cfg(not(target_arch = "wasm32"))]
+    Record(record::Args),
+    /// Summarise a Rerun recording: entities, frames, metrics.
+    #[cfg(not(target_arch = "wasm32"))]
+    Inspect(inspect::Args),
 }
 
 /// An error caused by the user's input: printed as `error: <message>`, exit status 2.
 #[derive(Debug)]
 pub struct UsageError(pub String);
 
-impl<T: std::fmt::Display> From<T> for UsageError {
-    fn from(message: T) -> Self {
-        UsageError(message.to_string())
+impl UsageError {
+    /// Writing to stdout failed. A closed pipe (`tetlab run --json | head`) is not an error: the
+    /// reader has all it wanted, so [`main`] exits quietly.
+    pub fn stdout(error: std::io::Error) -> UsageError {
+        if error.kind() == std::io::ErrorKind::BrokenPipe {
+            UsageError(String::new())
+        } else {
+            UsageError(format!("stdout: {error}"))
+        }
     }
 }
 
@@ -49,17 +65,24 @@ pub fn main() -> ExitCode {
         Err(err) => return report_clap_error(err),
     };
     let mut stdout = std::io::stdout().lock();
+    let mut success = ExitCode::SUCCESS;
     let outcome = match cli.command {
         Command::Gradient(args) => gradient::run(&args, &mut stdout),
         Command::CheckGradients(args) => check_gradients::run(&args, &mut stdout),
         Command::Run(args) => run::run(&args, &mut stdout),
+        #[cfg(not(target_arch = "wasm32"))]
+        Command::Record(args) => record::run(&args, &mut stdout).map(|ending| {
+            if let record::Ending::Interrupted(_) = ending {
+                success = ExitCode::from(record::INTERRUPTED);
+            }
+        }),
+        #[cfg(not(target_arch = "wasm32"))]
+        Command::Inspect(args) => inspect::run(&args, &mut stdout),
     };
-    match outcome.and_then(|()| {
-        stdout
-            .flush()
-            .map_err(|e| UsageError(format!("stdout: {e}")))
-    }) {
-        Ok(()) => ExitCode::SUCCESS,
+    let flushed = outcome.and_then(|()| stdout.flush().map_err(UsageError::stdout));
+    match flushed {
+        Ok(()) => success,
+        Err(UsageError(message)) if message.is_empty() => success,
         Err(UsageError(message)) => {
             eprintln!("error: {message}");
             ExitCode::from(2)

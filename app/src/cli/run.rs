@@ -61,7 +61,7 @@ impl FrameRecord {
 /// Runs the simulation for `--frames` frames and reports.
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let (scene, mut simulation) = args.simulation.build()?;
-    let io = |e: std::io::Error| UsageError(format!("stdout: {e}"));
+    let io = UsageError::stdout;
     let initial = Metrics::measure(&simulation);
     if args.json {
         write_json(out, &FrameRecord::new(&simulation, &initial)).map_err(io)?;

@@ -1,0 +1,332 @@
+//! What to draw, derived from a simulation once for every front end: the recorder logs it and
+//! the GUI paints it, so both show the same arrows in the same colours.
+
+use crate::constraints::volume::signed_volume;
+use crate::constraints::{Family, distance, plane, volume};
+use crate::mesh::{TET_EDGES, TetMesh};
+use crate::solver::Simulation;
+use glam::DVec3;
+
+/// An sRGB colour with alpha, 0–255 per channel.
+pub type Rgba = [u8; 4];
+
+/// Tets and particles in good shape.
+pub const HEALTHY: Rgba = [150, 180, 210, 255];
+/// Inverted tets (signed volume < 0) and their particles.
+pub const INVERTED: Rgba = [220, 40, 40, 255];
+/// Edges.
+pub const EDGE: Rgba = [60, 60, 70, 255];
+
+/// The colour of a constraint family's arrows: edges orange, heights green, volume blue.
+pub fn family_colour(family: Family) -> Rgba {
+    match family {
+        Family::Distance => [240, 150, 20, 255],
+        Family::Plane => [40, 170, 60, 255],
+        Family::Volume => [50, 100, 230, 255],
+    }
+}
+
+/// The colour map of V/V₀: red at ≤ 0 (flat or inverted), through yellow at ½, to white at ≥ 1.
+pub fn volume_ratio_colour(ratio: f64) -> Rgba {
+    let t = if ratio.is_finite() {
+        ratio.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (r, g, b) = if t < 0.5 {
+        (1.0, 2.0 * t, 0.0)
+    } else {
+        (1.0, 1.0, 2.0 * (t - 0.5))
+    };
+    [(r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8, 255]
+}
+
+/// Whether each tet is inverted (signed volume < 0), in tet order.
+pub fn inverted_tets(positions: &[DVec3], tets: &[[u32; 4]], out: &mut Vec<bool>) {
+    out.clear();
+    out.extend(
+        tets.iter()
+            .map(|t| signed_volume(&t.map(|i| positions[i as usize])) < 0.0),
+    );
+}
+
+/// A particle's colour: [`INVERTED`] when it belongs to an inverted tet, [`HEALTHY`] otherwise.
+pub fn particle_colours(
+    particles: usize,
+    tets: &[[u32; 4]],
+    inverted: &[bool],
+    out: &mut Vec<Rgba>,
+) {
+    out.clear();
+    out.resize(particles, HEALTHY);
+    for (tet, &bad) in tets.iter().zip(inverted) {
+        if bad {
+            for &i in tet {
+                out[i as usize] = INVERTED;
+            }
+        }
+    }
+}
+
+/// The triangles worth drawing: every face of every tet when the mesh is small (so a single tet
+/// or a small block is seen whole), the boundary surface otherwise.
+pub fn display_faces(mesh: &TetMesh) -> Vec<[u32; 3]> {
+    if mesh.tets.len() <= ALL_FACES_UP_TO {
+        mesh.tets.iter().flat_map(crate::mesh::tet_faces).collect()
+    } else {
+        mesh.surface_faces()
+    }
+}
+
+/// Meshes with at most this many tets are drawn with all their faces and edges.
+pub const ALL_FACES_UP_TO: usize = 64;
+
+/// The edges worth drawing, to go with [`display_faces`]: every edge of a small mesh, the edges of
+/// the boundary surface otherwise. Sorted pairs (smaller index first), sorted.
+pub fn display_edges(mesh: &TetMesh) -> Vec<[u32; 2]> {
+    if mesh.tets.len() <= ALL_FACES_UP_TO {
+        return mesh.edges();
+    }
+    let mut edges: Vec<[u32; 2]> = mesh
+        .surface_faces()
+        .iter()
+        .flat_map(|f| [[f[0], f[1]], [f[1], f[2]], [f[2], f[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+/// Chains edges into polylines that draw every edge exactly once: a polyline of k points draws
+/// k − 1 edges, so a mesh's edges need far fewer points than two per edge. Greedy: each walk
+/// starts at the lowest vertex with an odd number of unused edges (or any unused edge), and follows
+/// unused edges, lowest neighbour first, until it is stuck. Deterministic.
+pub fn edge_strips(edges: &[[u32; 2]]) -> Vec<Vec<u32>> {
+    let vertices = edges
+        .iter()
+        .flatten()
+        .map(|&v| v as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut neighbours: Vec<Vec<(u32, usize)>> = vec![Vec::new(); vertices];
+    for (e, &[a, b]) in edges.iter().enumerate() {
+        neighbours[a as usize].push((b, e));
+        neighbours[b as usize].push((a, e));
+    }
+    for list in &mut neighbours {
+        list.sort_unstable();
+    }
+    let mut used = vec![false; edges.len()];
+    let mut unused_degree: Vec<usize> = neighbours.iter().map(Vec::len).collect();
+    let mut next = vec![0usize; vertices];
+    let mut strips = Vec::new();
+    let starts = (0..vertices)
+        .filter(|&v| unused_degree[v] % 2 == 1)
+        .chain(0..vertices)
+        .collect::<Vec<_>>();
+    for start in starts {
+        while unused_degree[start] > 0 {
+            let mut strip = vec![start as u32];
+            let mut at = start;
+            while let Some(&(to, e)) = neighbours[at][next[at]..].iter().find(|(_, e)| !used[*e]) {
+                used[e] = true;
+                unused_degree[at] -= 1;
+                unused_degree[to as usize] -= 1;
+                while next[at] < neighbours[at].len() && used[neighbours[at][next[at]].1] {
+                    next[at] += 1;
+                }
+                strip.push(to);
+                at = to as usize;
+            }
+            strips.push(strip);
+        }
+    }
+    strips
+}
+
+/// One gradient arrow: ∇ₚC of one constraint at one particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Arrow {
+    /// The family of the constraint.
+    pub family: Family,
+    /// The particle the arrow starts at.
+    pub particle: u32,
+    /// Where it starts: the particle's position.
+    pub origin: DVec3,
+    /// ∇ₚC itself (unscaled).
+    pub gradient: DVec3,
+}
+
+/// The gradient arrows of `family` on tet `tet`: ∇ₚC at each particle p of each of the family's
+/// constraints on that tet — 6 edges × 2 particles, 4 heights × 4 particles, or 1 volume × 4
+/// particles. Degenerate constraints have no arrows. Appends to `out`.
+pub fn tet_gradient_arrows(
+    simulation: &Simulation,
+    tet: usize,
+    family: Family,
+    out: &mut Vec<Arrow>,
+) {
+    let positions = simulation.positions();
+    let corners = simulation.tets()[tet];
+    let mut push = |particles: &[u32], gradients: &[DVec3]| {
+        for (&particle, &gradient) in particles.iter().zip(gradients) {
+            out.push(Arrow {
+                family,
+                particle,
+                origin: positions[particle as usize],
+                gradient,
+            });
+        }
+    };
+    match family {
+        Family::Distance => {
+            let edges = &simulation.edges;
+            for (a, b) in TET_EDGES {
+                let key = [corners[a].min(corners[b]), corners[a].max(corners[b])];
+                if let Ok(c) = edges.particles.binary_search(&key) {
+                    let p = key.map(|i| positions[i as usize]);
+                    let e = distance::evaluate(&p, edges.rest[c]);
+                    if !e.degenerate {
+                        push(&key, &e.gradients);
+                    }
+                }
+            }
+        }
+        Family::Plane => {
+            let planes = &simulation.planes;
+            for c in 4 * tet..4 * tet + 4 {
+                let idx = planes.particles[c];
+                let e = plane::evaluate(&idx.map(|i| positions[i as usize]), planes.rest[c]);
+                if !e.degenerate {
+                    push(&idx, &e.gradients);
+                }
+            }
+        }
+        Family::Volume => {
+            let volumes = &simulation.volumes;
+            let idx = volumes.particles[tet];
+            let e = volume::evaluate(&idx.map(|i| positions[i as usize]), volumes.rest[tet]);
+            if !e.degenerate {
+                push(&idx, &e.gradients);
+            }
+        }
+    }
+}
+
+/// The factor that turns the gradients of `arrows` into drawable vectors: the longest becomes
+/// `length`. Gradients of different families have different units (1, 1 and m²), so each family
+/// is scaled on its own.
+pub fn arrow_scale(arrows: &[Arrow], family: Family, length: f64) -> f64 {
+    let longest = arrows
+        .iter()
+        .filter(|a| a.family == family)
+        .map(|a| a.gradient.length())
+        .fold(0.0, f64::max);
+    if longest > 0.0 { length / longest } else { 0.0 }
+}
+
+/// The mean edge length of tet `tet`: the natural length scale for drawing on it.
+pub fn tet_size(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
+    TET_EDGES
+        .iter()
+        .map(|&(a, b)| positions[tet[a] as usize].distance(positions[tet[b] as usize]))
+        .sum::<f64>()
+        / 6.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Builtin, Perturbation, Scene};
+    use crate::solver::Settings;
+
+    #[test]
+    fn an_inverted_tet_is_red_and_its_volume_arrows_point_back_through_the_face() {
+        let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        simulation.perturb(Perturbation::Invert);
+        let mut inverted = Vec::new();
+        inverted_tets(simulation.positions(), simulation.tets(), &mut inverted);
+        assert_eq!(inverted, [true]);
+        let mut colours = Vec::new();
+        particle_colours(4, simulation.tets(), &inverted, &mut colours);
+        assert!(colours.iter().all(|&c| c == INVERTED));
+
+        let mut arrows = Vec::new();
+        tet_gradient_arrows(&simulation, 0, Family::Volume, &mut arrows);
+        assert_eq!(arrows.len(), 4);
+        // Vertex 0 was reflected through the face (1, 2, 3): its arrow points back across it.
+        let p = simulation.positions();
+        let normal = (p[2] - p[1]).cross(p[3] - p[1]);
+        let side = (p[0] - p[1]).dot(normal).signum();
+        assert!(
+            arrows[0].gradient.dot(normal) * side < 0.0,
+            "the arrow crosses back over the face"
+        );
+
+        for (family, count) in [(Family::Distance, 12), (Family::Plane, 16)] {
+            let mut arrows = Vec::new();
+            tet_gradient_arrows(&simulation, 0, family, &mut arrows);
+            assert_eq!(arrows.len(), count, "{family:?}");
+            assert!(
+                (arrow_scale(&arrows, family, 0.5)
+                    * arrows
+                        .iter()
+                        .map(|a| a.gradient.length())
+                        .fold(0.0, f64::max)
+                    - 0.5)
+                    .abs()
+                    < 1e-12
+            );
+        }
+    }
+
+    #[test]
+    fn small_meshes_show_all_faces_and_large_ones_their_surface() {
+        let tet = Scene::builtin(Builtin::Tet, 1).unwrap();
+        assert_eq!(display_faces(&tet.mesh).len(), 4);
+        let cube = Scene::builtin(Builtin::Cube, 4).unwrap();
+        assert_eq!(display_faces(&cube.mesh).len(), 6 * 4 * 4 * 2);
+    }
+
+    #[test]
+    fn edge_strips_draw_every_edge_exactly_once_with_fewer_points() {
+        let bunny_like = Scene::builtin(Builtin::Ball, 3).unwrap();
+        for edges in [bunny_like.mesh.edges(), display_edges(&bunny_like.mesh)] {
+            let strips = edge_strips(&edges);
+            let mut drawn: Vec<[u32; 2]> = strips
+                .iter()
+                .flat_map(|s| s.windows(2).map(|w| [w[0].min(w[1]), w[0].max(w[1])]))
+                .collect();
+            drawn.sort_unstable();
+            assert_eq!(drawn, edges, "every edge once, no other");
+            let points: usize = strips.iter().map(Vec::len).sum();
+            assert!(
+                points < edges.len() * 2 * 3 / 4,
+                "{points} points for {} edges",
+                edges.len()
+            );
+        }
+        assert!(edge_strips(&[]).is_empty());
+    }
+
+    #[test]
+    fn large_meshes_draw_their_surface_edges() {
+        let ball = Scene::builtin(Builtin::Ball, 3).unwrap();
+        let surface = display_edges(&ball.mesh);
+        assert!(surface.len() < ball.mesh.edges().len());
+        // A closed triangulated surface has 3F/2 edges.
+        assert_eq!(surface.len() * 2, display_faces(&ball.mesh).len() * 3);
+        let tet = Scene::builtin(Builtin::Tet, 1).unwrap();
+        assert_eq!(display_edges(&tet.mesh).len(), 6);
+    }
+
+    #[test]
+    fn the_volume_colour_map_runs_from_red_to_white() {
+        assert_eq!(volume_ratio_colour(-3.0), [255, 0, 0, 255]);
+        assert_eq!(volume_ratio_colour(0.5), [255, 255, 0, 255]);
+        assert_eq!(volume_ratio_colour(1.7), [255, 255, 255, 255]);
+        assert_eq!(volume_ratio_colour(f64::NAN), [255, 0, 0, 255]);
+    }
+}

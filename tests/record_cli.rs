@@ -1,0 +1,314 @@
+//! `tetlab record` end to end: the file it writes is read back with Rerun's decoder (through
+//! `tetlab inspect`) and compared with the simulation that `tetlab run` reports.
+
+mod support;
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+use support::{assert_usage_error, stderr, stdout, tetlab};
+
+fn scratch(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tetlab-record-{}-{test}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn inspect(path: &Path) -> Value {
+    let output = tetlab(&["inspect", path.to_str().unwrap(), "--json"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    serde_json::from_str(&stdout(&output)).unwrap()
+}
+
+fn strings(value: &Value) -> Vec<&str> {
+    value
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect()
+}
+
+const RUN: [&str; 10] = [
+    "--scene",
+    "cube",
+    "--resolution",
+    "2",
+    "--perturb",
+    "mirror",
+    "--constraints",
+    "edges,plane,volume",
+    "--frames",
+    "20",
+];
+
+#[test]
+fn a_recording_holds_every_entity_frame_particle_and_metric_of_the_run() {
+    let path = scratch("full").join("cube.rrd");
+    let mut args = vec!["record", "--out", path.to_str().unwrap()];
+    args.extend(RUN);
+    let output = tetlab(&args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(
+        stdout(&output).contains("frames 0..=20"),
+        "{}",
+        stdout(&output)
+    );
+    assert!(
+        !path.with_extension("rrd.partial").exists(),
+        "the partial file was moved into place"
+    );
+
+    let summary = inspect(&path);
+    assert_eq!(summary["frames"], serde_json::json!([0, 20]));
+    let entities = summary["entities"].as_object().unwrap();
+    for entity in [
+        "world",
+        "world/particles",
+        "world/mesh",
+        "world/edges",
+        "world/gradients/edges",
+        "world/gradients/plane",
+        "world/gradients/volume",
+        "metrics/inverted_tets",
+        "metrics/volume_error",
+        "metrics/max_edge_strain",
+        "metrics/min_volume_ratio",
+    ] {
+        assert!(entities.contains_key(entity), "missing {entity}");
+    }
+    for per_frame in [
+        "world/particles",
+        "world/mesh",
+        "world/edges",
+        "world/gradients/volume",
+        "metrics/volume_error",
+    ] {
+        assert_eq!(
+            entities[per_frame]["frame_rows"], 21,
+            "{per_frame}: one row per frame"
+        );
+    }
+    // Unchanging data only once: topology and styles are static and never repeated per frame.
+    let mesh = &entities["world/mesh"];
+    assert_eq!(
+        strings(&mesh["static_components"]),
+        ["Mesh3D:triangle_indices"]
+    );
+    assert!(!strings(&mesh["frame_components"]).contains(&"Mesh3D:triangle_indices"));
+    assert_eq!(
+        strings(&entities["world"]["static_components"]),
+        ["ViewCoordinates:xyz"]
+    );
+
+    let particles = summary["particles"].as_array().unwrap();
+    assert_eq!(particles.len(), 21);
+    assert!(
+        particles.iter().all(|p| p[1] == 27),
+        "every particle, every frame"
+    );
+
+    // The metrics are the very numbers `tetlab run --json` prints for the same options.
+    let mut run_args = vec!["run", "--json"];
+    run_args.extend(RUN);
+    let run = tetlab(&run_args);
+    let frames: Vec<Value> = stdout(&run)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    for name in [
+        "inverted_tets",
+        "volume_error",
+        "max_edge_strain",
+        "min_volume_ratio",
+    ] {
+        let series = summary["metrics"][name].as_array().unwrap();
+        assert_eq!(series.len(), 21, "{name}");
+        for (recorded, printed) in series.iter().zip(&frames) {
+            assert_eq!(recorded[0], printed["frame"]);
+            assert_eq!(
+                recorded[1].as_f64(),
+                printed[name].as_f64(),
+                "{name} at frame {}",
+                printed["frame"]
+            );
+        }
+    }
+    let inverted = &summary["metrics"]["inverted_tets"];
+    assert_eq!(
+        inverted[0][1], 48.0,
+        "mirrored: every tet inverted at frame 0"
+    );
+    assert_eq!(inverted[20][1], 0.0, "recovered by frame 20");
+}
+
+#[test]
+fn arrows_none_logs_no_gradients_and_all_logs_every_tet() {
+    let dir = scratch("arrows");
+    let none = dir.join("none.rrd");
+    let all = dir.join("all.rrd");
+    for (path, mode) in [(&none, "none"), (&all, "all")] {
+        let output = tetlab(&[
+            "record",
+            "--scene",
+            "cube",
+            "--resolution",
+            "1",
+            "--frames",
+            "2",
+            "--arrows",
+            mode,
+            "--out",
+            path.to_str().unwrap(),
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+    }
+    assert_eq!(
+        inspect(&none)["entities"]["world/gradients/volume"]["frame_rows"],
+        0
+    );
+    assert_eq!(
+        inspect(&all)["entities"]["world/gradients/volume"]["frame_rows"],
+        3
+    );
+}
+
+/// Ctrl-C stops after the current frame and leaves a complete recording of every finished frame.
+#[test]
+fn an_interrupted_recording_is_complete_up_to_the_last_frame() {
+    let path = scratch("interrupt").join("long.rrd");
+    let partial = path.with_extension("rrd.partial");
+    let child = Command::new(env!("CARGO_BIN_EXE_tetlab"))
+        .args([
+            "record",
+            "--scene",
+            "cube",
+            "--frames",
+            "10000000",
+            "--quiet",
+            "--out",
+            path.to_str().unwrap(),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while std::fs::metadata(&partial).map(|m| m.len()).unwrap_or(0) < 200_000 {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "the recording never grew"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let output = child.wait_with_output().unwrap();
+    assert_eq!(output.status.code(), Some(130), "{}", stderr(&output));
+    assert!(stderr(&output).contains("interrupted: the recording holds frames 0..="));
+
+    let summary = inspect(&path);
+    let (first, last) = (
+        summary["frames"][0].as_i64().unwrap(),
+        summary["frames"][1].as_i64().unwrap(),
+    );
+    assert_eq!(first, 0);
+    assert!(last > 0);
+    for name in ["inverted_tets", "volume_error"] {
+        assert_eq!(
+            summary["metrics"][name].as_array().unwrap().len() as i64,
+            last + 1,
+            "{name}: every finished frame"
+        );
+    }
+    assert_eq!(
+        summary["particles"].as_array().unwrap().len() as i64,
+        last + 1
+    );
+}
+
+#[test]
+fn bad_options_and_unwritable_paths_are_one_line_errors() {
+    let dir = scratch("errors");
+    let ok = dir.join("ok.rrd");
+    let ok = ok.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["--out", "/nonexistent/dir/x.rrd"],
+            "--out /nonexistent/dir/x.rrd: cannot create the file",
+        ),
+        (vec!["--out", dir.to_str().unwrap()], "is a directory"),
+        (vec!["--out", ok, "--tet", "1"], "--tet: 1 is out of range"),
+        (vec!["--out", ok, "--arrows", "some"], "--arrows"),
+        (vec![], "--out"),
+        (vec!["--out", ok, "--connect"], "cannot be used with"),
+        (vec!["--out", ok, "--scene", "nowhere"], "--scene"),
+        (vec!["--out", ok, "--frames", "-1"], "--frames"),
+    ];
+    for (args, names) in cases {
+        let mut full = vec!["record"];
+        full.extend(args);
+        assert_usage_error(&tetlab(&full), names);
+    }
+    assert!(!Path::new(ok).exists());
+}
+
+/// A disk that is full: the partial file is a link to /dev/full, where every write fails.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_is_reported_and_leaves_nothing_behind() {
+    let path = scratch("full-disk").join("x.rrd");
+    let partial = path.with_extension("rrd.partial");
+    let _ = std::fs::remove_file(&partial);
+    std::os::unix::fs::symlink("/dev/full", &partial).unwrap();
+    let output = tetlab(&["record", "--frames", "5", "--out", path.to_str().unwrap()]);
+    assert_usage_error(&output, "No space left on device");
+    assert!(!path.exists());
+}
+
+#[test]
+fn a_viewer_that_is_not_there_is_reported() {
+    let output = tetlab(&["record", "--frames", "1", "--connect", "127.0.0.1:9"]);
+    assert_usage_error(&output, "--connect rerun+http://127.0.0.1:9/proxy");
+}
+
+#[test]
+fn inspect_refuses_what_is_not_a_recording() {
+    let path = scratch("inspect").join("not.rrd");
+    std::fs::write(&path, "hello").unwrap();
+    assert_usage_error(
+        &tetlab(&["inspect", path.to_str().unwrap()]),
+        "not.rrd: not a Rerun recording",
+    );
+    assert_usage_error(
+        &tetlab(&["inspect", "/nonexistent.rrd"]),
+        "/nonexistent.rrd: cannot read",
+    );
+}
+
+#[test]
+fn inspect_refuses_a_cut_off_recording() {
+    let dir = scratch("cut");
+    let path = dir.join("whole.rrd");
+    let output = tetlab(&[
+        "record",
+        "--scene",
+        "cube",
+        "--frames",
+        "30",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert!(output.status.success());
+    let bytes = std::fs::read(&path).unwrap();
+    let cut = dir.join("cut.rrd");
+    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    assert_usage_error(
+        &tetlab(&["inspect", cut.to_str().unwrap()]),
+        "incomplete recording",
+    );
+}
