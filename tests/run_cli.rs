@@ -165,3 +165,19 @@ fn a_broken_mesh_file_is_named_with_its_line() {
     let line = assert_usage_error(&output, "broken.msh:6: y: 'zero' is not a number");
     assert!(line.starts_with("error: --scene: "), "{line}");
 }
+
+#[test]
+fn a_diverging_run_stops_with_one_line_and_no_nonsense_numbers() {
+    let output = tetlab(&["run", "--gravity", "-1e300", "--frames", "5", "--json"]);
+    let err = stderr(&output);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        err.starts_with("error: the simulation diverged at frame 1"),
+        "{err}"
+    );
+    assert_eq!(
+        stdout(&output).lines().count(),
+        1,
+        "only the sound frame 0 is printed"
+    );
+}

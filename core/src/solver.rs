@@ -123,6 +123,10 @@ impl Default for Settings {
     }
 }
 
+/// The largest coordinate or velocity component (in m or m/s) a sound simulation has: below it,
+/// volumes (cubes), squared residuals and their sums over any mesh stay finite in f64.
+pub const SOUND_LIMIT: f64 = 1e30;
+
 /// Density used to lump masses: 1000 kg/m³.
 pub const DENSITY: f64 = 1000.0;
 
@@ -342,6 +346,16 @@ impl Simulation {
     /// Simulated time in seconds.
     pub fn time(&self) -> f64 {
         self.time
+    }
+
+    /// Whether every coordinate and velocity component is finite and below [`SOUND_LIMIT`] in
+    /// size. A step with extreme settings (say gravity 10³⁰⁰ and nothing to stop the fall) leaves
+    /// that range; front ends check this and stop.
+    pub fn is_sound(&self) -> bool {
+        self.positions
+            .iter()
+            .chain(&self.velocities)
+            .all(|v| v.abs().max_element() < SOUND_LIMIT)
     }
 
     /// Whether particle `i` is pinned.

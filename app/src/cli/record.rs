@@ -110,7 +110,11 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
             ending = Ending::Interrupted(simulation.frame());
             break;
         }
-        simulation.step();
+        if let Err(diverged) = SimulationArgs::step(&mut simulation) {
+            progress.finish();
+            target.close(rec, simulation.frame() - 1, &writer_errors, out)?;
+            return Err(diverged);
+        }
         recorder.log_frame(&simulation);
         progress.advance();
     }

@@ -91,7 +91,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let mut last_inverted_frame = (initial.inverted_tets > 0).then_some(0);
     let mut last = initial;
     for _ in 0..args.simulation.frames {
-        simulation.step();
+        SimulationArgs::step(&mut simulation)?;
         last = Metrics::measure(&simulation);
         if last.inverted_tets > 0 {
             last_inverted_frame = Some(simulation.frame());

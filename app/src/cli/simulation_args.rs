@@ -73,6 +73,20 @@ impl SimulationArgs {
         settings
     }
 
+    /// Advances one frame; an error if the state overflowed (it can only with extreme options).
+    pub fn step(simulation: &mut Simulation) -> Result<(), UsageError> {
+        simulation.step();
+        if simulation.is_sound() {
+            Ok(())
+        } else {
+            Err(UsageError(format!(
+                "the simulation diverged at frame {}: a coordinate or velocity passed 1e30 \
+                 (try a smaller --dt or --gravity)",
+                simulation.frame()
+            )))
+        }
+    }
+
     /// Loads the scene, builds the simulation and applies the perturbation.
     pub fn build(&self) -> Result<(Scene, Simulation), UsageError> {
         let scene = Scene::from_spec(&self.scene, self.resolution)
@@ -99,7 +113,7 @@ impl SimulationArgs {
             s.iterations,
             if s.iterations == 1 { "" } else { "s" },
             s.dt,
-            s.gravity
+            short_number(s.gravity)
         );
         for (family, alpha) in &self.compliance {
             text += &format!(", compliance {}={alpha}", family_name(*family));
@@ -108,6 +122,16 @@ impl SimulationArgs {
             text += &format!(", stiffness {}={k}", family_name(*family));
         }
         text
+    }
+}
+
+/// `x` as written by Rust when that is short (9.81), in scientific notation otherwise (1e300).
+fn short_number(x: f64) -> String {
+    let plain = x.to_string();
+    if plain.len() <= 12 {
+        plain
+    } else {
+        format!("{x:e}")
     }
 }
 
