@@ -5,6 +5,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# The workbench's screenless snapshot tests render with wgpu on Mesa's software Vulkan (lavapipe).
+if ! dpkg -s mesa-vulkan-drivers >/dev/null 2>&1; then
+  echo "== installing mesa-vulkan-drivers (software Vulkan for the snapshot tests)"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers >/dev/null
+fi
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+
 missing=()
 for component in rustfmt clippy; do
   rustup component list --installed 2>/dev/null | grep -q "^$component" || missing+=("$component")

@@ -1,9 +1,7 @@
-//! `tetlab`: the command-line entry point. Each subcommand lives in its own module under `cli/`.
-
-mod cli;
+//! `tetlab`: the workbench when started without a subcommand, otherwise the subcommand.
 
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    cli::main()
+    tetlab::cli::main()
 }

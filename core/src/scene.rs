@@ -3,7 +3,7 @@
 //! positions to set up an experiment (invert one tet, mirror the body, flatten it, scramble it).
 
 use crate::constraints::volume::signed_volume;
-use crate::mesh::{MeshError, TetMesh};
+use crate::mesh::{LoadReport, MeshError, TetMesh};
 use crate::random::SplitMix64;
 use glam::DVec3;
 use std::fmt;
@@ -132,10 +132,19 @@ impl Scene {
         })
     }
 
-    /// A scene from a mesh file. A mesh that reaches below the ground (y < 0) is lifted to rest
-    /// on it.
+    /// A scene from a mesh file (TetGen or Gmsh, by extension).
     pub fn load(path: &Path) -> Result<Scene, MeshError> {
-        let (mut mesh, report) = TetMesh::load(path)?;
+        let (mesh, report) = TetMesh::load(path)?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| path.display().to_string());
+        Ok(Scene::from_mesh(name, mesh, report))
+    }
+
+    /// A scene from a loaded mesh. A mesh that reaches below the ground (y < 0) is lifted to rest
+    /// on it; the notes say so, after what loading reported.
+    pub fn from_mesh(name: String, mut mesh: TetMesh, report: LoadReport) -> Scene {
         let mut notes = report.notes();
         let lowest = mesh
             .positions
@@ -151,16 +160,12 @@ impl Scene {
                 -lowest
             ));
         }
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| path.display().to_string());
-        Ok(Scene {
+        Scene {
             name,
             mesh,
             pinned: Vec::new(),
             notes,
-        })
+        }
     }
 }
 
@@ -285,12 +290,7 @@ impl Perturbation {
         match self {
             Perturbation::Invert => {
                 if let Some(tet) = mesh.tets.first() {
-                    let [a, b, c, d] = tet.map(|i| positions[i as usize]);
-                    let normal = (c - b).cross(d - b);
-                    if normal.length_squared() > 0.0 {
-                        let n = normal.normalize();
-                        positions[tet[0] as usize] = a - 2.0 * (a - b).dot(n) * n;
-                    }
+                    reflect_through_opposite_face(positions, tet, 0);
                 }
             }
             Perturbation::Mirror => {
@@ -319,6 +319,32 @@ impl Perturbation {
                 }
             }
         }
+    }
+}
+
+/// Reflects corner `k` of `tet` through the plane of the other three corners: p′ = p − 2((p − a)·n)n
+/// with n the unit normal of that face. The three edges at the corner keep their lengths and the
+/// tet's signed volume changes sign. A face of zero area has no plane: nothing moves.
+///
+/// ```
+/// use glam::DVec3;
+/// use tetlab_core::constraints::volume::signed_volume;
+/// use tetlab_core::scene::reflect_through_opposite_face;
+/// let mut p = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+/// reflect_through_opposite_face(&mut p, &[0, 1, 2, 3], 3);
+/// assert_eq!(p[3], -DVec3::Z);
+/// assert!(signed_volume(&[p[0], p[1], p[2], p[3]]) < 0.0);
+/// ```
+pub fn reflect_through_opposite_face(positions: &mut [DVec3], tet: &[u32; 4], k: usize) {
+    let others: Vec<DVec3> = (0..4)
+        .filter(|&j| j != k)
+        .map(|j| positions[tet[j] as usize])
+        .collect();
+    let normal = (others[1] - others[0]).cross(others[2] - others[0]);
+    if normal.length_squared() > 0.0 {
+        let n = normal.normalize();
+        let p = positions[tet[k] as usize];
+        positions[tet[k] as usize] = p - 2.0 * (p - others[0]).dot(n) * n;
     }
 }
 

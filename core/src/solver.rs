@@ -25,6 +25,7 @@ use glam::DVec3;
 
 /// XPBD or PBD.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Method {
     /// Extended PBD: compliance per family, λ accumulated within a substep.
     Xpbd,
@@ -34,6 +35,7 @@ pub enum Method {
 
 /// One value per constraint family.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PerFamily<T> {
     /// Edge distance.
     pub edges: T,
@@ -74,6 +76,7 @@ impl<T: Copy> PerFamily<T> {
 
 /// How the simulation runs. Every field may change between steps.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Settings {
     /// XPBD or PBD.
     pub method: Method,

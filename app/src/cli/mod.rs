@@ -17,12 +17,13 @@ use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::process::ExitCode;
 
-/// tetlab: a workbench for position-based dynamics on tetrahedra.
+/// tetlab: a workbench for position-based dynamics on tetrahedra. Without a subcommand it opens
+/// the interactive workbench.
 #[derive(Debug, Parser)]
 #[command(name = "tetlab", version, about, propagate_version = true)]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -66,7 +67,16 @@ pub fn main() -> ExitCode {
     };
     let mut stdout = std::io::stdout().lock();
     let mut success = ExitCode::SUCCESS;
-    let outcome = match cli.command {
+    let Some(command) = cli.command else {
+        return match crate::gui::run_native() {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(message) => {
+                eprintln!("error: the workbench could not start: {message}");
+                ExitCode::FAILURE
+            }
+        };
+    };
+    let outcome = match command {
         Command::Gradient(args) => gradient::run(&args, &mut stdout),
         Command::CheckGradients(args) => check_gradients::run(&args, &mut stdout),
         Command::Run(args) => run::run(&args, &mut stdout),

@@ -1,0 +1,335 @@
+//! What the 3D view draws, as triangles and lines: built each frame from the workbench, with the
+//! colours and arrows of `tetlab_core::visual` (the same the recorder logs).
+
+use super::render::{Geometry, Vertex};
+use super::workbench::Workbench;
+use glam::{DVec3, Vec3};
+use tetlab_core::constraints::Family;
+use tetlab_core::constraints::volume::signed_volume;
+use tetlab_core::mesh::TetMesh;
+use tetlab_core::visual::{self, Arrow, Rgba};
+
+/// Display options of the 3D view.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct ViewOptions {
+    /// Draw every tet face, translucent, instead of the outer surface.
+    pub see_through: bool,
+    /// Colour faces by V/V₀ instead of inverted/healthy.
+    pub colour_by_volume: bool,
+    /// Draw particles as handles.
+    pub particles: bool,
+    /// Draw edges.
+    pub edges: bool,
+    /// Draw the gradient arrows of the selected tet.
+    pub arrows: bool,
+    /// Draw arrows on every tet (small meshes only).
+    pub arrows_on_all_tets: bool,
+    /// Arrow length factor.
+    pub arrow_scale: f32,
+}
+
+impl Default for ViewOptions {
+    fn default() -> Self {
+        Self {
+            see_through: false,
+            colour_by_volume: false,
+            particles: true,
+            edges: true,
+            arrows: true,
+            arrows_on_all_tets: false,
+            arrow_scale: 1.0,
+        }
+    }
+}
+
+/// Meshes with at most this many tets may show arrows on every tet.
+pub const ARROWS_ON_ALL_UP_TO: usize = 64;
+
+/// Selected tets and particles.
+const SELECTED: Rgba = [250, 200, 40, 255];
+/// The particle under the pointer.
+const HOVERED: Rgba = [255, 255, 255, 255];
+/// Pinned particles.
+const PINNED: Rgba = [40, 40, 40, 255];
+/// The ground grid.
+const GRID: Rgba = [120, 120, 120, 255];
+
+/// Per-scene data the view reuses every frame: which faces and edges to draw.
+pub struct SceneCache {
+    surface_faces: Vec<([u32; 3], u32)>,
+    all_faces: Vec<([u32; 3], u32)>,
+    display_edges: Vec<[u32; 2]>,
+    all_edges: Vec<[u32; 2]>,
+    /// The size of the rest body (bounding-box diagonal).
+    pub size: f64,
+}
+
+impl SceneCache {
+    /// The faces and edges of `mesh`.
+    pub fn new(mesh: &TetMesh) -> Self {
+        let (lo, hi) = bounds(&mesh.positions);
+        Self {
+            surface_faces: visual::faces_with_tets(
+                mesh,
+                mesh.tets.len() <= visual::ALL_FACES_UP_TO,
+            ),
+            all_faces: visual::faces_with_tets(mesh, true),
+            display_edges: visual::display_edges(mesh),
+            all_edges: mesh.edges(),
+            size: (hi - lo).length().max(1e-6),
+        }
+    }
+}
+
+/// The box around `positions`.
+pub fn bounds(positions: &[DVec3]) -> (DVec3, DVec3) {
+    positions.iter().fold(
+        (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
+
+/// Builds everything the view draws this frame.
+pub fn build(
+    bench: &Workbench,
+    cache: &SceneCache,
+    options: &ViewOptions,
+    hovered: Option<usize>,
+) -> Geometry {
+    let simulation = &bench.simulation;
+    let positions = simulation.positions();
+    let tets = simulation.tets();
+    let mut inverted = Vec::new();
+    visual::inverted_tets(positions, tets, &mut inverted);
+    let mut geometry = Geometry::default();
+
+    let (faces, alpha) = if options.see_through {
+        (&cache.all_faces, 90)
+    } else {
+        (&cache.surface_faces, 255)
+    };
+    for &(face, tet) in faces {
+        let tet = tet as usize;
+        // Inverted wins over everything, the selection included (its edges are outlined instead).
+        let mut colour = if inverted[tet] {
+            visual::INVERTED
+        } else if bench.selected_tet == Some(tet) {
+            SELECTED
+        } else if options.colour_by_volume {
+            let rest = simulation.volumes.rest[tet];
+            let ratio = if rest > 0.0 {
+                signed_volume(&tets[tet].map(|i| positions[i as usize])) / rest
+            } else {
+                1.0
+            };
+            visual::volume_ratio_colour(ratio)
+        } else {
+            visual::HEALTHY
+        };
+        colour[3] = alpha;
+        let target = if alpha < 255 {
+            &mut geometry.transparent
+        } else {
+            &mut geometry.triangles
+        };
+        triangle(
+            target,
+            face.map(|i| positions[i as usize].as_vec3()),
+            colour,
+        );
+    }
+
+    if options.edges {
+        let edges = if options.see_through {
+            &cache.all_edges
+        } else {
+            &cache.display_edges
+        };
+        for &[a, b] in edges {
+            line(
+                &mut geometry.lines,
+                positions[a as usize].as_vec3(),
+                positions[b as usize].as_vec3(),
+                visual::EDGE,
+            );
+        }
+    }
+    if let Some(tet) = bench.selected_tet {
+        let corners = tets[tet];
+        for (a, b) in tetlab_core::mesh::TET_EDGES {
+            line(
+                &mut geometry.lines,
+                positions[corners[a] as usize].as_vec3(),
+                positions[corners[b] as usize].as_vec3(),
+                SELECTED,
+            );
+        }
+    }
+
+    if options.particles {
+        let mut colours = Vec::new();
+        visual::particle_colours(positions.len(), tets, &inverted, &mut colours);
+        let radius = (0.012 * cache.size) as f32;
+        for (i, p) in positions.iter().enumerate() {
+            let colour = if hovered == Some(i) {
+                HOVERED
+            } else if bench.selected_particle == Some(i) || bench.dragging == Some(i) {
+                SELECTED
+            } else if simulation.is_pinned(i) {
+                PINNED
+            } else {
+                colours[i]
+            };
+            octahedron(&mut geometry.triangles, p.as_vec3(), radius, colour);
+        }
+    }
+
+    if simulation.settings().ground {
+        ground_grid(&mut geometry.lines, simulation.rest_positions(), cache.size);
+    }
+
+    if options.arrows {
+        let all = options.arrows_on_all_tets && tets.len() <= ARROWS_ON_ALL_UP_TO;
+        let chosen: Vec<usize> = if all {
+            (0..tets.len()).collect()
+        } else {
+            bench.selected_tet.into_iter().collect()
+        };
+        let mut arrows = Vec::new();
+        for family in Family::ALL
+            .into_iter()
+            .filter(|&f| simulation.settings().active.get(f))
+        {
+            for &tet in &chosen {
+                arrows.clear();
+                visual::tet_gradient_arrows(simulation, tet, family, &mut arrows);
+                let length =
+                    0.35 * visual::tet_size(positions, &tets[tet]) * options.arrow_scale as f64;
+                let scale = visual::arrow_scale(&arrows, family, length);
+                for arrow in &arrows {
+                    draw_arrow(&mut geometry, arrow, scale, visual::family_colour(family));
+                }
+            }
+        }
+    }
+    geometry
+}
+
+fn vertex(position: Vec3, normal: Vec3, color: Rgba) -> Vertex {
+    Vertex {
+        position: position.to_array(),
+        normal: normal.to_array(),
+        color,
+    }
+}
+
+fn triangle(out: &mut Vec<Vertex>, [a, b, c]: [Vec3; 3], colour: Rgba) {
+    let normal = (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Y);
+    out.extend([a, b, c].map(|p| vertex(p, normal, colour)));
+}
+
+fn line(out: &mut Vec<Vertex>, a: Vec3, b: Vec3, colour: Rgba) {
+    out.extend([vertex(a, Vec3::Y, colour), vertex(b, Vec3::Y, colour)]);
+}
+
+/// A particle handle: a small octahedron.
+fn octahedron(out: &mut Vec<Vertex>, centre: Vec3, r: f32, colour: Rgba) {
+    let axes = [Vec3::X, Vec3::Y, Vec3::Z];
+    for sx in [-1.0f32, 1.0] {
+        for sy in [-1.0f32, 1.0] {
+            for sz in [-1.0f32, 1.0] {
+                let (a, b, c) = (axes[0] * sx * r, axes[1] * sy * r, axes[2] * sz * r);
+                let corners = if sx * sy * sz > 0.0 {
+                    [a, b, c]
+                } else {
+                    [a, c, b]
+                };
+                triangle(out, corners.map(|v| centre + v), colour);
+            }
+        }
+    }
+}
+
+/// A gradient arrow: a shaft from the particle along ∇C × scale and a cone at its tip.
+fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow, scale: f64, colour: Rgba) {
+    let start = arrow.origin.as_vec3();
+    let vector = (arrow.gradient * scale).as_vec3();
+    let length = vector.length();
+    if length <= 0.0 || !length.is_finite() {
+        return;
+    }
+    let tip = start + vector;
+    line(&mut geometry.lines, start, tip, colour);
+    let direction = vector / length;
+    let head = 0.2 * length;
+    let base = tip - direction * head;
+    let side = direction.any_orthonormal_vector() * (0.35 * head);
+    let other = direction.cross(side);
+    let segments = 8;
+    for k in 0..segments {
+        let angle = |k: usize| std::f32::consts::TAU * k as f32 / segments as f32;
+        let ring = |a: f32| base + side * a.cos() + other * a.sin();
+        let (p, q) = (ring(angle(k)), ring(angle(k + 1)));
+        triangle(&mut geometry.triangles, [tip, p, q], colour);
+        triangle(&mut geometry.triangles, [base, q, p], colour);
+    }
+}
+
+/// Grid lines on y = 0 around the rest body, 20 cells across three times its size.
+fn ground_grid(out: &mut Vec<Vertex>, rest: &[DVec3], size: f64) {
+    let (lo, hi) = bounds(rest);
+    let centre = (lo + hi) * 0.5;
+    let half = 1.5 * size;
+    let cells = 20;
+    for k in 0..=cells {
+        let t = -half + 2.0 * half * k as f64 / cells as f64;
+        let x = (centre.x + t) as f32;
+        let z = (centre.z + t) as f32;
+        let (x0, x1) = ((centre.x - half) as f32, (centre.x + half) as f32);
+        let (z0, z1) = ((centre.z - half) as f32, (centre.z + half) as f32);
+        line(out, Vec3::new(x, 0.0, z0), Vec3::new(x, 0.0, z1), GRID);
+        line(out, Vec3::new(x0, 0.0, z), Vec3::new(x1, 0.0, z), GRID);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tetlab_core::scene::Builtin;
+    use tetlab_core::solver::Settings;
+
+    #[test]
+    fn an_inverted_selected_tet_gets_arrows_and_the_geometry_is_well_formed() {
+        let mut bench = Workbench::builtin(Builtin::Tet, 1, Settings::default());
+        bench.invert_selected();
+        let cache = SceneCache::new(&bench.scene.mesh);
+        let geometry = build(&bench, &cache, &ViewOptions::default(), None);
+        assert_eq!(geometry.triangles.len() % 3, 0);
+        assert_eq!(geometry.lines.len() % 2, 0);
+        let arrow_colour = visual::family_colour(Family::Volume);
+        assert!(
+            geometry.lines.iter().any(|v| v.color == arrow_colour),
+            "volume arrows are drawn"
+        );
+        assert!(
+            geometry
+                .triangles
+                .iter()
+                .chain(&geometry.lines)
+                .all(|v| v.position.iter().all(|x| x.is_finite()))
+        );
+    }
+
+    #[test]
+    fn see_through_draws_every_face_translucent() {
+        let bench = Workbench::builtin(Builtin::Cube, 2, Settings::default());
+        let cache = SceneCache::new(&bench.scene.mesh);
+        let options = ViewOptions {
+            see_through: true,
+            ..ViewOptions::default()
+        };
+        let geometry = build(&bench, &cache, &options, None);
+        assert_eq!(geometry.transparent.len(), 48 * 4 * 3);
+    }
+}

@@ -1,0 +1,151 @@
+//! Playback, the scene, and the solver settings.
+
+use crate::gui::workbench::Workbench;
+use eframe::egui;
+use tetlab_core::constraints::Family;
+use tetlab_core::scene::Builtin;
+use tetlab_core::solver::Method;
+
+/// A scene the user asked for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneRequest {
+    /// A built-in scene at a resolution.
+    Builtin(Builtin, u32),
+    /// A mesh file.
+    File(String),
+}
+
+/// What the scene section edits between frames.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct SceneChoice {
+    /// The built-in scene's name.
+    pub builtin: String,
+    /// Its resolution.
+    pub resolution: u32,
+    /// The path typed in the "mesh file" field.
+    pub path: String,
+}
+
+impl Default for SceneChoice {
+    fn default() -> Self {
+        Self {
+            builtin: "cube".into(),
+            resolution: 3,
+            path: String::new(),
+        }
+    }
+}
+
+/// Shows playback and solver controls; returns a scene to load, if the user asked for one.
+pub fn show(
+    ui: &mut egui::Ui,
+    bench: &mut Workbench,
+    choice: &mut SceneChoice,
+) -> Option<SceneRequest> {
+    ui.heading("Playback");
+    ui.horizontal(|ui| {
+        let label = if bench.playing { "Pause" } else { "Play" };
+        if ui.button(label).on_hover_text("Space").clicked() {
+            bench.set_playing(!bench.playing);
+        }
+        if ui.button("Step frame").on_hover_text("N").clicked() {
+            bench.step_frame();
+        }
+        if ui.button("Step substep").on_hover_text("U").clicked() {
+            bench.step_substep();
+        }
+    });
+
+    ui.separator();
+    ui.heading("Scene");
+    let mut request = None;
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_label("built-in")
+            .selected_text(choice.builtin.clone())
+            .show_ui(ui, |ui| {
+                for builtin in Builtin::ALL {
+                    ui.selectable_value(
+                        &mut choice.builtin,
+                        builtin.name().to_owned(),
+                        builtin.name(),
+                    );
+                }
+            });
+    });
+    ui.add(egui::Slider::new(&mut choice.resolution, 1..=12).text("resolution"));
+    if ui.button("Load built-in scene").clicked() {
+        let builtin = Builtin::from_name(&choice.builtin).unwrap_or(Builtin::Cube);
+        request = Some(SceneRequest::Builtin(builtin, choice.resolution));
+    }
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::TextEdit::singleline(&mut choice.path)
+                .hint_text(".msh, .node or .ele path")
+                .desired_width(170.0),
+        )
+        .labelled_by(ui.label("mesh file").id);
+        if ui
+            .add_enabled(!choice.path.trim().is_empty(), egui::Button::new("Open"))
+            .clicked()
+        {
+            request = Some(SceneRequest::File(choice.path.trim().to_owned()));
+        }
+    });
+    ui.label(format!(
+        "{}: {} particles, {} tets",
+        bench.scene.name,
+        bench.simulation.positions().len(),
+        bench.simulation.tets().len()
+    ));
+    for note in &bench.scene.notes {
+        ui.small(note);
+    }
+
+    ui.separator();
+    ui.heading("Solver");
+    let mut settings = *bench.simulation.settings();
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");
+        ui.radio_value(&mut settings.method, Method::Pbd, "PBD");
+    });
+    for family in Family::ALL {
+        let name = match family {
+            Family::Distance => "edges",
+            Family::Plane => "heights (plane)",
+            Family::Volume => "volume",
+        };
+        ui.horizontal(|ui| {
+            let mut active = settings.active.get(family);
+            ui.checkbox(&mut active, name);
+            settings.active.set(family, active);
+            match settings.method {
+                Method::Xpbd => {
+                    let mut alpha = settings.compliance.get(family);
+                    ui.add(
+                        egui::DragValue::new(&mut alpha)
+                            .range(0.0..=10.0)
+                            .speed(1e-4)
+                            .prefix("alpha "),
+                    )
+                    .on_hover_text("XPBD compliance: 0 is rigid, larger is softer");
+                    settings.compliance.set(family, alpha);
+                }
+                Method::Pbd => {
+                    let mut k = settings.stiffness.get(family);
+                    ui.add(egui::Slider::new(&mut k, 0.0..=1.0).text("k"));
+                    settings.stiffness.set(family, k);
+                }
+            }
+        });
+    }
+    ui.add(egui::Slider::new(&mut settings.substeps, 1..=50).text("substeps"));
+    ui.add(egui::Slider::new(&mut settings.iterations, 1..=20).text("iterations"));
+    ui.add(egui::Slider::new(&mut settings.gravity, 0.0..=20.0).text("gravity"));
+    ui.checkbox(&mut settings.ground, "ground (y = 0)");
+    ui.add(egui::Slider::new(&mut settings.damping, 0.0..=10.0).text("damping"));
+    if settings != *bench.simulation.settings() {
+        bench.set_settings(settings);
+    }
+    request
+}

@@ -1,0 +1,7 @@
+//! The side panels of the workbench, one file each.
+
+pub mod controls;
+pub mod display;
+pub mod help;
+pub mod readouts;
+pub mod tools;

@@ -1,0 +1,59 @@
+//! Live numbers and their plots over time.
+
+use crate::gui::workbench::{Sample, Workbench};
+use eframe::egui;
+use egui_plot::{Legend, Line, Plot, PlotPoints};
+use std::time::Duration;
+
+/// Shows the metrics of the current frame and plots of the recent ones.
+pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration) {
+    let m = &bench.metrics;
+    egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
+        for (label, value) in [
+            (
+                "frame",
+                format!(
+                    "{} (t = {:.2} s)",
+                    bench.simulation.frame(),
+                    bench.simulation.time()
+                ),
+            ),
+            (
+                "inverted tets",
+                format!("{} of {}", m.inverted_tets, bench.simulation.tets().len()),
+            ),
+            ("min V/V0", format!("{:.4}", m.min_volume_ratio)),
+            ("volume error", format!("{:.3e}", m.volume_error)),
+            ("max edge strain", format!("{:.3e}", m.max_edge_strain)),
+            (
+                "step time",
+                format!("{:.2} ms", step_time.as_secs_f64() * 1e3),
+            ),
+        ] {
+            ui.label(label);
+            ui.monospace(value);
+            ui.end_row();
+        }
+    });
+    let series = |name: &str, value: fn(&Sample) -> f64| {
+        Line::new(
+            name.to_owned(),
+            PlotPoints::from_iter(bench.history.iter().map(|s| [s.time, value(s)])),
+        )
+    };
+    Plot::new("inverted plot")
+        .height(110.0)
+        .legend(Legend::default())
+        .allow_scroll(false)
+        .show(ui, |plot| {
+            plot.line(series("inverted tets", |s| s.metrics.inverted_tets as f64));
+        });
+    Plot::new("volume plot")
+        .height(110.0)
+        .legend(Legend::default())
+        .allow_scroll(false)
+        .show(ui, |plot| {
+            plot.line(series("min V/V0", |s| s.metrics.min_volume_ratio));
+            plot.line(series("volume error", |s| s.metrics.volume_error));
+        });
+}

@@ -1,0 +1,52 @@
+//! The keyboard shortcuts: one table, read by the key handler and by the help panel.
+
+use eframe::egui::Key;
+
+/// Something a key does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    /// Play or pause.
+    PlayPause,
+    /// Advance one frame.
+    StepFrame,
+    /// Advance one substep.
+    StepSubstep,
+    /// Back to the rest shape.
+    Reset,
+    /// Invert the selected tet.
+    InvertSelected,
+    /// Mirror the whole body.
+    Mirror,
+    /// Flatten the whole body.
+    Flatten,
+    /// Scramble the whole body.
+    Scramble,
+    /// Pin or free the selected particle.
+    TogglePin,
+    /// Select the next tet of the selected particle.
+    NextTet,
+    /// Frame the body in the view.
+    FrameView,
+    /// Show or hide the help.
+    Help,
+}
+
+/// Every shortcut: key, action, what the help says.
+pub const SHORTCUTS: [(Key, Action, &str); 12] = [
+    (Key::Space, Action::PlayPause, "play / pause"),
+    (Key::N, Action::StepFrame, "step one frame"),
+    (Key::U, Action::StepSubstep, "step one substep"),
+    (Key::R, Action::Reset, "reset to rest"),
+    (Key::I, Action::InvertSelected, "invert the selected tet"),
+    (Key::M, Action::Mirror, "mirror everything"),
+    (Key::F, Action::Flatten, "flatten everything"),
+    (Key::S, Action::Scramble, "scramble"),
+    (
+        Key::P,
+        Action::TogglePin,
+        "pin / unpin the selected particle",
+    ),
+    (Key::T, Action::NextTet, "next tet of the selected particle"),
+    (Key::V, Action::FrameView, "frame the body"),
+    (Key::H, Action::Help, "this help"),
+];

@@ -1,0 +1,311 @@
+//! The workbench's state apart from any widget: the scene, the simulation, what is selected and
+//! held, and the recent metrics. Every action a panel or the 3D view offers is a method here.
+
+use glam::DVec3;
+use std::collections::VecDeque;
+use tetlab_core::metrics::Metrics;
+use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
+use tetlab_core::solver::{Settings, Simulation};
+
+/// How many frames of metrics the plots keep.
+pub const HISTORY: usize = 600;
+
+/// One point of the metric plots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Simulated time, seconds.
+    pub time: f64,
+    /// The metrics at that time.
+    pub metrics: Metrics,
+}
+
+/// The scene being simulated and everything the user has chosen about it.
+pub struct Workbench {
+    /// The loaded scene (rest shape).
+    pub scene: Scene,
+    /// The simulation of it.
+    pub simulation: Simulation,
+    /// Whether frames advance by themselves.
+    pub playing: bool,
+    /// The selected particle.
+    pub selected_particle: Option<usize>,
+    /// The selected tet (one containing the selected particle).
+    pub selected_tet: Option<usize>,
+    /// The particle being dragged.
+    pub dragging: Option<usize>,
+    /// Recent metrics, oldest first.
+    pub history: VecDeque<Sample>,
+    /// The metrics of the current state.
+    pub metrics: Metrics,
+    /// Seed of the next scramble.
+    pub scramble_seed: u64,
+}
+
+impl Workbench {
+    /// A workbench on `scene`, paused at rest, with tet 0 and its first corner selected.
+    pub fn new(scene: Scene, settings: Settings) -> Self {
+        let simulation = Simulation::new(&scene, settings);
+        let mut workbench = Workbench {
+            scene,
+            metrics: Metrics::measure(&simulation),
+            simulation,
+            playing: false,
+            selected_particle: None,
+            selected_tet: None,
+            dragging: None,
+            history: VecDeque::with_capacity(HISTORY),
+            scramble_seed: 1,
+        };
+        workbench.select_tet(0);
+        workbench.record();
+        workbench
+    }
+
+    /// A built-in scene at a resolution (clamped to what [`Scene::builtin`] accepts).
+    pub fn builtin(builtin: Builtin, resolution: u32, settings: Settings) -> Self {
+        let resolution = resolution.clamp(1, 16);
+        let scene = Scene::builtin(builtin, resolution).expect("resolution is in range");
+        Workbench::new(scene, settings)
+    }
+
+    /// Replaces the scene, keeping the settings.
+    pub fn load(&mut self, scene: Scene) {
+        *self = Workbench::new(scene, *self.simulation.settings());
+    }
+
+    /// Advances one frame.
+    pub fn step_frame(&mut self) {
+        self.simulation.step();
+        self.after_change();
+    }
+
+    /// Advances one substep (Δt / substeps), without counting a frame.
+    pub fn step_substep(&mut self) {
+        self.simulation.substep();
+        self.after_change();
+    }
+
+    /// Back to the rest shape.
+    pub fn reset(&mut self) {
+        self.simulation.reset();
+        self.history.clear();
+        self.after_change();
+    }
+
+    /// Applies a perturbation to the whole body.
+    pub fn perturb(&mut self, perturbation: Perturbation) {
+        self.simulation.perturb(perturbation);
+        self.after_change();
+    }
+
+    /// Scrambles with the next seed.
+    pub fn scramble(&mut self) {
+        self.perturb(Perturbation::Scramble(self.scramble_seed));
+        self.scramble_seed += 1;
+    }
+
+    /// Reflects the selected particle through the opposite face of the selected tet: that tet
+    /// inverts with its edge lengths kept.
+    pub fn invert_selected(&mut self) {
+        let (Some(particle), Some(tet)) = (self.selected_particle, self.selected_tet) else {
+            return;
+        };
+        let corners = self.simulation.tets()[tet];
+        let Some(k) = corners.iter().position(|&i| i as usize == particle) else {
+            return;
+        };
+        let mut positions = self.simulation.positions().to_vec();
+        reflect_through_opposite_face(&mut positions, &corners, k);
+        self.simulation.place(particle, positions[particle]);
+        self.after_change();
+    }
+
+    /// Pins the selected particle, or frees it if pinned.
+    pub fn toggle_pin(&mut self) {
+        if let Some(i) = self.selected_particle {
+            let pinned = self.simulation.is_pinned(i);
+            self.simulation.set_pinned(i, !pinned);
+        }
+    }
+
+    /// Selects a particle and the first tet that contains it.
+    pub fn select_particle(&mut self, particle: usize) {
+        self.selected_particle = Some(particle);
+        let first = self.tets_of(particle).next();
+        self.selected_tet = first;
+    }
+
+    /// Selects a tet and its first corner.
+    pub fn select_tet(&mut self, tet: usize) {
+        if let Some(corners) = self.simulation.tets().get(tet) {
+            self.selected_tet = Some(tet);
+            self.selected_particle = Some(corners[0] as usize);
+        }
+    }
+
+    /// Selects the next tet that contains the selected particle.
+    pub fn next_tet_of_selected(&mut self) {
+        let Some(particle) = self.selected_particle else {
+            return;
+        };
+        let tets: Vec<usize> = self.tets_of(particle).collect();
+        if tets.is_empty() {
+            return;
+        }
+        let at = self
+            .selected_tet
+            .and_then(|t| tets.iter().position(|&x| x == t));
+        self.selected_tet = Some(tets[at.map_or(0, |i| (i + 1) % tets.len())]);
+    }
+
+    fn tets_of(&self, particle: usize) -> impl Iterator<Item = usize> + '_ {
+        self.simulation
+            .tets()
+            .iter()
+            .enumerate()
+            .filter(move |(_, t)| t.contains(&(particle as u32)))
+            .map(|(i, _)| i)
+    }
+
+    /// Starts dragging a particle toward `target`: held by the grab constraint while playing,
+    /// moved directly (kinematically) while paused.
+    pub fn start_drag(&mut self, particle: usize, target: DVec3) {
+        self.select_particle(particle);
+        self.dragging = Some(particle);
+        if self.playing {
+            self.simulation.grab(particle, target);
+        } else {
+            self.simulation.place(particle, target);
+            self.after_change();
+        }
+    }
+
+    /// Moves the dragged particle's target.
+    pub fn drag_to(&mut self, target: DVec3) {
+        let Some(particle) = self.dragging else {
+            return;
+        };
+        if self.simulation.grabbed().is_some() {
+            self.simulation.move_grab(target);
+        } else {
+            self.simulation.place(particle, target);
+            self.after_change();
+        }
+    }
+
+    /// Lets go of the dragged particle.
+    pub fn end_drag(&mut self) {
+        self.dragging = None;
+        self.simulation.release();
+    }
+
+    /// Starts or stops playing; a drag in progress switches between grab and kinematic moves.
+    pub fn set_playing(&mut self, playing: bool) {
+        self.playing = playing;
+        if let Some(particle) = self.dragging {
+            let position = self.simulation.positions()[particle];
+            if playing {
+                self.simulation.grab(particle, position);
+            } else {
+                self.simulation.release();
+                self.simulation.place(particle, position);
+            }
+        }
+    }
+
+    /// Changes the solver settings.
+    pub fn set_settings(&mut self, settings: Settings) {
+        self.simulation.set_settings(settings);
+        self.after_change();
+    }
+
+    fn after_change(&mut self) {
+        self.metrics = Metrics::measure(&self.simulation);
+        self.record();
+    }
+
+    fn record(&mut self) {
+        if self.history.len() == HISTORY {
+            self.history.pop_front();
+        }
+        self.history.push_back(Sample {
+            time: self.simulation.time(),
+            metrics: self.metrics,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverting_the_selected_tet_then_playing_recovers_it() {
+        let mut bench = Workbench::builtin(Builtin::Cube, 2, Settings::default());
+        bench.select_tet(5);
+        bench.invert_selected();
+        assert!(bench.metrics.inverted_tets >= 1);
+        bench.set_playing(true);
+        for _ in 0..60 {
+            bench.step_frame();
+        }
+        assert_eq!(bench.metrics.inverted_tets, 0);
+    }
+
+    #[test]
+    fn a_paused_drag_moves_the_particle_and_a_running_drag_pulls_it() {
+        let mut bench = Workbench::builtin(
+            Builtin::Cube,
+            2,
+            Settings {
+                gravity: 0.0,
+                ground: false,
+                ..Settings::default()
+            },
+        );
+        let target = bench.simulation.positions()[0] + DVec3::new(0.0, 0.0, -0.3);
+        bench.start_drag(0, target);
+        assert_eq!(
+            bench.simulation.positions()[0],
+            target,
+            "paused: the particle goes where it is put"
+        );
+        bench.end_drag();
+        bench.set_playing(true);
+        let start = bench.simulation.positions()[3];
+        let pulled = start + DVec3::new(0.0, 0.5, 0.0);
+        bench.start_drag(3, pulled);
+        bench.step_frame();
+        assert_eq!(
+            bench.simulation.positions()[3],
+            pulled,
+            "running: held rigidly by the grab"
+        );
+        bench.end_drag();
+        assert!(bench.simulation.inverse_masses()[3] > 0.0);
+    }
+
+    #[test]
+    fn selection_cycles_through_the_tets_of_a_particle() {
+        let mut bench = Workbench::builtin(Builtin::Cube, 2, Settings::default());
+        bench.select_particle(13);
+        let first = bench.selected_tet.unwrap();
+        bench.next_tet_of_selected();
+        assert_ne!(bench.selected_tet, Some(first));
+        assert!(bench.simulation.tets()[bench.selected_tet.unwrap()].contains(&13));
+    }
+
+    #[test]
+    fn pins_toggle_and_history_is_bounded() {
+        let mut bench = Workbench::builtin(Builtin::Tet, 1, Settings::default());
+        bench.select_particle(2);
+        bench.toggle_pin();
+        assert!(bench.simulation.is_pinned(2));
+        bench.toggle_pin();
+        assert!(!bench.simulation.is_pinned(2));
+        for _ in 0..HISTORY + 10 {
+            bench.step_frame();
+        }
+        assert_eq!(bench.history.len(), HISTORY);
+    }
+}

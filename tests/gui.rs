@@ -1,0 +1,257 @@
+//! The workbench, screenless: egui_kittest drives it like a user (buttons, keys, a mouse drag)
+//! and renders it with wgpu on a software adapter. Each test checks the state and the pixels of
+//! the 3D view, and compares a snapshot in tests/snapshots/ (refresh with UPDATE_SNAPSHOTS=1).
+
+use eframe::egui;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use tetlab::gui::{Preferences, TetlabApp, viewport};
+use tetlab_core::visual;
+
+fn workbench(scene: &str, resolution: u32) -> Harness<'static, TetlabApp> {
+    let mut preferences = Preferences::default();
+    preferences.scene.builtin = scene.into();
+    preferences.scene.resolution = resolution;
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .wgpu()
+        .build_eframe(move |cc| {
+            let mut app = TetlabApp::new(cc).expect("the wgpu renderer is there");
+            app.load(
+                tetlab_core::scene::Scene::from_spec(&preferences.scene.builtin, resolution)
+                    .unwrap(),
+            );
+            app.preferences = preferences.clone();
+            app
+        });
+    harness.run_steps(3);
+    harness
+}
+
+/// How many pixels of the 3D view, outside the legend in its top-left corner, are close to
+/// `colour` (after two-sided lighting, so the hue is compared, not the brightness).
+fn pixels_like(harness: &mut Harness<'static, TetlabApp>, colour: visual::Rgba) -> usize {
+    let image = harness.render().expect("renders");
+    let rect = harness.state().viewport.rect;
+    let scale = image.width() as f32 / 1280.0;
+    let mut count = 0;
+    for y in (rect.min.y * scale) as u32..(rect.max.y * scale) as u32 {
+        for x in (rect.min.x * scale) as u32..(rect.max.x * scale) as u32 {
+            let in_legend = (x as f32) < (rect.min.x + 180.0) * scale
+                && (y as f32) < (rect.min.y + 100.0) * scale;
+            if in_legend {
+                continue;
+            }
+            let p = image
+                .get_pixel(x.min(image.width() - 1), y.min(image.height() - 1))
+                .0;
+            let hue = |c: [u8; 4]| {
+                let sum = c[0] as f32 + c[1] as f32 + c[2] as f32 + 1.0;
+                [c[0] as f32 / sum, c[1] as f32 / sum, c[2] as f32 / sum]
+            };
+            let (a, b) = (hue(p), hue(colour));
+            if (a[0] - b[0]).abs() + (a[1] - b[1]).abs() + (a[2] - b[2]).abs() < 0.08
+                && p[0] as u32 + p[1] as u32 + p[2] as u32 > 120
+            {
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+fn click_at(harness: &mut Harness<'static, TetlabApp>, pos: egui::Pos2) {
+    harness.event(egui::Event::PointerMoved(pos));
+    harness.run_steps(1);
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Default::default(),
+        });
+        harness.run_steps(1);
+    }
+}
+
+#[test]
+fn the_initial_scene_shows_the_body_in_the_3d_view() {
+    let mut harness = workbench("cube", 3);
+    assert_eq!(harness.state().bench.simulation.tets().len(), 162);
+    assert!(
+        pixels_like(&mut harness, visual::HEALTHY) > 5000,
+        "the cube is drawn"
+    );
+    harness.snapshot("workbench_initial");
+}
+
+/// A corner tet of a cube, selected by clicking its particle, inverted with the tool, recovered by
+/// playing.
+#[test]
+fn a_tet_inverted_through_the_ui_turns_red_with_arrows_and_recovers_when_played() {
+    let mut harness = workbench("cube", 2);
+    // Click the particle at the top front corner (the camera looks from +x, +y, +z).
+    let corner = 26;
+    let (rect, camera) = (
+        harness.state().viewport.rect,
+        harness.state().viewport.camera,
+    );
+    let (at, _) = viewport::project(
+        &camera,
+        rect,
+        harness.state().bench.simulation.positions()[corner],
+    )
+    .unwrap();
+    click_at(&mut harness, at);
+    assert_eq!(harness.state().bench.selected_particle, Some(corner));
+    harness.get_by_label("Invert selected tet").click();
+    harness.run_steps(2);
+    assert!(harness.state().bench.metrics.inverted_tets >= 1);
+    harness.snapshot("tet_inverted");
+    assert!(
+        pixels_like(&mut harness, visual::INVERTED) > 1000,
+        "the inverted tet is red"
+    );
+    assert!(
+        pixels_like(
+            &mut harness,
+            visual::family_colour(tetlab_core::constraints::Family::Volume)
+        ) > 50,
+        "volume arrows"
+    );
+
+    harness.get_by_label("Play").click();
+    harness.run_steps(60);
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 0);
+    // The rigid snap-back launches the body out of the view (an open issue); V frames it again.
+    harness.get_by_label("Pause").click();
+    harness.key_press(egui::Key::V);
+    harness.run_steps(2);
+    harness.snapshot("tet_recovered");
+    assert!(
+        pixels_like(&mut harness, visual::INVERTED) < 50,
+        "no red left"
+    );
+    assert!(
+        pixels_like(&mut harness, visual::HEALTHY) > 5000,
+        "the cube is still in view"
+    );
+}
+
+#[test]
+fn keys_drive_the_workbench() {
+    let mut harness = workbench("cube", 2);
+    harness.key_press(egui::Key::M);
+    harness.run_steps(1);
+    assert_eq!(
+        harness.state().bench.metrics.inverted_tets,
+        48,
+        "M mirrors every tet"
+    );
+    harness.key_press(egui::Key::R);
+    harness.run_steps(1);
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 0, "R resets");
+    harness.key_press(egui::Key::Space);
+    harness.run_steps(1);
+    assert!(harness.state().bench.playing);
+}
+
+#[test]
+fn dragging_a_particle_while_paused_moves_it() {
+    let mut harness = workbench("tet", 1);
+    let (rect, camera) = (
+        harness.state().viewport.rect,
+        harness.state().viewport.camera,
+    );
+    let apex = 3;
+    let before = harness.state().bench.simulation.positions()[apex];
+    let (start, _) = viewport::project(&camera, rect, before).expect("in view");
+    let end = start + egui::vec2(-80.0, 40.0);
+    harness.event(egui::Event::PointerMoved(start));
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerButton {
+        pos: start,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: Default::default(),
+    });
+    harness.run_steps(1);
+    for k in 1..=8 {
+        harness.event(egui::Event::PointerMoved(
+            start + (end - start) * (k as f32 / 8.0),
+        ));
+        harness.run_steps(1);
+    }
+    harness.event(egui::Event::PointerButton {
+        pos: end,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: Default::default(),
+    });
+    harness.run_steps(2);
+    let after = harness.state().bench.simulation.positions()[apex];
+    assert!(
+        after.distance(before) > 0.1,
+        "the apex moved from {before} to {after}"
+    );
+    assert_eq!(harness.state().bench.selected_particle, Some(apex));
+    let (landed, _) = viewport::project(&camera, rect, after).unwrap();
+    assert!(
+        landed.distance(end) < 3.0,
+        "it follows the pointer: {landed:?} vs {end:?}"
+    );
+}
+
+#[test]
+fn the_controls_switch_solver_and_families() {
+    let mut harness = workbench("cube", 2);
+    harness.get_by_label("PBD").click();
+    harness.get_by_label("heights (plane)").click();
+    harness.run_steps(2);
+    let settings = *harness.state().bench.simulation.settings();
+    assert_eq!(settings.method, tetlab_core::solver::Method::Pbd);
+    assert!(settings.active.plane);
+    harness.snapshot("controls_pbd_heights");
+}
+
+#[test]
+fn a_bad_mesh_file_shows_an_error_and_keeps_the_scene() {
+    let mut harness = workbench("cube", 2);
+    let path = std::env::temp_dir().join(format!("tetlab-gui-{}.msh", std::process::id()));
+    std::fs::write(&path, "$MeshFormat\n9.9 0 8\n$EndMeshFormat\n").unwrap();
+    harness.get_by_label("mesh file").click();
+    harness.run_steps(1);
+    harness
+        .get_by_label("mesh file")
+        .type_text(path.to_str().unwrap());
+    harness.run_steps(1);
+    harness.get_by_label("Open").click();
+    harness.run_steps(2);
+    let error = harness.state().error.clone().expect("an error is shown");
+    assert!(
+        error.contains(":2: MSH version 9.9 is not supported"),
+        "{error}"
+    );
+    assert_eq!(
+        harness.state().bench.simulation.tets().len(),
+        48,
+        "the cube stays"
+    );
+}
+
+/// Writes the screenshot in the README: a mirrored cube recovering, with the heights on.
+#[test]
+fn readme_screenshot() {
+    let mut harness = workbench("cube", 3);
+    harness.get_by_label("heights (plane)").click();
+    harness.key_press(egui::Key::M);
+    harness.run_steps(2);
+    harness.key_press(egui::Key::N);
+    harness.run_steps(1);
+    assert!(harness.state().bench.metrics.inverted_tets > 0);
+    let image = harness.render().unwrap();
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/workbench.png");
+    image.save(&path).unwrap();
+    harness.snapshot("readme_screenshot");
+}
