@@ -225,3 +225,34 @@ pub fn run_native() -> Result<(), String> {
     )
     .map_err(|e| e.to_string())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tetlab_core::solver::Method;
+
+    /// What `save` writes, `new` reads back: eframe stores the preferences as RON text.
+    #[test]
+    fn preferences_survive_a_save_and_load() {
+        let mut preferences = Preferences::default();
+        preferences.scene.builtin = "ball".into();
+        preferences.scene.resolution = 2;
+        preferences.settings.method = Method::Pbd;
+        preferences.settings.active.plane = true;
+        preferences.settings.substeps = 7;
+        preferences.view.see_through = true;
+        let text = ron::to_string(&preferences).unwrap();
+        let restored: Preferences = ron::from_str(&text).unwrap();
+        assert_eq!(restored, preferences);
+        let app = TetlabApp::with_preferences(restored);
+        assert_eq!(app.bench.scene.name, "ball");
+        assert_eq!(*app.bench.simulation.settings(), preferences.settings);
+    }
+
+    #[test]
+    fn missing_or_old_preferences_fall_back_to_defaults() {
+        let restored: Preferences = ron::from_str("(scene: (builtin: \"tet\"))").unwrap();
+        assert_eq!(restored.scene.builtin, "tet");
+        assert_eq!(restored.settings, Settings::default());
+    }
+}
