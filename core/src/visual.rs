@@ -80,24 +80,14 @@ pub fn display_faces(mesh: &TetMesh) -> Vec<[u32; 3]> {
 /// Every face of every tet (`all`), or the boundary faces only, each with the tet it belongs to,
 /// wound outward from that tet, in tet order.
 pub fn faces_with_tets(mesh: &TetMesh, all: bool) -> Vec<([u32; 3], u32)> {
-    let faces = mesh
-        .tets
-        .iter()
-        .enumerate()
-        .flat_map(|(t, tet)| crate::mesh::tet_faces(tet).map(|f| (f, t as u32)));
     if all {
-        return faces.collect();
+        let faces = mesh.tets.iter().enumerate();
+        faces
+            .flat_map(|(t, tet)| crate::mesh::tet_faces(tet).map(|f| (f, t as u32)))
+            .collect()
+    } else {
+        mesh.surface_faces_with_tets()
     }
-    let boundary: std::collections::HashSet<[u32; 3]> =
-        mesh.surface_faces().into_iter().map(sorted_face).collect();
-    faces
-        .filter(|(f, _)| boundary.contains(&sorted_face(*f)))
-        .collect()
-}
-
-fn sorted_face(mut f: [u32; 3]) -> [u32; 3] {
-    f.sort_unstable();
-    f
 }
 
 /// Meshes with at most this many tets are drawn with all their faces and edges.

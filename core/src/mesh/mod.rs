@@ -139,28 +139,25 @@ impl TetMesh {
     /// (b − a)×(c − a) points out of the body. In tet order, then face order, so the result is
     /// deterministic.
     pub fn surface_faces(&self) -> Vec<[u32; 3]> {
-        let mut keyed: Vec<([u32; 3], [u32; 3])> = self
-            .tets
-            .iter()
-            .flat_map(|t| tet_faces(t).map(|f| (sorted(f), f)))
-            .collect();
-        keyed.sort_unstable_by_key(|(key, _)| *key);
-        let mut boundary = std::collections::HashSet::new();
-        let mut i = 0;
-        while i < keyed.len() {
-            let mut j = i + 1;
-            while j < keyed.len() && keyed[j].0 == keyed[i].0 {
-                j += 1;
+        self.surface_faces_with_tets()
+            .into_iter()
+            .map(|(face, _)| face)
+            .collect()
+    }
+
+    /// [`TetMesh::surface_faces`], each with the tet it belongs to.
+    pub fn surface_faces_with_tets(&self) -> Vec<([u32; 3], u32)> {
+        let mut uses: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
+        for tet in &self.tets {
+            for face in tet_faces(tet) {
+                *uses.entry(sorted(face)).or_insert(0) += 1;
             }
-            if j - i == 1 {
-                boundary.insert(keyed[i].0);
-            }
-            i = j;
         }
         self.tets
             .iter()
-            .flat_map(tet_faces)
-            .filter(|f| boundary.contains(&sorted(*f)))
+            .enumerate()
+            .flat_map(|(t, tet)| tet_faces(tet).map(|face| (face, t as u32)))
+            .filter(|(face, _)| uses[&sorted(*face)] == 1)
             .collect()
     }
 
