@@ -7,7 +7,8 @@
 //! 2. XPBD only: λ = 0 for every constraint;
 //! 3. `iterations` Gauss–Seidel sweeps over the active families in a fixed order (edges, plane,
 //!    volume, then the grab, then the ground y ≥ 0), each constraint projected at once;
-//! 4. v = (x − x_prev) / h, then damped: v *= max(0, 1 − damping · h).
+//! 4. v = (x − x_prev) / h, then damped: v *= max(0, 1 − damping · h) — except, with
+//!    [`Settings::settle_edits`], in the frame after a user edit, where v keeps its predicted value.
 //!
 //! Projecting one constraint C with particles i, gradients ∇ᵢC and inverse masses wᵢ:
 //! - XPBD: α̃ = α / h², Δλ = (−C − α̃ λ) / (Σ wᵢ|∇ᵢC|² + α̃), λ += Δλ, Δxᵢ = wᵢ ∇ᵢC Δλ;
@@ -100,6 +101,10 @@ pub struct Settings {
     pub damping: f64,
     /// Compliance of the grab constraint; 0 moves the grabbed particle with the target exactly.
     pub grab_compliance: f64,
+    /// During the frame after an edit (a perturbation or a particle placed by hand), constraint
+    /// corrections move particles without giving them velocity. A large violation made by hand is
+    /// otherwise undone by rigid constraints within a substep, and v = Δx/h launches the body.
+    pub settle_edits: bool,
 }
 
 impl Default for Settings {
@@ -122,6 +127,7 @@ impl Default for Settings {
             ground: true,
             damping: 0.0,
             grab_compliance: 0.0,
+            settle_edits: false,
         }
     }
 }
@@ -262,6 +268,8 @@ pub struct Simulation {
     /// Signed volume constraints, one per tet, in tet order.
     pub volumes: ConstraintSet<4>,
     grab: Option<Grab>,
+    /// An edit happened since the last full frame; see [`Settings::settle_edits`].
+    edited: bool,
     frame: u64,
     time: f64,
 }
@@ -299,6 +307,7 @@ impl Simulation {
             planes,
             volumes,
             grab: None,
+            edited: false,
             frame: 0,
             time: 0.0,
         };
@@ -380,6 +389,7 @@ impl Simulation {
         };
         perturbation.apply(&mut self.positions, &mesh);
         self.stop();
+        self.edited = true;
     }
 
     /// Puts particle `i` at `position` at rest (a kinematic move, e.g. a drag while paused).
@@ -387,6 +397,7 @@ impl Simulation {
         self.positions[i] = position;
         self.previous[i] = position;
         self.velocities[i] = DVec3::ZERO;
+        self.edited = true;
     }
 
     /// Back to the rest shape, at rest, at frame 0.
@@ -473,6 +484,7 @@ impl Simulation {
             grab.target_velocity = (grab.target - grab.target_at_last_step) / self.settings.dt;
             grab.target_at_last_step = grab.target;
         }
+        self.edited = false;
         self.frame += 1;
         self.time += self.settings.dt;
     }
@@ -494,7 +506,11 @@ impl Simulation {
         for _ in 0..self.settings.iterations.max(1) {
             self.sweep(h);
         }
-        self.update_velocities(h);
+        // Settling keeps the predicted velocities: the sweeps moved particles back onto the
+        // constraints, and that motion is not turned into velocity.
+        if !(self.settings.settle_edits && self.edited) {
+            self.update_velocities(h);
+        }
     }
 
     fn predict(&mut self, h: f64) {

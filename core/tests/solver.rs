@@ -392,3 +392,60 @@ fn pbd_stiffness_is_corrected_for_the_iteration_count() {
         );
     }
 }
+
+/// Height of the highest particle after `frames` frames of a lone tet inverted by hand.
+fn highest_after_inverting(settle_edits: bool, frames: usize) -> (f64, usize) {
+    let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+    let mut simulation = Simulation::new(
+        &scene,
+        Settings {
+            settle_edits,
+            ..Settings::default()
+        },
+    );
+    simulation.perturb(Perturbation::Invert);
+    for _ in 0..frames {
+        simulation.step();
+    }
+    let highest = simulation
+        .positions()
+        .iter()
+        .map(|p| p.y)
+        .fold(f64::MIN, f64::max);
+    (highest, Metrics::measure(&simulation).inverted_tets)
+}
+
+#[test]
+fn settling_an_edit_recovers_the_tet_without_launching_it() {
+    let (launched, inverted) = highest_after_inverting(false, 30);
+    assert_eq!(inverted, 0);
+    assert!(
+        launched > 5.0,
+        "rigid snap-back turns into velocity: the tet reaches {launched}"
+    );
+    let (settled, inverted) = highest_after_inverting(true, 30);
+    assert_eq!(inverted, 0);
+    assert!(
+        settled < 1.5,
+        "settled, the tet stays near the ground: {settled}"
+    );
+    // Only the frame after the edit settles: later frames are plain XPBD again.
+    let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+    let mut simulation = Simulation::new(
+        &scene,
+        Settings {
+            settle_edits: true,
+            gravity: 0.0,
+            ground: false,
+            ..Settings::default()
+        },
+    );
+    simulation.step();
+    simulation.place(3, simulation.positions()[3] + DVec3::Y);
+    simulation.step();
+    let after_settled_frame = simulation.velocities()[3].length();
+    assert!(
+        after_settled_frame < 1e-9,
+        "no velocity from the settled correction: {after_settled_frame}"
+    );
+}

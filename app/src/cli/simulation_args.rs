@@ -45,6 +45,10 @@ pub struct SimulationArgs {
     /// PBD stiffness of a family, FAMILY=k with 0 ≤ k ≤ 1 (default 1); repeatable.
     #[arg(long, value_name = "FAMILY=k", value_parser = stiffness)]
     pub stiffness: Vec<(Family, f64)>,
+    /// In the frame after the perturbation, move particles back onto the constraints without
+    /// giving them velocity (otherwise a large violation launches the body).
+    #[arg(long)]
+    pub settle_edits: bool,
     /// Velocity damping per second (≥ 0).
     #[arg(long, default_value_t = 0.0, value_parser = non_negative, allow_hyphen_values = true)]
     pub damping: f64,
@@ -62,6 +66,7 @@ impl SimulationArgs {
             gravity: self.gravity,
             ground: self.gravity != 0.0,
             damping: self.damping,
+            settle_edits: self.settle_edits,
             ..Settings::default()
         };
         for &(family, alpha) in &self.compliance {
@@ -115,6 +120,9 @@ impl SimulationArgs {
             s.dt,
             short_number(s.gravity)
         );
+        if self.settle_edits {
+            text += ", settle edits";
+        }
         for (family, alpha) in &self.compliance {
             text += &format!(", compliance {}={alpha}", family_name(*family));
         }

@@ -22,7 +22,7 @@ use viewport::Viewport;
 use workbench::Workbench;
 
 /// What the workbench remembers between runs (eframe storage).
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct Preferences {
     /// The scene section.
@@ -31,6 +31,21 @@ pub struct Preferences {
     pub settings: Settings,
     /// The display options.
     pub view: ViewOptions,
+}
+
+impl Default for Preferences {
+    /// The solver's defaults, except that edits settle: inverting or dragging by hand is undone
+    /// without launching the body out of view.
+    fn default() -> Self {
+        Self {
+            scene: SceneChoice::default(),
+            settings: Settings {
+                settle_edits: true,
+                ..Settings::default()
+            },
+            view: ViewOptions::default(),
+        }
+    }
 }
 
 const STORAGE_KEY: &str = "tetlab";
@@ -253,6 +268,7 @@ mod tests {
     fn missing_or_old_preferences_fall_back_to_defaults() {
         let restored: Preferences = ron::from_str("(scene: (builtin: \"tet\"))").unwrap();
         assert_eq!(restored.scene.builtin, "tet");
-        assert_eq!(restored.settings, Settings::default());
+        assert_eq!(restored.settings, Preferences::default().settings);
+        assert!(restored.settings.settle_edits);
     }
 }

@@ -144,6 +144,8 @@ pub fn show(
     ui.add(egui::Slider::new(&mut settings.gravity, 0.0..=20.0).text("gravity"));
     ui.checkbox(&mut settings.ground, "ground (y = 0)");
     ui.add(egui::Slider::new(&mut settings.damping, 0.0..=10.0).text("damping"));
+    ui.checkbox(&mut settings.settle_edits, "settle edits")
+        .on_hover_text("After an invert, mirror, flatten or drag, move particles back without giving them velocity");
     if settings != *bench.simulation.settings() {
         bench.set_settings(settings);
     }
