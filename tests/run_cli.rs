@@ -181,3 +181,35 @@ fn a_diverging_run_stops_with_one_line_and_no_nonsense_numbers() {
         "only the sound frame 0 is printed"
     );
 }
+
+#[test]
+fn the_bipyramid_asset_inverts_one_tet_through_the_shared_face_and_recovers() {
+    let path = format!(
+        "{}/../assets/meshes/bipyramid.node",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let output = tetlab(&[
+        "run",
+        "--scene",
+        &path,
+        "--perturb",
+        "invert",
+        "--frames",
+        "60",
+    ]);
+    let text = stdout(&output);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(
+        text.contains("scene bipyramid: 5 particles, 2 tets, 9 edges"),
+        "{text}"
+    );
+    assert!(
+        text.contains("1 tets with negative rest volume reordered to positive"),
+        "{text}"
+    );
+    assert!(
+        text.contains("frame      0: inverted tets      1"),
+        "{text}"
+    );
+    assert!(text.contains("no inverted tets from frame"), "{text}");
+}
