@@ -238,6 +238,20 @@ pub fn arrow_scale(arrows: &[Arrow], family: Family, length: f64) -> f64 {
     if longest > 0.0 { length / longest } else { 0.0 }
 }
 
+/// The box around `positions`: lowest and highest corner.
+pub fn bounds(positions: &[DVec3]) -> (DVec3, DVec3) {
+    positions.iter().fold(
+        (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
+
+/// The diagonal of [`bounds`]: the natural length scale for drawing a body (at least 10⁻⁶).
+pub fn body_size(positions: &[DVec3]) -> f64 {
+    let (lo, hi) = bounds(positions);
+    (hi - lo).length().max(1e-6)
+}
+
 /// The mean edge length of tet `tet`: the natural length scale for drawing on it.
 pub fn tet_size(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
     TET_EDGES

@@ -8,7 +8,7 @@
 use super::UsageError;
 use super::inspect::Summary;
 use super::simulation_args::{SimulationArgs, family_name};
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rerun::RecordingStream;
 use std::io::{IsTerminal, Write};
@@ -360,7 +360,7 @@ impl<'a> Recorder<'a> {
             rec.log_static(path, what).ok();
         };
         log("world", &rerun::ViewCoordinates::RIGHT_HAND_Y_UP());
-        let size = body_size(simulation.rest_positions());
+        let size = visual::body_size(simulation.rest_positions());
         log(
             "world/particles",
             &rerun::Points3D::update_fields()
@@ -510,15 +510,6 @@ impl<'a> Recorder<'a> {
 
 fn rgba(c: Rgba) -> rerun::Color {
     rerun::Color::from_unmultiplied_rgba(c[0], c[1], c[2], c[3])
-}
-
-/// The diagonal of the bounding box of `positions`.
-fn body_size(positions: &[DVec3]) -> f64 {
-    let (lo, hi) = positions.iter().fold(
-        (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    (hi - lo).length().max(1e-6)
 }
 
 /// The default layout: the 3D view on the left, the four metrics stacked on the right.

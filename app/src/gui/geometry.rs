@@ -68,7 +68,6 @@ pub struct SceneCache {
 impl SceneCache {
     /// The faces and edges of `mesh`.
     pub fn new(mesh: &TetMesh) -> Self {
-        let (lo, hi) = bounds(&mesh.positions);
         Self {
             surface_faces: visual::faces_with_tets(
                 mesh,
@@ -77,17 +76,9 @@ impl SceneCache {
             all_faces: visual::faces_with_tets(mesh, true),
             display_edges: visual::display_edges(mesh),
             all_edges: mesh.edges(),
-            size: (hi - lo).length().max(1e-6),
+            size: visual::body_size(&mesh.positions),
         }
     }
-}
-
-/// The box around `positions`.
-pub fn bounds(positions: &[DVec3]) -> (DVec3, DVec3) {
-    positions.iter().fold(
-        (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    )
 }
 
 /// Builds everything the view draws this frame.
@@ -278,7 +269,7 @@ fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow, scale: f64, colour: Rgba) 
 
 /// Grid lines on y = 0 around the rest body, 20 cells across three times its size.
 fn ground_grid(out: &mut Vec<Vertex>, rest: &[DVec3], size: f64) {
-    let (lo, hi) = bounds(rest);
+    let (lo, hi) = visual::bounds(rest);
     let centre = (lo + hi) * 0.5;
     let half = 1.5 * size;
     let cells = 20;

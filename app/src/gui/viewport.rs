@@ -43,7 +43,7 @@ impl Viewport {
 
     /// Keeps the camera angles and frames the current body.
     pub fn frame(&mut self, bench: &Workbench) {
-        let (lo, hi) = geometry::bounds(bench.simulation.positions());
+        let (lo, hi) = tetlab_core::visual::bounds(bench.simulation.positions());
         self.camera.frame(lo.as_vec3(), hi.as_vec3());
     }
 
@@ -59,11 +59,11 @@ impl Viewport {
         self.rect = rect;
         let aspect = rect.width() / rect.height().max(1.0);
         let pointer = response.hover_pos();
-        self.hovered = pointer.and_then(|p| self.pick(bench, rect, aspect, p));
+        self.hovered = pointer.and_then(|p| self.pick(bench, rect, p));
 
         if response.drag_started_by(PointerButton::Primary) {
             let start = ui.input(|i| i.pointer.press_origin()).or(pointer);
-            if let Some(particle) = start.and_then(|p| self.pick(bench, rect, aspect, p)) {
+            if let Some(particle) = start.and_then(|p| self.pick(bench, rect, p)) {
                 let position = bench.simulation.positions()[particle].as_vec3();
                 self.drag_plane = Some((position, self.camera.forward()));
                 bench.start_drag(particle, position.as_dvec3());
@@ -121,8 +121,7 @@ impl Viewport {
     }
 
     /// The particle nearest to screen point `p` within [`PICK_RADIUS`], in front of the camera.
-    fn pick(&self, bench: &Workbench, rect: Rect, aspect: f32, p: Pos2) -> Option<usize> {
-        debug_assert!((aspect - rect.width() / rect.height().max(1.0)).abs() < 1e-3);
+    fn pick(&self, bench: &Workbench, rect: Rect, p: Pos2) -> Option<usize> {
         let mut best: Option<(usize, f32)> = None;
         for (i, position) in bench.simulation.positions().iter().enumerate() {
             let Some((screen, depth)) = project(&self.camera, rect, *position) else {
