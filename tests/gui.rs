@@ -120,6 +120,17 @@ fn a_tet_inverted_through_the_ui_turns_red_with_arrows_and_recovers_when_played(
         "volume arrows"
     );
 
+    // One substep: the projections' corrections appear as magenta arrows.
+    harness.key_press(egui::Key::U);
+    harness.run_steps(2);
+    let moved = harness.state().bench.simulation.corrections()[corner].length();
+    assert!(moved > 0.05, "the inverted corner is pushed back: {moved}");
+    assert!(
+        pixels_like(&mut harness, visual::CORRECTION) > 50,
+        "correction arrows"
+    );
+    harness.snapshot("tet_substep_corrections");
+
     harness.get_by_label("Play").click();
     harness.run_steps(60);
     assert_eq!(harness.state().bench.metrics.inverted_tets, 0);
@@ -147,9 +158,61 @@ fn keys_drive_the_workbench() {
     harness.key_press(egui::Key::R);
     harness.run_steps(1);
     assert_eq!(harness.state().bench.metrics.inverted_tets, 0, "R resets");
+
+    // Orbit by dragging on empty space, then C brings the first view back.
+    let first_view = harness.state().viewport.camera;
+    let empty = harness.state().viewport.rect.left_bottom() + egui::vec2(30.0, -30.0);
+    harness.event(egui::Event::PointerMoved(empty));
+    harness.event(egui::Event::PointerButton {
+        pos: empty,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: Default::default(),
+    });
+    harness.run_steps(1);
+    for k in 1..=5 {
+        harness.event(egui::Event::PointerMoved(
+            empty + egui::vec2(20.0 * k as f32, 0.0),
+        ));
+        harness.run_steps(1);
+    }
+    harness.event(egui::Event::PointerButton {
+        pos: empty + egui::vec2(100.0, 0.0),
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: Default::default(),
+    });
+    harness.run_steps(1);
+    assert_ne!(
+        harness.state().viewport.camera,
+        first_view,
+        "the drag orbits"
+    );
+    harness.key_press(egui::Key::C);
+    harness.run_steps(1);
+    assert_eq!(
+        harness.state().viewport.camera,
+        first_view,
+        "C resets the camera"
+    );
+
+    // Mirror everything and play: the body recovers where it is, it is not launched.
+    harness.key_press(egui::Key::M);
     harness.key_press(egui::Key::Space);
     harness.run_steps(1);
     assert!(harness.state().bench.playing);
+    let mut highest = f64::MIN;
+    for _ in 0..90 {
+        harness.run_steps(1);
+        for p in harness.state().bench.simulation.positions() {
+            highest = highest.max(p.y);
+        }
+    }
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 0);
+    assert!(
+        highest < 1.5,
+        "the 1 m cube stays near the ground: {highest} m"
+    );
 }
 
 #[test]
@@ -235,16 +298,25 @@ fn a_bad_mesh_file_shows_an_error_and_keeps_the_scene() {
     );
 }
 
-/// Writes the screenshot in the README: a mirrored cube recovering, with the heights on.
+/// Writes the screenshot in the README: a corner tet of a 3³ cube inverted by hand, red, with the
+/// gradient arrows of all three families pointing back.
 #[test]
 fn readme_screenshot() {
     let mut harness = workbench("cube", 3);
     harness.get_by_label("heights (plane)").click();
-    harness.key_press(egui::Key::M);
-    harness.run_steps(2);
-    harness.key_press(egui::Key::N);
     harness.run_steps(1);
-    assert!(harness.state().bench.metrics.inverted_tets > 0);
+    let corner = 63;
+    let (rect, camera) = (
+        harness.state().viewport.rect,
+        harness.state().viewport.camera,
+    );
+    let position = harness.state().bench.simulation.positions()[corner];
+    let (at, _) = viewport::project(&camera, rect, position).unwrap();
+    click_at(&mut harness, at);
+    harness.key_press(egui::Key::I);
+    harness.run_steps(2);
+    assert!(harness.state().bench.metrics.inverted_tets >= 1);
+    assert!(pixels_like(&mut harness, visual::INVERTED) > 1000);
     let image = harness.render().unwrap();
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/workbench.png");

@@ -71,6 +71,7 @@ fn a_recording_holds_every_entity_frame_particle_and_metric_of_the_run() {
         "world/gradients/edges",
         "world/gradients/plane",
         "world/gradients/volume",
+        "world/corrections",
         "metrics/inverted_tets",
         "metrics/volume_error",
         "metrics/max_edge_strain",
@@ -83,6 +84,7 @@ fn a_recording_holds_every_entity_frame_particle_and_metric_of_the_run() {
         "world/mesh",
         "world/edges",
         "world/gradients/volume",
+        "world/corrections",
         "metrics/volume_error",
     ] {
         assert_eq!(

@@ -8,7 +8,13 @@
 //! 3. `iterations` Gauss–Seidel sweeps over the active families in a fixed order (edges, plane,
 //!    volume, then the grab, then the ground y ≥ 0), each constraint projected at once;
 //! 4. v = (x − x_prev) / h, then damped: v *= max(0, 1 − damping · h) — except, with
-//!    [`Settings::settle_edits`], in the frame after a user edit, where v keeps its predicted value.
+//!    [`Settings::settle_edits`], while an edit settles: there |v| is also capped at the predicted
+//!    speed, so the projections may turn the motion but never speed it up.
+//!
+//! The correction Δp of a substep is, per particle, the position after the sweeps minus the
+//! predicted one ([`Simulation::corrections`]). An edit (a perturbation, a particle placed by hand)
+//! settles until the largest Δp of a substep is below [`Simulation::settle_tolerance`], or for at
+//! most [`MAX_SETTLE_FRAMES`] frames.
 //!
 //! Projecting one constraint C with particles i, gradients ∇ᵢC and inverse masses wᵢ:
 //! - XPBD: α̃ = α / h², Δλ = (−C − α̃ λ) / (Σ wᵢ|∇ᵢC|² + α̃), λ += Δλ, Δxᵢ = wᵢ ∇ᵢC Δλ;
@@ -101,9 +107,9 @@ pub struct Settings {
     pub damping: f64,
     /// Compliance of the grab constraint; 0 moves the grabbed particle with the target exactly.
     pub grab_compliance: f64,
-    /// During the frame after an edit (a perturbation or a particle placed by hand), constraint
-    /// corrections move particles without giving them velocity. A large violation made by hand is
-    /// otherwise undone by rigid constraints within a substep, and v = Δx/h launches the body.
+    /// After an edit (a perturbation or a particle placed by hand), constraint corrections may
+    /// move particles but not speed them up, until the edit's violation is undone. Otherwise rigid
+    /// constraints undo a large violation within a substep, and v = Δx/h launches the body.
     pub settle_edits: bool,
 }
 
@@ -138,6 +144,13 @@ pub const SOUND_LIMIT: f64 = 1e30;
 
 /// Density used to lump masses: 1000 kg/m³.
 pub const DENSITY: f64 = 1000.0;
+
+/// The longest an edit settles, in frames (one second at 60 frames per second).
+pub const MAX_SETTLE_FRAMES: u32 = 60;
+
+/// An edit has settled when no particle is corrected by more than this fraction of the mean rest
+/// edge length in a substep (plus what gravity alone causes; see [`Simulation::settle_tolerance`]).
+pub const SETTLE_FRACTION: f64 = 1e-3;
 
 /// The constraints of one family: particle indices, rest values and XPBD multipliers, one entry
 /// per constraint, in projection order.
@@ -268,8 +281,12 @@ pub struct Simulation {
     /// Signed volume constraints, one per tet, in tet order.
     pub volumes: ConstraintSet<4>,
     grab: Option<Grab>,
-    /// An edit happened since the last full frame; see [`Settings::settle_edits`].
-    edited: bool,
+    /// Δp of the last substep; during a substep, the predicted positions.
+    corrections: Vec<DVec3>,
+    /// The mean rest edge length, the scale of "settled".
+    mean_edge: f64,
+    /// Frames an edit has been settling, `None` when none is; see [`Settings::settle_edits`].
+    settling: Option<u32>,
     frame: u64,
     time: f64,
 }
@@ -288,6 +305,11 @@ impl Simulation {
         let planes = ConstraintSet::new(plane_particles, &positions, plane::evaluate);
         let volumes = ConstraintSet::new(mesh.tets.clone(), &positions, volume::evaluate);
         let lumped_inverse_masses = lumped_inverse_masses(mesh, &volumes.rest);
+        let mean_edge = if edges.is_empty() {
+            1.0
+        } else {
+            edges.rest.iter().sum::<f64>() / edges.len() as f64
+        };
         let mut pinned = vec![false; positions.len()];
         for &i in &scene.pinned {
             pinned[i as usize] = true;
@@ -307,7 +329,9 @@ impl Simulation {
             planes,
             volumes,
             grab: None,
-            edited: false,
+            corrections: vec![DVec3::ZERO; n],
+            mean_edge,
+            settling: None,
             frame: 0,
             time: 0.0,
         };
@@ -338,6 +362,26 @@ impl Simulation {
     /// Current particle velocities.
     pub fn velocities(&self) -> &[DVec3] {
         &self.velocities
+    }
+
+    /// Δp of the last substep, per particle: the position after the constraint projections minus
+    /// the predicted position. Zero after a perturbation or a reset, and for a particle placed by
+    /// hand, until the next substep.
+    pub fn corrections(&self) -> &[DVec3] {
+        &self.corrections
+    }
+
+    /// Whether an edit is settling (see [`Settings::settle_edits`]).
+    pub fn is_settling(&self) -> bool {
+        self.settling.is_some()
+    }
+
+    /// The largest Δp per substep, in metres, at which an edit counts as settled:
+    /// [`SETTLE_FRACTION`] × the mean rest edge length, plus g h², the correction that gravity
+    /// alone causes in a body at rest on the ground.
+    pub fn settle_tolerance(&self) -> f64 {
+        let h = self.settings.dt / self.settings.substeps.max(1) as f64;
+        SETTLE_FRACTION * self.mean_edge + self.settings.gravity.abs() * h * h
     }
 
     /// Inverse masses in use (0 for pinned or grabbed-rigidly particles).
@@ -389,7 +433,7 @@ impl Simulation {
         };
         perturbation.apply(&mut self.positions, &mesh);
         self.stop();
-        self.edited = true;
+        self.settling = Some(0);
     }
 
     /// Puts particle `i` at `position` at rest (a kinematic move, e.g. a drag while paused).
@@ -397,13 +441,15 @@ impl Simulation {
         self.positions[i] = position;
         self.previous[i] = position;
         self.velocities[i] = DVec3::ZERO;
-        self.edited = true;
+        self.corrections[i] = DVec3::ZERO;
+        self.settling = Some(0);
     }
 
     /// Back to the rest shape, at rest, at frame 0.
     pub fn reset(&mut self) {
         self.positions.copy_from_slice(&self.rest_positions);
         self.stop();
+        self.settling = None;
         self.frame = 0;
         self.time = 0.0;
     }
@@ -412,6 +458,7 @@ impl Simulation {
     fn stop(&mut self) {
         self.previous.copy_from_slice(&self.positions);
         self.velocities.fill(DVec3::ZERO);
+        self.corrections.fill(DVec3::ZERO);
         for lambda in [
             &mut self.edges.lambda,
             &mut self.planes.lambda,
@@ -484,7 +531,13 @@ impl Simulation {
             grab.target_velocity = (grab.target - grab.target_at_last_step) / self.settings.dt;
             grab.target_at_last_step = grab.target;
         }
-        self.edited = false;
+        if let Some(frames) = self.settling {
+            let largest = self.largest_correction();
+            self.settling = (self.settings.settle_edits
+                && largest > self.settle_tolerance()
+                && frames + 1 < MAX_SETTLE_FRAMES)
+                .then_some(frames + 1);
+        }
         self.frame += 1;
         self.time += self.settings.dt;
     }
@@ -506,11 +559,20 @@ impl Simulation {
         for _ in 0..self.settings.iterations.max(1) {
             self.sweep(h);
         }
-        // Settling keeps the predicted velocities: the sweeps moved particles back onto the
-        // constraints, and that motion is not turned into velocity.
-        if !(self.settings.settle_edits && self.edited) {
-            self.update_velocities(h);
+        for (correction, p) in self.corrections.iter_mut().zip(&self.positions) {
+            *correction = *p - *correction;
         }
+        self.update_velocities(h, self.settings.settle_edits && self.settling.is_some());
+    }
+
+    /// The longest Δp of the last substep among particles that can move.
+    fn largest_correction(&self) -> f64 {
+        self.corrections
+            .iter()
+            .zip(&self.inverse_masses)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(c, _)| c.length())
+            .fold(0.0, f64::max)
     }
 
     fn predict(&mut self, h: f64) {
@@ -531,6 +593,7 @@ impl Simulation {
         if let Some(grab) = self.rigid_grab() {
             self.positions[grab.particle] = grab.target;
         }
+        self.corrections.copy_from_slice(&self.positions);
     }
 
     fn rule(&self, family: Family, h: f64) -> Rule {
@@ -607,10 +670,15 @@ impl Simulation {
         }
     }
 
-    fn update_velocities(&mut self, h: f64) {
+    /// v = (x − x_prev) / h, damped; when `settling`, no faster than the predicted velocity.
+    fn update_velocities(&mut self, h: f64, settling: bool) {
         let keep = (1.0 - self.settings.damping * h).max(0.0);
         for i in 0..self.positions.len() {
-            self.velocities[i] = (self.positions[i] - self.previous[i]) / h * keep;
+            let mut velocity = (self.positions[i] - self.previous[i]) / h;
+            if settling {
+                velocity = velocity.clamp_length_max(self.velocities[i].length());
+            }
+            self.velocities[i] = velocity * keep;
         }
     }
 }

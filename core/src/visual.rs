@@ -157,37 +157,71 @@ pub fn edge_strips(edges: &[[u32; 2]]) -> Vec<Vec<u32>> {
     strips
 }
 
-/// One gradient arrow: ∇ₚC of one constraint at one particle.
+/// The colour of the correction arrows (Δp of the last substep): magenta.
+pub const CORRECTION: Rgba = [200, 50, 200, 255];
+
+/// What an arrow shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// ∇ₚC of one constraint of a family.
+    Gradient(Family),
+    /// Δp, the correction the last substep's projections made (see
+    /// [`Simulation::corrections`]).
+    Correction,
+}
+
+impl Quantity {
+    /// The arrow colour: [`family_colour`] for gradients, [`CORRECTION`] for corrections.
+    pub fn colour(self) -> Rgba {
+        match self {
+            Quantity::Gradient(family) => family_colour(family),
+            Quantity::Correction => CORRECTION,
+        }
+    }
+}
+
+/// One arrow at one particle.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Arrow {
-    /// The family of the constraint.
-    pub family: Family,
+    /// What it shows.
+    pub quantity: Quantity,
     /// The particle the arrow starts at.
     pub particle: u32,
     /// Where it starts: the particle's position.
     pub origin: DVec3,
-    /// ∇ₚC itself (unscaled).
-    pub gradient: DVec3,
+    /// The quantity itself (∇ₚC, or Δp in metres), unscaled.
+    pub value: DVec3,
+    /// What to draw from `origin`: `value` times the arrow set's scale.
+    pub vector: DVec3,
 }
+
+/// The longest gradient arrow of a family on a tet at gain 1, as a fraction of the tet's mean edge
+/// length ([`tet_size`]).
+pub const GRADIENT_ARROW_LENGTH: f64 = 0.4;
 
 /// The gradient arrows of `family` on tet `tet`: ∇ₚC at each particle p of each of the family's
 /// constraints on that tet — 6 edges × 2 particles, 4 heights × 4 particles, or 1 volume × 4
-/// particles. Degenerate constraints have no arrows. Appends to `out`.
+/// particles. Degenerate constraints have no arrows. Gradients of different families have
+/// different units (1, 1 and m²), so each family is scaled on its own: its longest arrow on the tet
+/// is drawn `gain` × [`GRADIENT_ARROW_LENGTH`] × the tet's size long. Appends to `out`.
 pub fn tet_gradient_arrows(
     simulation: &Simulation,
     tet: usize,
     family: Family,
+    gain: f64,
     out: &mut Vec<Arrow>,
 ) {
     let positions = simulation.positions();
     let corners = simulation.tets()[tet];
+    let first = out.len();
     let mut push = |particles: &[u32], gradients: &[DVec3]| {
         for (&particle, &gradient) in particles.iter().zip(gradients) {
             out.push(Arrow {
-                family,
+                quantity: Quantity::Gradient(family),
                 particle,
                 origin: positions[particle as usize],
-                gradient,
+                value: gradient,
+                vector: DVec3::ZERO,
             });
         }
     };
@@ -224,18 +258,38 @@ pub fn tet_gradient_arrows(
             }
         }
     }
+    let added = &mut out[first..];
+    let longest = added.iter().map(|a| a.value.length()).fold(0.0, f64::max);
+    let length = gain * GRADIENT_ARROW_LENGTH * tet_size(positions, &corners);
+    let scale = if longest > 0.0 { length / longest } else { 0.0 };
+    for arrow in added {
+        arrow.vector = arrow.value * scale;
+    }
 }
 
-/// The factor that turns the gradients of `arrows` into drawable vectors: the longest becomes
-/// `length`. Gradients of different families have different units (1, 1 and m²), so each family
-/// is scaled on its own.
-pub fn arrow_scale(arrows: &[Arrow], family: Family, length: f64) -> f64 {
-    let longest = arrows
-        .iter()
-        .filter(|a| a.family == family)
-        .map(|a| a.gradient.length())
-        .fold(0.0, f64::max);
-    if longest > 0.0 { length / longest } else { 0.0 }
+/// The correction arrows of `particles`: Δp of the last substep at each, drawn `gain` times its
+/// true length (Δp is a displacement, in the scene's units). Zero corrections have no arrow.
+/// Appends to `out`.
+pub fn correction_arrows(
+    simulation: &Simulation,
+    particles: impl IntoIterator<Item = u32>,
+    gain: f64,
+    out: &mut Vec<Arrow>,
+) {
+    let positions = simulation.positions();
+    let corrections = simulation.corrections();
+    for particle in particles {
+        let correction = corrections[particle as usize];
+        if correction != DVec3::ZERO {
+            out.push(Arrow {
+                quantity: Quantity::Correction,
+                particle,
+                origin: positions[particle as usize],
+                value: correction,
+                vector: correction * gain,
+            });
+        }
+    }
 }
 
 /// The box around `positions`: lowest and highest corner.
@@ -280,31 +334,46 @@ mod tests {
         assert!(colours.iter().all(|&c| c == INVERTED));
 
         let mut arrows = Vec::new();
-        tet_gradient_arrows(&simulation, 0, Family::Volume, &mut arrows);
+        tet_gradient_arrows(&simulation, 0, Family::Volume, 1.0, &mut arrows);
         assert_eq!(arrows.len(), 4);
         // Vertex 0 was reflected through the face (1, 2, 3): its arrow points back across it.
         let p = simulation.positions();
         let normal = (p[2] - p[1]).cross(p[3] - p[1]);
         let side = (p[0] - p[1]).dot(normal).signum();
         assert!(
-            arrows[0].gradient.dot(normal) * side < 0.0,
+            arrows[0].value.dot(normal) * side < 0.0,
             "the arrow crosses back over the face"
         );
 
+        let size = tet_size(p, &simulation.tets()[0]);
         for (family, count) in [(Family::Distance, 12), (Family::Plane, 16)] {
             let mut arrows = Vec::new();
-            tet_gradient_arrows(&simulation, 0, family, &mut arrows);
+            tet_gradient_arrows(&simulation, 0, family, 2.0, &mut arrows);
             assert_eq!(arrows.len(), count, "{family:?}");
-            assert!(
-                (arrow_scale(&arrows, family, 0.5)
-                    * arrows
-                        .iter()
-                        .map(|a| a.gradient.length())
-                        .fold(0.0, f64::max)
-                    - 0.5)
-                    .abs()
-                    < 1e-12
-            );
+            let longest = arrows.iter().map(|a| a.vector.length()).fold(0.0, f64::max);
+            assert!((longest - 2.0 * GRADIENT_ARROW_LENGTH * size).abs() < 1e-12);
+            for a in &arrows {
+                assert!(a.vector.cross(a.value).length() < 1e-12 && a.vector.dot(a.value) >= 0.0);
+                assert_eq!(a.quantity.colour(), family_colour(family));
+            }
+        }
+    }
+
+    #[test]
+    fn correction_arrows_are_the_last_substeps_displacements_times_the_gain() {
+        let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        simulation.perturb(Perturbation::Invert);
+        let mut arrows = Vec::new();
+        correction_arrows(&simulation, 0..4, 10.0, &mut arrows);
+        assert!(arrows.is_empty(), "nothing projected yet");
+        simulation.substep();
+        correction_arrows(&simulation, 0..4, 10.0, &mut arrows);
+        assert_eq!(arrows.len(), 4);
+        for a in &arrows {
+            assert_eq!(a.value, simulation.corrections()[a.particle as usize]);
+            assert_eq!(a.vector, a.value * 10.0);
+            assert_eq!(a.quantity.colour(), CORRECTION);
         }
     }
 

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use tetlab_core::mesh::TetMesh;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{DENSITY, Method, PerFamily, Settings, Simulation};
+use tetlab_core::solver::{DENSITY, MAX_SETTLE_FRAMES, Method, PerFamily, Settings, Simulation};
 
 /// Counts allocations made by this test binary, to check that a step makes none.
 struct CountingAllocator;
@@ -393,59 +393,130 @@ fn pbd_stiffness_is_corrected_for_the_iteration_count() {
     }
 }
 
-/// Height of the highest particle after `frames` frames of a lone tet inverted by hand.
-fn highest_after_inverting(settle_edits: bool, frames: usize) -> (f64, usize) {
-    let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+/// A cube of 3³ cells perturbed with `perturbation`, then run for three seconds: the highest any
+/// particle got, the frame from which none was inverted, and the frames the edit took to settle.
+fn after_perturbing_a_cube(
+    perturbation: Perturbation,
+    settle_edits: bool,
+) -> (f64, Option<usize>, Option<usize>) {
+    let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
     let mut simulation = Simulation::new(
         &scene,
         Settings {
             settle_edits,
+            active: families(true, true, true),
             ..Settings::default()
         },
     );
-    simulation.perturb(Perturbation::Invert);
-    for _ in 0..frames {
+    simulation.perturb(perturbation);
+    let (mut highest, mut recovered, mut settled) = (f64::MIN, None, None);
+    for frame in 0..180 {
         simulation.step();
+        for p in simulation.positions() {
+            highest = highest.max(p.y);
+        }
+        if recovered.is_none() && Metrics::measure(&simulation).inverted_tets == 0 {
+            recovered = Some(frame);
+        }
+        if settled.is_none() && !simulation.is_settling() {
+            settled = Some(frame + 1);
+        }
     }
-    let highest = simulation
-        .positions()
-        .iter()
-        .map(|p| p.y)
-        .fold(f64::MIN, f64::max);
-    (highest, Metrics::measure(&simulation).inverted_tets)
+    (highest, recovered, settled)
 }
 
 #[test]
-fn settling_an_edit_recovers_the_tet_without_launching_it() {
-    let (launched, inverted) = highest_after_inverting(false, 30);
-    assert_eq!(inverted, 0);
-    assert!(
-        launched > 5.0,
-        "rigid snap-back turns into velocity: the tet reaches {launched}"
-    );
-    let (settled, inverted) = highest_after_inverting(true, 30);
-    assert_eq!(inverted, 0);
-    assert!(
-        settled < 1.5,
-        "settled, the tet stays near the ground: {settled}"
-    );
-    // Only the frame after the edit settles: later frames are plain XPBD again.
+fn settling_undoes_a_mirror_or_a_flatten_without_launching_the_body() {
+    for perturbation in [Perturbation::Mirror, Perturbation::Flatten] {
+        let (launched, recovered, _) = after_perturbing_a_cube(perturbation, false);
+        assert!(recovered.is_some());
+        assert!(
+            launched > 50.0,
+            "{perturbation:?}: rigid snap-back becomes velocity, the cube (1 m tall) reaches {launched} m"
+        );
+        let (highest, recovered, settled) = after_perturbing_a_cube(perturbation, true);
+        assert!(
+            recovered.is_some(),
+            "{perturbation:?}: recovers when settled"
+        );
+        assert!(
+            highest < 1.5,
+            "{perturbation:?}: settled, the cube stays near the ground: {highest} m"
+        );
+        let settled = settled.expect("the edit settles");
+        assert!(
+            (2..MAX_SETTLE_FRAMES as usize).contains(&settled),
+            "{perturbation:?}: settling lasts while the violation is undone, not one frame \
+             and not until the limit: {settled} frames"
+        );
+    }
+}
+
+#[test]
+fn settling_never_speeds_a_particle_up_and_ends_at_the_limit() {
     let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+    let settings = Settings {
+        settle_edits: true,
+        gravity: 0.0,
+        ground: false,
+        // A soft tet far from rest keeps being corrected for longer than the limit.
+        compliance: PerFamily::splat(1e-4),
+        ..Settings::default()
+    };
+    let mut simulation = Simulation::new(&scene, settings);
+    simulation.place(3, simulation.positions()[3] + DVec3::new(0.0, 30.0, 0.0));
+    for _ in 0..MAX_SETTLE_FRAMES - 1 {
+        simulation.step();
+        assert!(simulation.is_settling());
+        let fastest = simulation
+            .velocities()
+            .iter()
+            .map(|v| v.length())
+            .fold(0.0, f64::max);
+        assert_eq!(
+            fastest, 0.0,
+            "at rest and without gravity, settling adds no speed"
+        );
+    }
+    simulation.step();
+    assert!(
+        !simulation.is_settling(),
+        "{MAX_SETTLE_FRAMES} frames at most"
+    );
+    simulation.step();
+    assert!(
+        simulation.velocities()[3].length() > 0.0,
+        "after settling, corrections are velocity again"
+    );
+}
+
+#[test]
+fn corrections_are_the_projection_displacements_and_conserve_momentum() {
+    let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
     let mut simulation = Simulation::new(
         &scene,
         Settings {
-            settle_edits: true,
             gravity: 0.0,
             ground: false,
+            active: families(true, true, true),
             ..Settings::default()
         },
     );
-    simulation.step();
-    simulation.place(3, simulation.positions()[3] + DVec3::Y);
-    simulation.step();
-    let after_settled_frame = simulation.velocities()[3].length();
+    simulation.perturb(Perturbation::Scramble(3));
+    assert!(simulation.corrections().iter().all(|c| *c == DVec3::ZERO));
+    let before = simulation.positions().to_vec();
+    simulation.substep();
+    let mut momentum = DVec3::ZERO;
+    let mut largest: f64 = 0.0;
+    for (i, correction) in simulation.corrections().iter().enumerate() {
+        // At rest without gravity the prediction is the old position.
+        assert!((simulation.positions()[i] - before[i] - *correction).length() < 1e-12);
+        momentum += *correction / simulation.inverse_masses()[i];
+        largest = largest.max(correction.length());
+    }
+    assert!(largest > 1e-2, "a scrambled body is corrected: {largest}");
     assert!(
-        after_settled_frame < 1e-9,
-        "no velocity from the settled correction: {after_settled_frame}"
+        momentum.length() < 1e-9 * largest / simulation.inverse_masses()[0],
+        "internal constraints move no centre of mass: Σ m Δp = {momentum}"
     );
 }

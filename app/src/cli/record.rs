@@ -20,7 +20,7 @@ use tetlab_core::constraints::Family;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::Scene;
 use tetlab_core::solver::Simulation;
-use tetlab_core::visual::{self, Arrow, Rgba};
+use tetlab_core::visual::{self, Arrow, Quantity, Rgba};
 
 /// The viewer address `--connect` uses when given no value.
 pub const DEFAULT_VIEWER: &str = "rerun+http://127.0.0.1:9876/proxy";
@@ -333,6 +333,7 @@ impl Progress {
 /// `world/particles`, `world/mesh`
 /// and `world/edges` (all faces and edges of a small mesh, the surface of a large one, as
 /// [`visual::display_faces`] and [`visual::display_edges`] choose), `world/gradients/<family>`,
+/// `world/corrections` (Δp of the last substep, at its true length),
 /// `metrics/<name>`, `run` (a description).
 pub struct Recorder<'a> {
     rec: &'a RecordingStream,
@@ -378,11 +379,11 @@ impl<'a> Recorder<'a> {
                 .with_colors([rgba(visual::EDGE)])
                 .with_radii([rerun::Radius::new_ui_points(0.75)]),
         );
-        for family in Family::ALL {
+        let quantities = Family::ALL.map(Quantity::Gradient);
+        for quantity in quantities.into_iter().chain([Quantity::Correction]) {
             log(
-                &format!("world/gradients/{}", family_name(family)),
-                &rerun::Arrows3D::update_fields()
-                    .with_colors([rgba(visual::family_colour(family))]),
+                &arrow_path(quantity),
+                &rerun::Arrows3D::update_fields().with_colors([rgba(quantity.colour())]),
             );
         }
         let perturbation = args
@@ -471,40 +472,55 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// Logs the gradient arrows of the chosen tets, one entity per active family, and Δp of the
+    /// last substep at their particles, at its true length.
     fn log_arrows(&mut self, simulation: &Simulation) {
-        let tets: Vec<usize> = match self.arrows {
+        let tets = match self.arrows {
             ArrowsMode::None => return,
-            ArrowsMode::Selected => vec![self.tet],
-            ArrowsMode::All => (0..simulation.tets().len()).collect(),
+            ArrowsMode::Selected => self.tet..self.tet + 1,
+            ArrowsMode::All => 0..simulation.tets().len(),
         };
         let active = simulation.settings().active;
-        for family in Family::ALL {
-            let path = format!("world/gradients/{}", family_name(family));
-            if !active.get(family) {
-                continue;
+        self.arrow_scratch.clear();
+        for family in Family::ALL.into_iter().filter(|&f| active.get(f)) {
+            for tet in tets.clone() {
+                visual::tet_gradient_arrows(simulation, tet, family, 1.0, &mut self.arrow_scratch);
             }
-            let mut origins = Vec::new();
-            let mut vectors = Vec::new();
-            for &tet in &tets {
-                self.arrow_scratch.clear();
-                visual::tet_gradient_arrows(simulation, tet, family, &mut self.arrow_scratch);
-                let length =
-                    0.5 * visual::tet_size(simulation.positions(), &simulation.tets()[tet]);
-                let scale = visual::arrow_scale(&self.arrow_scratch, family, length);
-                for arrow in &self.arrow_scratch {
-                    origins.push(arrow.origin.as_vec3());
-                    vectors.push((arrow.gradient * scale).as_vec3());
-                }
+        }
+        match self.arrows {
+            ArrowsMode::All => {
+                let particles = 0..simulation.positions().len() as u32;
+                visual::correction_arrows(simulation, particles, 1.0, &mut self.arrow_scratch);
             }
+            _ => {
+                let corners = simulation.tets()[self.tet];
+                visual::correction_arrows(simulation, corners, 1.0, &mut self.arrow_scratch);
+            }
+        }
+        let quantities = Family::ALL
+            .into_iter()
+            .filter(|&f| active.get(f))
+            .map(Quantity::Gradient)
+            .chain([Quantity::Correction]);
+        for quantity in quantities {
+            let arrows = self.arrow_scratch.iter().filter(|a| a.quantity == quantity);
             self.rec
                 .log(
-                    path.as_str(),
+                    arrow_path(quantity),
                     &rerun::Arrows3D::update_fields()
-                        .with_origins(origins)
-                        .with_vectors(vectors),
+                        .with_origins(arrows.clone().map(|a| a.origin.as_vec3()))
+                        .with_vectors(arrows.map(|a| a.vector.as_vec3())),
                 )
                 .ok();
         }
+    }
+}
+
+/// Where arrows of `quantity` are logged.
+fn arrow_path(quantity: Quantity) -> String {
+    match quantity {
+        Quantity::Gradient(family) => format!("world/gradients/{}", family_name(family)),
+        Quantity::Correction => "world/corrections".to_owned(),
     }
 }
 

@@ -27,6 +27,10 @@ pub struct ViewOptions {
     pub arrows_on_all_tets: bool,
     /// Arrow length factor.
     pub arrow_scale: f32,
+    /// Draw Δp, the correction of the last substep, at the particles that have gradient arrows.
+    pub corrections: bool,
+    /// How many times its true length Δp is drawn.
+    pub correction_gain: f32,
 }
 
 impl Default for ViewOptions {
@@ -39,6 +43,8 @@ impl Default for ViewOptions {
             arrows: true,
             arrows_on_all_tets: false,
             arrow_scale: 1.0,
+            corrections: true,
+            correction_gain: 1.0,
         }
     }
 }
@@ -47,7 +53,7 @@ impl Default for ViewOptions {
 pub const ARROWS_ON_ALL_UP_TO: usize = 64;
 
 /// Selected tets and particles.
-const SELECTED: Rgba = [250, 200, 40, 255];
+pub const SELECTED: Rgba = [250, 200, 40, 255];
 /// The particle under the pointer.
 const HOVERED: Rgba = [255, 255, 255, 255];
 /// Pinned particles.
@@ -180,29 +186,34 @@ pub fn build(
         ground_grid(&mut geometry.lines, simulation.rest_positions(), cache.size);
     }
 
+    let all = options.arrows_on_all_tets && tets.len() <= ARROWS_ON_ALL_UP_TO;
+    let chosen: Vec<usize> = if all {
+        (0..tets.len()).collect()
+    } else {
+        bench.selected_tet.into_iter().collect()
+    };
+    let mut arrows = Vec::new();
     if options.arrows {
-        let all = options.arrows_on_all_tets && tets.len() <= ARROWS_ON_ALL_UP_TO;
-        let chosen: Vec<usize> = if all {
-            (0..tets.len()).collect()
-        } else {
-            bench.selected_tet.into_iter().collect()
-        };
-        let mut arrows = Vec::new();
         for family in Family::ALL
             .into_iter()
             .filter(|&f| simulation.settings().active.get(f))
         {
             for &tet in &chosen {
-                arrows.clear();
-                visual::tet_gradient_arrows(simulation, tet, family, &mut arrows);
-                let length =
-                    0.35 * visual::tet_size(positions, &tets[tet]) * options.arrow_scale as f64;
-                let scale = visual::arrow_scale(&arrows, family, length);
-                for arrow in &arrows {
-                    draw_arrow(&mut geometry, arrow, scale, visual::family_colour(family));
-                }
+                let gain = options.arrow_scale as f64;
+                visual::tet_gradient_arrows(simulation, tet, family, gain, &mut arrows);
             }
         }
+    }
+    if options.corrections {
+        let gain = options.correction_gain as f64;
+        if all {
+            visual::correction_arrows(simulation, 0..positions.len() as u32, gain, &mut arrows);
+        } else if let Some(tet) = bench.selected_tet {
+            visual::correction_arrows(simulation, tets[tet], gain, &mut arrows);
+        }
+    }
+    for arrow in &arrows {
+        draw_arrow(&mut geometry, arrow);
     }
     geometry
 }
@@ -242,10 +253,12 @@ fn octahedron(out: &mut Vec<Vertex>, centre: Vec3, r: f32, colour: Rgba) {
     }
 }
 
-/// A gradient arrow: a shaft from the particle along ∇C × scale and a cone at its tip.
-fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow, scale: f64, colour: Rgba) {
+/// An arrow: a shaft from the particle along its vector and a cone at its tip, in its quantity's
+/// colour.
+fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow) {
+    let colour = arrow.quantity.colour();
     let start = arrow.origin.as_vec3();
-    let vector = (arrow.gradient * scale).as_vec3();
+    let vector = arrow.vector.as_vec3();
     let length = vector.length();
     if length <= 0.0 || !length.is_finite() {
         return;

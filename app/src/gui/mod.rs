@@ -15,10 +15,11 @@ use eframe::egui;
 use geometry::{SceneCache, ViewOptions};
 use panels::controls::{SceneChoice, SceneRequest};
 use shortcuts::{Action, SHORTCUTS};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
 use tetlab_core::solver::Settings;
 use viewport::Viewport;
+use web_time::Instant;
 use workbench::Workbench;
 
 /// What the workbench remembers between runs (eframe storage).
@@ -132,6 +133,7 @@ impl TetlabApp {
             Action::TogglePin => bench.toggle_pin(),
             Action::NextTet => bench.next_tet_of_selected(),
             Action::FrameView => self.viewport.frame(&self.bench),
+            Action::ResetCamera => self.viewport.reset_camera(&self.bench),
             Action::Help => self.show_help = !self.show_help,
         }
     }
@@ -170,7 +172,7 @@ impl eframe::App for TetlabApp {
             ctx.request_repaint();
         }
         let mut request = None;
-        let mut frame_view = false;
+        let mut view_request = None;
         egui::Panel::left("controls")
             .default_size(300.0)
             .show(ui, |ui| {
@@ -196,7 +198,7 @@ impl eframe::App for TetlabApp {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     panels::readouts::show(ui, &self.bench, self.step_time);
                     ui.separator();
-                    frame_view = panels::display::show(
+                    view_request = panels::display::show(
                         ui,
                         &mut self.preferences.view,
                         self.bench.simulation.tets().len(),
@@ -211,8 +213,8 @@ impl eframe::App for TetlabApp {
         if let Some(request) = request {
             self.request(request);
         }
-        if frame_view {
-            self.viewport.frame(&self.bench);
+        if let Some(action) = view_request {
+            self.act(action);
         }
         self.preferences.settings = *self.bench.simulation.settings();
     }

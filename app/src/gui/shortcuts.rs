@@ -27,12 +27,14 @@ pub enum Action {
     NextTet,
     /// Frame the body in the view.
     FrameView,
+    /// Back to the first camera view.
+    ResetCamera,
     /// Show or hide the help.
     Help,
 }
 
 /// Every shortcut: key, action, what the help says.
-pub const SHORTCUTS: [(Key, Action, &str); 12] = [
+pub const SHORTCUTS: [(Key, Action, &str); 13] = [
     (Key::Space, Action::PlayPause, "play / pause"),
     (Key::N, Action::StepFrame, "step one frame"),
     (Key::U, Action::StepSubstep, "step one substep"),
@@ -48,5 +50,6 @@ pub const SHORTCUTS: [(Key, Action, &str); 12] = [
     ),
     (Key::T, Action::NextTet, "next tet of the selected particle"),
     (Key::V, Action::FrameView, "frame the body"),
+    (Key::C, Action::ResetCamera, "reset the camera"),
     (Key::H, Action::Help, "this help"),
 ];

@@ -37,7 +37,7 @@ impl Viewport {
             drag_plane: None,
             rect: Rect::NOTHING,
         };
-        viewport.frame(bench);
+        viewport.reset_camera(bench);
         viewport
     }
 
@@ -45,6 +45,12 @@ impl Viewport {
     pub fn frame(&mut self, bench: &Workbench) {
         let (lo, hi) = tetlab_core::visual::bounds(bench.simulation.positions());
         self.camera.frame(lo.as_vec3(), hi.as_vec3());
+    }
+
+    /// Back to the first view: the default angles, framing the rest shape.
+    pub fn reset_camera(&mut self, bench: &Workbench) {
+        let (lo, hi) = tetlab_core::visual::bounds(bench.simulation.rest_positions());
+        self.camera = OrbitCamera::framing(lo.as_vec3(), hi.as_vec3());
     }
 
     /// Shows the view in all the space `ui` has left.
@@ -117,7 +123,7 @@ impl Viewport {
         };
         ui.painter()
             .add(egui_wgpu::Callback::new_paint_callback(rect, callback));
-        legend(ui, rect, bench);
+        legend(ui, rect, bench, options);
     }
 
     /// The particle nearest to screen point `p` within [`PICK_RADIUS`], in front of the camera.
@@ -164,7 +170,7 @@ fn to_glam(v: Vec2) -> GVec2 {
 }
 
 /// The colour key in the view's corner.
-fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench) {
+fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
     use tetlab_core::constraints::Family;
     use tetlab_core::visual;
     let painter = ui.painter_at(rect);
@@ -194,10 +200,11 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench) {
         visual::INVERTED,
         format!("inverted ({} tets)", bench.metrics.inverted_tets),
     );
-    entry([250, 200, 40, 255], "selected tet".to_owned());
+    entry(geometry::SELECTED, "selected tet".to_owned());
+    let active = bench.simulation.settings().active;
     for family in Family::ALL
         .into_iter()
-        .filter(|&f| bench.simulation.settings().active.get(f))
+        .filter(|&f| options.arrows && active.get(f))
     {
         let name = match family {
             Family::Distance => "grad C: edges",
@@ -205,6 +212,12 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench) {
             Family::Volume => "grad C: volume",
         };
         entry(visual::family_colour(family), name.to_owned());
+    }
+    if options.corrections {
+        entry(
+            visual::CORRECTION,
+            format!("dp, last substep (x{})", options.correction_gain),
+        );
     }
 }
 

@@ -1,10 +1,11 @@
 //! What the 3D view shows.
 
 use crate::gui::geometry::{ARROWS_ON_ALL_UP_TO, ViewOptions};
+use crate::gui::shortcuts::Action;
 use eframe::egui;
 
-/// Shows the display options; returns true if "frame the body" was pressed.
-pub fn show(ui: &mut egui::Ui, options: &mut ViewOptions, tets: usize) -> bool {
+/// Shows the display options; returns the camera action asked for, if any.
+pub fn show(ui: &mut egui::Ui, options: &mut ViewOptions, tets: usize) -> Option<Action> {
     ui.heading("Display");
     ui.checkbox(&mut options.see_through, "See-through (all faces)");
     ui.checkbox(&mut options.colour_by_volume, "Colour by V/V0");
@@ -25,5 +26,22 @@ pub fn show(ui: &mut egui::Ui, options: &mut ViewOptions, tets: usize) -> bool {
             .logarithmic(true)
             .text("arrow length"),
     );
-    ui.button("Frame the body").on_hover_text("V").clicked()
+    ui.checkbox(&mut options.corrections, "Corrections dp (last substep)")
+        .on_hover_text("The displacement the last substep's projections gave each particle");
+    ui.add_enabled(
+        options.corrections,
+        egui::Slider::new(&mut options.correction_gain, 1.0..=1000.0)
+            .logarithmic(true)
+            .text("dp drawn x"),
+    );
+    let mut action = None;
+    ui.horizontal(|ui| {
+        if ui.button("Frame the body").on_hover_text("V").clicked() {
+            action = Some(Action::FrameView);
+        }
+        if ui.button("Reset camera").on_hover_text("C").clicked() {
+            action = Some(Action::ResetCamera);
+        }
+    });
+    action
 }

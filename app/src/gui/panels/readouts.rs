@@ -26,6 +26,14 @@ pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration) {
             ("volume error", format!("{:.3e}", m.volume_error)),
             ("max edge strain", format!("{:.3e}", m.max_edge_strain)),
             (
+                "settling an edit",
+                if bench.simulation.is_settling() {
+                    "yes".to_owned()
+                } else {
+                    "no".to_owned()
+                },
+            ),
+            (
                 "step time",
                 format!("{:.2} ms", step_time.as_secs_f64() * 1e3),
             ),
