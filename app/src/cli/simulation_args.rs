@@ -45,8 +45,8 @@ pub struct SimulationArgs {
     /// PBD stiffness of a family, FAMILY=k with 0 ≤ k ≤ 1 (default 1); repeatable.
     #[arg(long, value_name = "FAMILY=k", value_parser = stiffness)]
     pub stiffness: Vec<(Family, f64)>,
-    /// In the frame after the perturbation, move particles back onto the constraints without
-    /// giving them velocity (otherwise a large violation launches the body).
+    /// After the perturbation, let corrections move particles but not speed them up until the
+    /// violation is undone (otherwise a large violation launches the body).
     #[arg(long)]
     pub settle_edits: bool,
     /// Velocity damping per second (≥ 0).
