@@ -37,8 +37,8 @@ fn pixels_like(harness: &mut Harness<'static, TetlabApp>, colour: visual::Rgba) 
     let mut count = 0;
     for y in (rect.min.y * scale) as u32..(rect.max.y * scale) as u32 {
         for x in (rect.min.x * scale) as u32..(rect.max.x * scale) as u32 {
-            let in_legend = (x as f32) < (rect.min.x + 180.0) * scale
-                && (y as f32) < (rect.min.y + 100.0) * scale;
+            let in_legend = (x as f32) < (rect.min.x + 200.0) * scale
+                && (y as f32) < (rect.min.y + 160.0) * scale;
             if in_legend {
                 continue;
             }
@@ -322,4 +322,85 @@ fn readme_screenshot() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/workbench.png");
     image.save(&path).unwrap();
     harness.snapshot("readme_screenshot");
+}
+
+/// Step-by-step mode on a lone inverted tet: J begins a substep, then projects one constraint per
+/// press (highlighted in the view with its arrows), then closes the sweep; K finishes a substep.
+#[test]
+fn step_by_step_projects_one_constraint_per_key_press() {
+    use tetlab_core::stepper::{Advanced, StepByStep};
+    let mut harness = workbench("tet", 1);
+    harness.key_press(egui::Key::I);
+    harness.run_steps(1);
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 1);
+    let inverted_ratio = harness.state().bench.metrics.min_volume_ratio;
+    let mut expected = harness.state().bench.simulation.clone();
+    expected.substep();
+
+    harness.key_press(egui::Key::J);
+    harness.run_steps(1);
+    assert_eq!(
+        harness.state().bench.last_advance,
+        Some(Advanced::BeganSubstep)
+    );
+    // Six edges, then the volume: stop before the volume to see it pending.
+    for _ in 0..6 {
+        harness.key_press(egui::Key::J);
+        harness.run_steps(1);
+        assert!(matches!(
+            harness.state().bench.last_advance,
+            Some(Advanced::Projected(_))
+        ));
+    }
+    let pending = harness
+        .state()
+        .bench
+        .stepping
+        .unwrap()
+        .pending(&harness.state().bench.simulation)
+        .expect("the volume is next");
+    assert_eq!(pending.family, tetlab_core::constraints::Family::Volume);
+    harness.get_by_label_contains("next projects volume #0");
+    assert!(
+        pixels_like(&mut harness, tetlab::gui::geometry::PENDING) > 50,
+        "the pending constraint is highlighted"
+    );
+    assert!(
+        pixels_like(&mut harness, visual::CORRECTION) > 20,
+        "with the Δx it will apply"
+    );
+    harness.snapshot("step_by_step");
+
+    harness.key_press(egui::Key::K);
+    harness.run_steps(1);
+    let bench = &harness.state().bench;
+    assert_eq!(bench.stepping, Some(StepByStep::BetweenSubsteps));
+    assert_eq!(bench.simulation.positions(), expected.positions());
+    assert!(
+        bench.metrics.min_volume_ratio > inverted_ratio + 0.5,
+        "the volume projection pushed the tet back: V/V0 {inverted_ratio} -> {}",
+        bench.metrics.min_volume_ratio
+    );
+
+    harness.key_press(egui::Key::Space);
+    harness.run_steps(1);
+    assert!(harness.state().bench.playing && harness.state().bench.stepping.is_none());
+}
+
+/// The inspector (E) shows the selected tet's constraints with their formulas and the
+/// finite-difference check.
+#[test]
+fn the_inspector_shows_the_numbers_of_the_selected_tet() {
+    let mut harness = workbench("cube", 2);
+    harness.get_by_label("heights (plane)").click();
+    harness.key_press(egui::Key::I);
+    harness.key_press(egui::Key::E);
+    harness.run_steps(2);
+    assert!(harness.state().show_inspector);
+    harness.get_by_label_contains("Tet 0: particles");
+    harness.get_by_label_contains("Signed volume (1)");
+    harness.get_by_label_contains("C = ⅙ e₁ · (e₂ × e₃) − V");
+    harness.get_by_label_contains("volume #0   C = ");
+    harness.get_by_label_contains("finite-difference relative error");
+    harness.snapshot("inspector");
 }

@@ -3,17 +3,21 @@
 //! - [`constraints`]: the edge-distance, height-above-face ("plane") and signed-volume
 //!   constraints, their values and analytic gradients, written once for f32 and f64.
 //! - [`finite_difference`]: numerical gradients to check the analytic ones against.
-//! - [`verify`]: analytic gradients against finite differences on random configurations.
+//! - [`verify`]: analytic gradients against finite differences on random configurations;
+//!   [`inspector`]: the same check, live, on the constraints of one tet.
 //! - [`random`]: a seeded generator, so random inputs are the same everywhere.
 //! - [`vector`]: the small vector trait the formulas are generic over.
+//! - [`solver`]: the XPBD/PBD simulation; [`stepper`]: the same, one projection at a time.
 
 pub mod constraints;
 pub mod finite_difference;
+pub mod inspector;
 pub mod mesh;
 pub mod metrics;
 pub mod random;
 pub mod scene;
 pub mod solver;
+pub mod stepper;
 pub mod vector;
 pub mod verify;
 pub mod visual;

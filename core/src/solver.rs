@@ -26,7 +26,7 @@
 //! nothing, and the same inputs give the same bits.
 
 use crate::constraints::{Evaluation, Family, distance, plane, volume};
-use crate::mesh::TetMesh;
+use crate::mesh::{TET_EDGES, TetMesh};
 use crate::scene::Scene;
 use glam::DVec3;
 
@@ -223,11 +223,7 @@ fn correction<const N: usize>(
     if evaluation.degenerate {
         return None;
     }
-    let weighted_norm: f64 = weights
-        .iter()
-        .zip(&evaluation.gradients)
-        .map(|(w, g)| w * g.length_squared())
-        .sum();
+    let weighted_norm = weighted_norm(&weights, &evaluation.gradients);
     if weighted_norm <= 0.0 || !weighted_norm.is_finite() {
         return None;
     }
@@ -246,6 +242,16 @@ fn correction<const N: usize>(
         delta_lambda,
         delta_x,
     })
+}
+
+/// Σ wᵢ |∇ₚᵢC|², the denominator of every projection.
+#[inline]
+fn weighted_norm<const N: usize>(weights: &[f64; N], gradients: &[DVec3; N]) -> f64 {
+    weights
+        .iter()
+        .zip(gradients)
+        .map(|(w, g)| w * g.length_squared())
+        .sum()
 }
 
 /// A particle held by the user.
@@ -543,8 +549,26 @@ impl Simulation {
     }
 
     /// One substep: predict, project every active family `iterations` times, update velocities.
+    /// The same as [`Simulation::begin_substep`], then for each iteration every constraint of
+    /// [`Simulation::projection_order`] through [`Simulation::project`] and
+    /// [`Simulation::end_sweep`], then [`Simulation::end_substep`] — done here in tight loops.
     pub fn substep(&mut self) {
-        let h = self.settings.dt / self.settings.substeps.max(1) as f64;
+        let h = self.substep_length();
+        self.begin_substep();
+        for _ in 0..self.settings.iterations.max(1) {
+            self.sweep(h);
+        }
+        self.end_substep();
+    }
+
+    /// h = Δt / substeps.
+    pub fn substep_length(&self) -> f64 {
+        self.settings.dt / self.settings.substeps.max(1) as f64
+    }
+
+    /// The first part of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
+    pub fn begin_substep(&mut self) {
+        let h = self.substep_length();
         self.predict(h);
         for lambda in [
             &mut self.edges.lambda,
@@ -556,13 +580,118 @@ impl Simulation {
         if let Some(grab) = &mut self.grab {
             grab.lambda = 0.0;
         }
-        for _ in 0..self.settings.iterations.max(1) {
-            self.sweep(h);
+    }
+
+    /// The end of one sweep, after the constraint families: the grab, then the ground y ≥ 0.
+    pub fn end_sweep(&mut self) {
+        let h = self.substep_length();
+        self.project_soft_grab(h);
+        if self.settings.ground {
+            for (p, &w) in self.positions.iter_mut().zip(&self.inverse_masses) {
+                if w > 0.0 && p.y < 0.0 {
+                    p.y = 0.0;
+                }
+            }
         }
+    }
+
+    /// The last part of a substep: Δp = x − predicted x, then velocities from the positions.
+    pub fn end_substep(&mut self) {
+        let h = self.substep_length();
         for (correction, p) in self.corrections.iter_mut().zip(&self.positions) {
             *correction = *p - *correction;
         }
         self.update_velocities(h, self.settings.settle_edits && self.settling.is_some());
+    }
+
+    /// The constraints one sweep projects, in order: every constraint of each active family
+    /// (edges, then heights, then volumes), as (family, index in the family).
+    pub fn projection_order(&self) -> impl Iterator<Item = (Family, usize)> + '_ {
+        let active = self.settings.active;
+        Family::ALL
+            .into_iter()
+            .filter(move |&f| active.get(f))
+            .flat_map(move |f| (0..self.constraint_count(f)).map(move |c| (f, c)))
+    }
+
+    /// The constraints of `family` on tet `tet`, as indices in the family: its edges (six), its
+    /// four heights, or its volume.
+    pub fn tet_constraints(&self, tet: usize, family: Family) -> impl Iterator<Item = usize> + '_ {
+        let corners = self.tets[tet];
+        let edges = (family == Family::Distance)
+            .then(|| {
+                TET_EDGES.iter().filter_map(move |&(a, b)| {
+                    let key = [corners[a].min(corners[b]), corners[a].max(corners[b])];
+                    self.edges.particles.binary_search(&key).ok()
+                })
+            })
+            .into_iter()
+            .flatten();
+        let heights = (family == Family::Plane)
+            .then(|| 4 * tet..4 * tet + 4)
+            .into_iter()
+            .flatten();
+        let volume = (family == Family::Volume).then_some(tet);
+        edges.chain(heights).chain(volume)
+    }
+
+    /// How many constraints `family` has.
+    pub fn constraint_count(&self, family: Family) -> usize {
+        match family {
+            Family::Distance => self.edges.len(),
+            Family::Plane => self.planes.len(),
+            Family::Volume => self.volumes.len(),
+        }
+    }
+
+    /// What projecting constraint `c` of `family` now would do, with the current λ and the rule
+    /// (XPBD or PBD) of the current settings: C, ∇C, the inverse masses, Δλ and Δx.
+    pub fn projection(&self, family: Family, c: usize) -> Projection {
+        let rule = self.rule(family, self.substep_length());
+        match family {
+            Family::Distance => describe(
+                family,
+                c,
+                &self.edges,
+                &self.positions,
+                &self.inverse_masses,
+                rule,
+                distance::evaluate,
+            ),
+            Family::Plane => describe(
+                family,
+                c,
+                &self.planes,
+                &self.positions,
+                &self.inverse_masses,
+                rule,
+                plane::evaluate,
+            ),
+            Family::Volume => describe(
+                family,
+                c,
+                &self.volumes,
+                &self.positions,
+                &self.inverse_masses,
+                rule,
+                volume::evaluate,
+            ),
+        }
+    }
+
+    /// Projects constraint `c` of `family` once, exactly as a sweep does.
+    pub fn project(&mut self, family: Family, c: usize) {
+        let rule = self.rule(family, self.substep_length());
+        let (positions, w) = (&mut self.positions, &self.inverse_masses);
+        match family {
+            Family::Distance => {
+                project_one(&mut self.edges, positions, w, rule, distance::evaluate, c)
+            }
+            Family::Plane => project_one(&mut self.planes, positions, w, rule, plane::evaluate, c),
+            Family::Volume => {
+                project_one(&mut self.volumes, positions, w, rule, volume::evaluate, c)
+            }
+        }
     }
 
     /// The longest Δp of the last substep among particles that can move.
@@ -644,14 +773,7 @@ impl Simulation {
                 volume::evaluate,
             );
         }
-        self.project_soft_grab(h);
-        if self.settings.ground {
-            for (p, &w) in self.positions.iter_mut().zip(&self.inverse_masses) {
-                if w > 0.0 && p.y < 0.0 {
-                    p.y = 0.0;
-                }
-            }
-        }
+        self.end_sweep();
     }
 
     fn project_soft_grab(&mut self, h: f64) {
@@ -693,16 +815,108 @@ fn project_all<const N: usize>(
     evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
 ) {
     for c in 0..set.particles.len() {
-        let idx = set.particles[c];
-        let evaluation = evaluate(&idx.map(|i| positions[i as usize]), set.rest[c]);
-        let weights = idx.map(|i| inverse_masses[i as usize]);
-        if let Some(correction) = correction(evaluation, weights, set.lambda[c], rule) {
-            set.lambda[c] += correction.delta_lambda;
-            for k in 0..N {
-                positions[idx[k] as usize] += correction.delta_x[k];
-            }
+        project_one(set, positions, inverse_masses, rule, evaluate, c);
+    }
+}
+
+/// Projects constraint `c` of `set`: λ += Δλ, xᵢ += Δxᵢ.
+#[inline]
+fn project_one<const N: usize>(
+    set: &mut ConstraintSet<N>,
+    positions: &mut [DVec3],
+    inverse_masses: &[f64],
+    rule: Rule,
+    evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
+    c: usize,
+) {
+    let idx = set.particles[c];
+    let evaluation = evaluate(&idx.map(|i| positions[i as usize]), set.rest[c]);
+    let weights = idx.map(|i| inverse_masses[i as usize]);
+    if let Some(correction) = correction(evaluation, weights, set.lambda[c], rule) {
+        set.lambda[c] += correction.delta_lambda;
+        for k in 0..N {
+            positions[idx[k] as usize] += correction.delta_x[k];
         }
     }
+}
+
+/// One constraint, described for a reader: see [`Simulation::projection`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    /// The constraint's family.
+    pub family: Family,
+    /// Its index within the family.
+    pub constraint: usize,
+    /// Its particles; the first [`Projection::len`] are used (2 for an edge, 4 otherwise).
+    pub particles: [u32; 4],
+    /// How many particles it has.
+    pub len: usize,
+    /// C now.
+    pub value: f64,
+    /// The rest value, d or V.
+    pub rest: f64,
+    /// ∇ₚC for each particle.
+    pub gradients: [DVec3; 4],
+    /// The inverse mass w of each particle (0 if pinned or held).
+    pub inverse_masses: [f64; 4],
+    /// Σ wᵢ |∇ₚᵢC|².
+    pub weighted_norm: f64,
+    /// λ accumulated so far in this substep (XPBD).
+    pub lambda: f64,
+    /// XPBD: Δλ; PBD: k′ s. `None` when the projection is skipped (degenerate, or every particle
+    /// fixed).
+    pub delta_lambda: Option<f64>,
+    /// Δx the projection would give each particle (zero when skipped).
+    pub delta_x: [DVec3; 4],
+    /// Whether ∇C is undefined here.
+    pub degenerate: bool,
+}
+
+impl Projection {
+    /// The particles it uses.
+    pub fn particles(&self) -> &[u32] {
+        &self.particles[..self.len]
+    }
+}
+
+/// [`Projection`] of constraint `c` of `set`.
+fn describe<const N: usize>(
+    family: Family,
+    c: usize,
+    set: &ConstraintSet<N>,
+    positions: &[DVec3],
+    inverse_masses: &[f64],
+    rule: Rule,
+    evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
+) -> Projection {
+    let idx = set.particles[c];
+    let evaluation = evaluate(&idx.map(|i| positions[i as usize]), set.rest[c]);
+    let weights = idx.map(|i| inverse_masses[i as usize]);
+    let correction = correction(evaluation, weights, set.lambda[c], rule);
+    let mut projection = Projection {
+        family,
+        constraint: c,
+        particles: [0; 4],
+        len: N,
+        value: evaluation.value,
+        rest: set.rest[c],
+        gradients: [DVec3::ZERO; 4],
+        inverse_masses: [0.0; 4],
+        weighted_norm: weighted_norm(&weights, &evaluation.gradients),
+        lambda: set.lambda[c],
+        delta_lambda: correction.map(|c| c.delta_lambda),
+        delta_x: [DVec3::ZERO; 4],
+        degenerate: evaluation.degenerate,
+    };
+    for k in 0..N {
+        projection.particles[k] = idx[k];
+        projection.gradients[k] = evaluation.gradients[k];
+        projection.inverse_masses[k] = weights[k];
+        if let Some(correction) = &correction {
+            projection.delta_x[k] = correction.delta_x[k];
+        }
+    }
+    projection
 }
 
 /// 1 / Σ (density × V₀ / 4) over the tets at each particle. A particle whose tets all have zero

@@ -1,10 +1,10 @@
 //! What to draw, derived from a simulation once for every front end: the recorder logs it and
 //! the GUI paints it, so both show the same arrows in the same colours.
 
+use crate::constraints::Family;
 use crate::constraints::volume::signed_volume;
-use crate::constraints::{Family, distance, plane, volume};
 use crate::mesh::{TET_EDGES, TetMesh};
-use crate::solver::Simulation;
+use crate::solver::{Projection, Simulation};
 use glam::DVec3;
 
 /// An sRGB colour with alpha, 0–255 per channel.
@@ -212,10 +212,13 @@ pub fn tet_gradient_arrows(
     out: &mut Vec<Arrow>,
 ) {
     let positions = simulation.positions();
-    let corners = simulation.tets()[tet];
     let first = out.len();
-    let mut push = |particles: &[u32], gradients: &[DVec3]| {
-        for (&particle, &gradient) in particles.iter().zip(gradients) {
+    for c in simulation.tet_constraints(tet, family) {
+        let projection = simulation.projection(family, c);
+        if projection.degenerate {
+            continue;
+        }
+        for (&particle, &gradient) in projection.particles().iter().zip(&projection.gradients) {
             out.push(Arrow {
                 quantity: Quantity::Gradient(family),
                 particle,
@@ -224,46 +227,64 @@ pub fn tet_gradient_arrows(
                 vector: DVec3::ZERO,
             });
         }
-    };
-    match family {
-        Family::Distance => {
-            let edges = &simulation.edges;
-            for (a, b) in TET_EDGES {
-                let key = [corners[a].min(corners[b]), corners[a].max(corners[b])];
-                if let Ok(c) = edges.particles.binary_search(&key) {
-                    let p = key.map(|i| positions[i as usize]);
-                    let e = distance::evaluate(&p, edges.rest[c]);
-                    if !e.degenerate {
-                        push(&key, &e.gradients);
-                    }
-                }
-            }
-        }
-        Family::Plane => {
-            let planes = &simulation.planes;
-            for c in 4 * tet..4 * tet + 4 {
-                let idx = planes.particles[c];
-                let e = plane::evaluate(&idx.map(|i| positions[i as usize]), planes.rest[c]);
-                if !e.degenerate {
-                    push(&idx, &e.gradients);
-                }
-            }
-        }
-        Family::Volume => {
-            let volumes = &simulation.volumes;
-            let idx = volumes.particles[tet];
-            let e = volume::evaluate(&idx.map(|i| positions[i as usize]), volumes.rest[tet]);
-            if !e.degenerate {
-                push(&idx, &e.gradients);
-            }
+    }
+    let length = gain * GRADIENT_ARROW_LENGTH * tet_size(positions, &simulation.tets()[tet]);
+    scale_to_longest(&mut out[first..], length);
+}
+
+/// Sets each arrow's vector to its value times one factor, chosen so the longest is `length`.
+fn scale_to_longest(arrows: &mut [Arrow], length: f64) {
+    let longest = arrows.iter().map(|a| a.value.length()).fold(0.0, f64::max);
+    let scale = if longest > 0.0 { length / longest } else { 0.0 };
+    for arrow in arrows {
+        arrow.vector = arrow.value * scale;
+    }
+}
+
+/// The arrows of one projection (the one step-by-step mode is about to make): ∇ₚC at each of its
+/// particles, the longest drawn `gain` × [`GRADIENT_ARROW_LENGTH`] × the mean distance between
+/// them, and the Δx it will apply, `correction_gain` times its true length. Appends to `out`.
+pub fn projection_arrows(
+    positions: &[DVec3],
+    projection: &Projection,
+    gain: f64,
+    correction_gain: f64,
+    out: &mut Vec<Arrow>,
+) {
+    let particles = projection.particles();
+    let point = |k: usize| positions[particles[k] as usize];
+    let mut size = 0.0;
+    let mut pairs = 0;
+    for a in 0..particles.len() {
+        for b in a + 1..particles.len() {
+            size += point(a).distance(point(b));
+            pairs += 1;
         }
     }
-    let added = &mut out[first..];
-    let longest = added.iter().map(|a| a.value.length()).fold(0.0, f64::max);
-    let length = gain * GRADIENT_ARROW_LENGTH * tet_size(positions, &corners);
-    let scale = if longest > 0.0 { length / longest } else { 0.0 };
-    for arrow in added {
-        arrow.vector = arrow.value * scale;
+    let size = size / pairs.max(1) as f64;
+    let first = out.len();
+    if !projection.degenerate {
+        for (&particle, &gradient) in particles.iter().zip(&projection.gradients) {
+            out.push(Arrow {
+                quantity: Quantity::Gradient(projection.family),
+                particle,
+                origin: positions[particle as usize],
+                value: gradient,
+                vector: DVec3::ZERO,
+            });
+        }
+    }
+    scale_to_longest(&mut out[first..], gain * GRADIENT_ARROW_LENGTH * size);
+    for (&particle, &delta) in particles.iter().zip(&projection.delta_x) {
+        if delta != DVec3::ZERO {
+            out.push(Arrow {
+                quantity: Quantity::Correction,
+                particle,
+                origin: positions[particle as usize],
+                value: delta,
+                vector: delta * correction_gain,
+            });
+        }
     }
 }
 

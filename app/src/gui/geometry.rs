@@ -54,6 +54,8 @@ pub const ARROWS_ON_ALL_UP_TO: usize = 64;
 
 /// Selected tets and particles.
 pub const SELECTED: Rgba = [250, 200, 40, 255];
+/// The constraint step-by-step mode projects next: its particles and the lines between them.
+pub const PENDING: Rgba = [40, 220, 220, 255];
 /// The particle under the pointer.
 const HOVERED: Rgba = [255, 255, 255, 255];
 /// Pinned particles.
@@ -186,36 +188,79 @@ pub fn build(
         ground_grid(&mut geometry.lines, simulation.rest_positions(), cache.size);
     }
 
-    let all = options.arrows_on_all_tets && tets.len() <= ARROWS_ON_ALL_UP_TO;
-    let chosen: Vec<usize> = if all {
-        (0..tets.len()).collect()
-    } else {
-        bench.selected_tet.into_iter().collect()
-    };
     let mut arrows = Vec::new();
+    let pending = bench.stepping.and_then(|s| s.pending(simulation));
+    if let Some(projection) = &pending {
+        let particles = projection.particles();
+        for a in 0..particles.len() {
+            for b in a + 1..particles.len() {
+                line(
+                    &mut geometry.lines,
+                    positions[particles[a] as usize].as_vec3(),
+                    positions[particles[b] as usize].as_vec3(),
+                    PENDING,
+                );
+            }
+        }
+        let radius = (0.02 * cache.size) as f32;
+        for &i in particles {
+            octahedron(
+                &mut geometry.triangles,
+                positions[i as usize].as_vec3(),
+                radius,
+                PENDING,
+            );
+        }
+        visual::projection_arrows(
+            positions,
+            projection,
+            options.arrow_scale as f64,
+            options.correction_gain as f64,
+            &mut arrows,
+        );
+    } else {
+        tet_arrows(bench, options, &mut arrows);
+    }
+    for arrow in &arrows {
+        draw_arrow(&mut geometry, arrow);
+    }
+    geometry
+}
+
+/// The arrows of the selected tet (or of every tet of a small mesh): ∇C per active family, and
+/// Δp of the last substep, as the options ask.
+fn tet_arrows(bench: &Workbench, options: &ViewOptions, arrows: &mut Vec<Arrow>) {
+    let simulation = &bench.simulation;
+    let tets = simulation.tets();
+    let all = options.arrows_on_all_tets && tets.len() <= ARROWS_ON_ALL_UP_TO;
+    let chosen = if all {
+        0..tets.len()
+    } else {
+        match bench.selected_tet {
+            Some(tet) => tet..tet + 1,
+            None => 0..0,
+        }
+    };
     if options.arrows {
         for family in Family::ALL
             .into_iter()
             .filter(|&f| simulation.settings().active.get(f))
         {
-            for &tet in &chosen {
+            for tet in chosen.clone() {
                 let gain = options.arrow_scale as f64;
-                visual::tet_gradient_arrows(simulation, tet, family, gain, &mut arrows);
+                visual::tet_gradient_arrows(simulation, tet, family, gain, arrows);
             }
         }
     }
     if options.corrections {
         let gain = options.correction_gain as f64;
         if all {
-            visual::correction_arrows(simulation, 0..positions.len() as u32, gain, &mut arrows);
+            let particles = 0..simulation.positions().len() as u32;
+            visual::correction_arrows(simulation, particles, gain, arrows);
         } else if let Some(tet) = bench.selected_tet {
-            visual::correction_arrows(simulation, tets[tet], gain, &mut arrows);
+            visual::correction_arrows(simulation, tets[tet], gain, arrows);
         }
     }
-    for arrow in &arrows {
-        draw_arrow(&mut geometry, arrow);
-    }
-    geometry
 }
 
 fn vertex(position: Vec3, normal: Vec3, color: Rgba) -> Vertex {
@@ -254,7 +299,7 @@ fn octahedron(out: &mut Vec<Vertex>, centre: Vec3, r: f32, colour: Rgba) {
 }
 
 /// An arrow: a shaft from the particle along its vector and a cone at its tip, in its quantity's
-/// colour.
+/// colour, in the overlay (never hidden by the body).
 fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow) {
     let colour = arrow.quantity.colour();
     let start = arrow.origin.as_vec3();
@@ -264,7 +309,7 @@ fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow) {
         return;
     }
     let tip = start + vector;
-    line(&mut geometry.lines, start, tip, colour);
+    line(&mut geometry.overlay_lines, start, tip, colour);
     let direction = vector / length;
     let head = 0.2 * length;
     let base = tip - direction * head;
@@ -275,8 +320,8 @@ fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow) {
         let angle = |k: usize| std::f32::consts::TAU * k as f32 / segments as f32;
         let ring = |a: f32| base + side * a.cos() + other * a.sin();
         let (p, q) = (ring(angle(k)), ring(angle(k + 1)));
-        triangle(&mut geometry.triangles, [tip, p, q], colour);
-        triangle(&mut geometry.triangles, [base, q, p], colour);
+        triangle(&mut geometry.overlay_triangles, [tip, p, q], colour);
+        triangle(&mut geometry.overlay_triangles, [base, q, p], colour);
     }
 }
 
@@ -313,7 +358,10 @@ mod tests {
         assert_eq!(geometry.lines.len() % 2, 0);
         let arrow_colour = visual::family_colour(Family::Volume);
         assert!(
-            geometry.lines.iter().any(|v| v.color == arrow_colour),
+            geometry
+                .overlay_lines
+                .iter()
+                .any(|v| v.color == arrow_colour),
             "volume arrows are drawn"
         );
         assert!(

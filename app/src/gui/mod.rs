@@ -51,6 +51,26 @@ impl Default for Preferences {
 
 const STORAGE_KEY: &str = "tetlab";
 
+/// Adds DejaVu Sans Mono after egui's own fonts, for the glyphs of the formulas (∇ ₀ ⅙ × λ Δ …)
+/// that egui's fonts lack.
+pub fn install_fonts(ctx: &egui::Context) {
+    let mut fonts = egui::FontDefinitions::default();
+    fonts.font_data.insert(
+        "DejaVuSansMono".into(),
+        std::sync::Arc::new(egui::FontData::from_static(include_bytes!(
+            "../../../assets/fonts/DejaVuSansMono.ttf"
+        ))),
+    );
+    for family in [egui::FontFamily::Proportional, egui::FontFamily::Monospace] {
+        fonts
+            .families
+            .entry(family)
+            .or_default()
+            .push("DejaVuSansMono".into());
+    }
+    ctx.set_fonts(fonts);
+}
+
 /// The workbench application.
 pub struct TetlabApp {
     /// The simulation and selection.
@@ -64,6 +84,8 @@ pub struct TetlabApp {
     pub error: Option<String>,
     step_time: Duration,
     show_help: bool,
+    /// Whether the inspector window is open.
+    pub show_inspector: bool,
 }
 
 impl TetlabApp {
@@ -74,6 +96,7 @@ impl TetlabApp {
             .as_ref()
             .ok_or("tetlab's 3D view needs the wgpu renderer")?;
         render::Renderer::install(render_state);
+        install_fonts(&cc.egui_ctx);
         let preferences: Preferences = cc
             .storage
             .and_then(|s| eframe::get_value(s, STORAGE_KEY))
@@ -95,6 +118,7 @@ impl TetlabApp {
             error: None,
             step_time: Duration::ZERO,
             show_help: false,
+            show_inspector: false,
         }
     }
 
@@ -125,6 +149,8 @@ impl TetlabApp {
             Action::PlayPause => bench.set_playing(!bench.playing),
             Action::StepFrame => bench.step_frame(),
             Action::StepSubstep => bench.step_substep(),
+            Action::StepProjection => bench.step_projection(),
+            Action::FinishSubstep => bench.finish_substep(),
             Action::Reset => bench.reset(),
             Action::InvertSelected => bench.invert_selected(),
             Action::Mirror => bench.perturb(Perturbation::Mirror),
@@ -134,6 +160,7 @@ impl TetlabApp {
             Action::NextTet => bench.next_tet_of_selected(),
             Action::FrameView => self.viewport.frame(&self.bench),
             Action::ResetCamera => self.viewport.reset_camera(&self.bench),
+            Action::Inspector => self.show_inspector = !self.show_inspector,
             Action::Help => self.show_help = !self.show_help,
         }
     }
@@ -189,7 +216,7 @@ impl eframe::App for TetlabApp {
                     request =
                         panels::controls::show(ui, &mut self.bench, &mut self.preferences.scene);
                     ui.separator();
-                    panels::tools::show(ui, &mut self.bench);
+                    panels::tools::show(ui, &mut self.bench, &mut self.show_inspector);
                 });
             });
         egui::Panel::right("readouts")
@@ -210,6 +237,7 @@ impl eframe::App for TetlabApp {
                 .show(ui, &mut self.bench, &self.cache, &self.preferences.view);
         });
         panels::help::show(&ctx, &mut self.show_help);
+        panels::inspector::show(&ctx, &mut self.show_inspector, &self.bench);
         if let Some(request) = request {
             self.request(request);
         }

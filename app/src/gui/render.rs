@@ -29,6 +29,11 @@ pub struct Geometry {
     pub transparent: Vec<Vertex>,
     /// Line segments, two vertices each.
     pub lines: Vec<Vertex>,
+    /// Lit triangles drawn last, on a cleared depth buffer: in front of the body, so arrows inside
+    /// or behind it stay visible (they still hide each other correctly).
+    pub overlay_triangles: Vec<Vertex>,
+    /// Line segments drawn with the overlay triangles.
+    pub overlay_lines: Vec<Vertex>,
 }
 
 #[repr(C)]
@@ -142,6 +147,8 @@ pub struct Renderer {
     triangle_buffer: VertexBuffer,
     transparent_buffer: VertexBuffer,
     line_buffer: VertexBuffer,
+    overlay_triangle_buffer: VertexBuffer,
+    overlay_line_buffer: VertexBuffer,
 }
 
 impl Renderer {
@@ -335,6 +342,8 @@ impl Renderer {
             triangle_buffer: VertexBuffer::new(device),
             transparent_buffer: VertexBuffer::new(device),
             line_buffer: VertexBuffer::new(device),
+            overlay_triangle_buffer: VertexBuffer::new(device),
+            overlay_line_buffer: VertexBuffer::new(device),
         }
     }
 
@@ -437,40 +446,66 @@ impl egui_wgpu::CallbackTrait for ViewCallback {
         renderer
             .line_buffer
             .upload(device, queue, &self.geometry.lines);
+        renderer
+            .overlay_triangle_buffer
+            .upload(device, queue, &self.geometry.overlay_triangles);
+        renderer
+            .overlay_line_buffer
+            .upload(device, queue, &self.geometry.overlay_lines);
         renderer.target(device, size);
         let renderer = &*renderer;
         let target = renderer.target.as_ref().expect("made above");
         let [r, g, b, a] = self.background;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("tetlab view"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.color,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &target.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
+        let background = wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a });
+        // The scene, then the overlay over it on a fresh depth buffer.
+        for (load, passes) in [
+            (
+                background,
+                [
+                    (&renderer.opaque, &renderer.triangle_buffer),
+                    (&renderer.lines, &renderer.line_buffer),
+                    (&renderer.transparent, &renderer.transparent_buffer),
+                ]
+                .as_slice(),
+            ),
+            (
+                wgpu::LoadOp::Load,
+                [
+                    (&renderer.opaque, &renderer.overlay_triangle_buffer),
+                    (&renderer.lines, &renderer.overlay_line_buffer),
+                ]
+                .as_slice(),
+            ),
+        ] {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("tetlab view"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target.color,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &target.depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
                 }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_bind_group(0, &renderer.uniform_group, &[]);
-        pass.set_pipeline(&renderer.opaque);
-        renderer.triangle_buffer.draw(&mut pass);
-        pass.set_pipeline(&renderer.lines);
-        renderer.line_buffer.draw(&mut pass);
-        pass.set_pipeline(&renderer.transparent);
-        renderer.transparent_buffer.draw(&mut pass);
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &renderer.uniform_group, &[]);
+            for (pipeline, buffer) in passes {
+                pass.set_pipeline(pipeline);
+                buffer.draw(&mut pass);
+            }
+        }
         Vec::new()
     }
 

@@ -11,6 +11,10 @@ pub enum Action {
     StepFrame,
     /// Advance one substep.
     StepSubstep,
+    /// Step-by-step: the next single projection (or prediction, or end of sweep).
+    StepProjection,
+    /// Step-by-step: finish the substep under way.
+    FinishSubstep,
     /// Back to the rest shape.
     Reset,
     /// Invert the selected tet.
@@ -29,15 +33,27 @@ pub enum Action {
     FrameView,
     /// Back to the first camera view.
     ResetCamera,
+    /// Show or hide the inspector.
+    Inspector,
     /// Show or hide the help.
     Help,
 }
 
 /// Every shortcut: key, action, what the help says.
-pub const SHORTCUTS: [(Key, Action, &str); 13] = [
+pub const SHORTCUTS: [(Key, Action, &str); 16] = [
     (Key::Space, Action::PlayPause, "play / pause"),
     (Key::N, Action::StepFrame, "step one frame"),
     (Key::U, Action::StepSubstep, "step one substep"),
+    (
+        Key::J,
+        Action::StepProjection,
+        "step by step: the next projection",
+    ),
+    (
+        Key::K,
+        Action::FinishSubstep,
+        "step by step: finish the substep",
+    ),
     (Key::R, Action::Reset, "reset to rest"),
     (Key::I, Action::InvertSelected, "invert the selected tet"),
     (Key::M, Action::Mirror, "mirror everything"),
@@ -51,5 +67,10 @@ pub const SHORTCUTS: [(Key, Action, &str); 13] = [
     (Key::T, Action::NextTet, "next tet of the selected particle"),
     (Key::V, Action::FrameView, "frame the body"),
     (Key::C, Action::ResetCamera, "reset the camera"),
+    (
+        Key::E,
+        Action::Inspector,
+        "inspector (numbers of the selected tet)",
+    ),
     (Key::H, Action::Help, "this help"),
 ];

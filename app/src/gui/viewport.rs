@@ -201,6 +201,12 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
         format!("inverted ({} tets)", bench.metrics.inverted_tets),
     );
     entry(geometry::SELECTED, "selected tet".to_owned());
+    let stepping = bench
+        .stepping
+        .is_some_and(|s| s.pending(&bench.simulation).is_some());
+    if stepping {
+        entry(geometry::PENDING, "next projection".to_owned());
+    }
     let active = bench.simulation.settings().active;
     for family in Family::ALL
         .into_iter()
@@ -213,7 +219,12 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
         };
         entry(visual::family_colour(family), name.to_owned());
     }
-    if options.corrections {
+    if stepping {
+        entry(
+            visual::CORRECTION,
+            format!("dx of the next projection (x{})", options.correction_gain),
+        );
+    } else if options.corrections {
         entry(
             visual::CORRECTION,
             format!("dp, last substep (x{})", options.correction_gain),

@@ -6,6 +6,7 @@ use std::collections::VecDeque;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::solver::{Settings, Simulation};
+use tetlab_core::stepper::{Advanced, StepByStep};
 
 /// How many frames of metrics the plots keep.
 pub const HISTORY: usize = 600;
@@ -39,6 +40,10 @@ pub struct Workbench {
     pub metrics: Metrics,
     /// Seed of the next scramble.
     pub scramble_seed: u64,
+    /// Step-by-step projection, while that mode is on (paused, one constraint per press).
+    pub stepping: Option<StepByStep>,
+    /// What the last step-by-step press did.
+    pub last_advance: Option<Advanced>,
 }
 
 impl Workbench {
@@ -55,6 +60,8 @@ impl Workbench {
             dragging: None,
             history: VecDeque::with_capacity(HISTORY),
             scramble_seed: 1,
+            stepping: None,
+            last_advance: None,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -75,18 +82,50 @@ impl Workbench {
 
     /// Advances one frame.
     pub fn step_frame(&mut self) {
+        self.leave_step_mode();
         self.simulation.step();
         self.after_change();
     }
 
     /// Advances one substep (Δt / substeps), without counting a frame.
     pub fn step_substep(&mut self) {
+        self.leave_step_mode();
         self.simulation.substep();
         self.after_change();
     }
 
+    /// Step-by-step mode: pauses, then does the next single thing of a substep — begin it
+    /// (predict), project one constraint, or close a sweep.
+    pub fn step_projection(&mut self) {
+        self.set_playing(false);
+        let stepper = self.stepping.get_or_insert_default();
+        self.last_advance = Some(stepper.advance(&mut self.simulation));
+        self.after_change();
+    }
+
+    /// Step-by-step mode: makes the remaining projections of the substep under way and ends it,
+    /// staying in the mode.
+    pub fn finish_substep(&mut self) {
+        if let Some(stepper) = &mut self.stepping {
+            stepper.finish(&mut self.simulation);
+            self.last_advance = None;
+            self.after_change();
+        }
+    }
+
+    /// Ends step-by-step mode, finishing the substep under way so that the simulation stands
+    /// between substeps (every edit and every other kind of step starts from there).
+    pub fn leave_step_mode(&mut self) {
+        if let Some(mut stepper) = self.stepping.take() {
+            stepper.finish(&mut self.simulation);
+            self.last_advance = None;
+        }
+    }
+
     /// Back to the rest shape.
     pub fn reset(&mut self) {
+        self.stepping = None;
+        self.last_advance = None;
         self.simulation.reset();
         self.history.clear();
         self.after_change();
@@ -94,6 +133,7 @@ impl Workbench {
 
     /// Applies a perturbation to the whole body.
     pub fn perturb(&mut self, perturbation: Perturbation) {
+        self.finish_substep();
         self.simulation.perturb(perturbation);
         self.after_change();
     }
@@ -114,6 +154,7 @@ impl Workbench {
         let Some(k) = corners.iter().position(|&i| i as usize == particle) else {
             return;
         };
+        self.finish_substep();
         let mut positions = self.simulation.positions().to_vec();
         reflect_through_opposite_face(&mut positions, &corners, k);
         self.simulation.place(particle, positions[particle]);
@@ -170,6 +211,7 @@ impl Workbench {
     /// Starts dragging a particle toward `target`: held by the grab constraint while playing,
     /// moved directly (kinematically) while paused.
     pub fn start_drag(&mut self, particle: usize, target: DVec3) {
+        self.finish_substep();
         self.select_particle(particle);
         self.dragging = Some(particle);
         if self.playing {
@@ -200,7 +242,11 @@ impl Workbench {
     }
 
     /// Starts or stops playing; a drag in progress switches between grab and kinematic moves.
+    /// Playing ends step-by-step mode.
     pub fn set_playing(&mut self, playing: bool) {
+        if playing {
+            self.leave_step_mode();
+        }
         self.playing = playing;
         if let Some(particle) = self.dragging {
             let position = self.simulation.positions()[particle];
@@ -213,8 +259,12 @@ impl Workbench {
         }
     }
 
-    /// Changes the solver settings.
+    /// Changes the solver settings. Step-by-step mode first finishes its substep under the old
+    /// settings.
     pub fn set_settings(&mut self, settings: Settings) {
+        if settings != *self.simulation.settings() {
+            self.finish_substep();
+        }
         self.simulation.set_settings(settings);
         self.after_change();
     }

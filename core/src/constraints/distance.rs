@@ -12,6 +12,13 @@
 use super::Evaluation;
 use crate::vector::{Real, Vector3};
 
+/// The constraint and its gradients as lines of math, for display (the inspector, lessons).
+pub const FORMULA: &[&str] = &[
+    "C = |p₀ − p₁| − d",
+    "∇ₚ₀C = (p₀ − p₁) / |p₀ − p₁|",
+    "∇ₚ₁C = −∇ₚ₀C",
+];
+
 /// d = |p0 − p1| of a rest configuration.
 #[inline]
 pub fn rest_value<V: Vector3>(p: &[V; 2]) -> V::Real {

@@ -90,6 +90,16 @@ impl Family {
         Family::ALL.into_iter().find(|f| f.name() == name)
     }
 
+    /// The constraint and its gradients as lines of math: [`distance::FORMULA`],
+    /// [`plane::FORMULA`] or [`volume::FORMULA`].
+    pub fn formula(self) -> &'static [&'static str] {
+        match self {
+            Family::Distance => distance::FORMULA,
+            Family::Plane => plane::FORMULA,
+            Family::Volume => volume::FORMULA,
+        }
+    }
+
     /// How many particles one constraint of this family touches.
     pub fn arity(self) -> usize {
         match self {

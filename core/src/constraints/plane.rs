@@ -21,6 +21,16 @@
 use super::{Evaluation, first_from_rest};
 use crate::vector::{Vector3, spans_no_plane};
 
+/// The constraint and its gradients as lines of math, for display (the inspector, lessons).
+pub const FORMULA: &[&str] = &[
+    "e₁ = p₁ − p₀,  e₂ = p₂ − p₀,  e₃ = p₃ − p₀,  c = e₂ × e₃,  n = c / |c|",
+    "C = e₁ · n − d",
+    "∇ₚ₁C = n",
+    "∇ₚ₂C = (e₃ × e₁ + (n × e₃)(n · e₁)) / |c|",
+    "∇ₚ₃C = −(e₂ × e₁ + (n × e₂)(n · e₁)) / |c|",
+    "∇ₚ₀C = −(∇ₚ₁C + ∇ₚ₂C + ∇ₚ₃C)",
+];
+
 /// The four height constraints of a tet (a, b, c, d), as index orders into it.
 ///
 /// Entry k keeps vertex k off the plane of the other three, written in the constraint's own order

@@ -20,6 +20,16 @@
 use super::{Evaluation, first_from_rest};
 use crate::vector::{Real, Vector3, spans_no_plane};
 
+/// The constraint and its gradients as lines of math, for display (the inspector, lessons).
+pub const FORMULA: &[&str] = &[
+    "e₁ = p₁ − p₀,  e₂ = p₂ − p₀,  e₃ = p₃ − p₀",
+    "C = ⅙ e₁ · (e₂ × e₃) − V",
+    "∇ₚ₁C = ⅙ e₂ × e₃",
+    "∇ₚ₂C = ⅙ e₃ × e₁",
+    "∇ₚ₃C = ⅙ e₁ × e₂",
+    "∇ₚ₀C = −(∇ₚ₁C + ∇ₚ₂C + ∇ₚ₃C)",
+];
+
 /// V = ⅙ (p1 − p0)·((p2 − p0)×(p3 − p0)) of a rest configuration: positive when
 /// (p1 − p0, p2 − p0, p3 − p0) is a right-handed frame.
 #[inline]

@@ -5,6 +5,7 @@ use eframe::egui;
 use tetlab_core::constraints::Family;
 use tetlab_core::scene::Builtin;
 use tetlab_core::solver::Method;
+use tetlab_core::stepper::Next;
 
 /// A scene the user asked for.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,6 +38,56 @@ impl Default for SceneChoice {
     }
 }
 
+/// The step-by-step buttons and where the substep stands.
+fn step_by_step(ui: &mut egui::Ui, bench: &mut Workbench) {
+    ui.horizontal(|ui| {
+        if ui
+            .button("Next projection")
+            .on_hover_text("J: one constraint at a time")
+            .clicked()
+        {
+            bench.step_projection();
+        }
+        if ui
+            .add_enabled(
+                bench.stepping.is_some(),
+                egui::Button::new("Finish substep"),
+            )
+            .on_hover_text("K")
+            .clicked()
+        {
+            bench.finish_substep();
+        }
+    });
+    let Some(stepper) = bench.stepping else {
+        return;
+    };
+    let simulation = &bench.simulation;
+    let (done, total) = stepper.progress(simulation);
+    let status = match (stepper.next(simulation), stepper.iteration(simulation)) {
+        (Next::BeginSubstep, _) => {
+            "next: begin a substep (predict x from v and gravity)".to_owned()
+        }
+        (Next::Project(family, c), Some((i, n))) => format!(
+            "sweep {}/{n}, {}/{total}: next projects {} #{c}",
+            i + 1,
+            done + 1,
+            family.name()
+        ),
+        (Next::EndSweep { last }, Some((i, n))) => format!(
+            "sweep {}/{n} done: next {}",
+            i + 1,
+            if last {
+                "ground, then velocities v = (x - x_prev)/h"
+            } else {
+                "ground, then the next sweep"
+            }
+        ),
+        (_, None) => String::new(),
+    };
+    ui.label(egui::RichText::new(status).monospace());
+}
+
 /// Shows playback and solver controls; returns a scene to load, if the user asked for one.
 pub fn show(
     ui: &mut egui::Ui,
@@ -56,6 +107,7 @@ pub fn show(
             bench.step_substep();
         }
     });
+    step_by_step(ui, bench);
 
     ui.separator();
     ui.heading("Scene");

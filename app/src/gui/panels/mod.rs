@@ -3,5 +3,6 @@
 pub mod controls;
 pub mod display;
 pub mod help;
+pub mod inspector;
 pub mod readouts;
 pub mod tools;

@@ -4,8 +4,8 @@ use crate::gui::workbench::Workbench;
 use eframe::egui;
 use tetlab_core::scene::Perturbation;
 
-/// Shows the tools.
-pub fn show(ui: &mut egui::Ui, bench: &mut Workbench) {
+/// Shows the tools; "Inspect" opens the inspector.
+pub fn show(ui: &mut egui::Ui, bench: &mut Workbench, inspector_open: &mut bool) {
     ui.heading("Tools");
     ui.horizontal_wrapped(|ui| {
         let has_selection = bench.selected_tet.is_some() && bench.selected_particle.is_some();
@@ -61,6 +61,13 @@ pub fn show(ui: &mut egui::Ui, bench: &mut Workbench) {
                     .clicked()
                 {
                     bench.next_tet_of_selected();
+                }
+                if ui
+                    .button("Inspect")
+                    .on_hover_text("E: C, grad C, w, lambda of this tet's constraints")
+                    .clicked()
+                {
+                    *inspector_open = !*inspector_open;
                 }
             });
         }

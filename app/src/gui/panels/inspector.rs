@@ -1,0 +1,141 @@
+//! The inspector: for the selected tet (and, in step-by-step mode, for the constraint about to be
+//! projected) every active constraint's numbers as the solver sees them, its gradient checked
+//! against central differences, and its formula.
+
+use crate::gui::workbench::Workbench;
+use eframe::egui;
+use glam::DVec3;
+use tetlab_core::constraints::Family;
+use tetlab_core::inspector::{Inspection, inspect, inspect_tet};
+use tetlab_core::solver::Method;
+
+/// Shows the inspector as a window while `open` is true.
+pub fn show(ctx: &egui::Context, open: &mut bool, bench: &Workbench) {
+    egui::Window::new("Inspector")
+        .open(open)
+        .default_pos([320.0, 60.0])
+        .default_width(560.0)
+        .vscroll(true)
+        .show(ctx, |ui| contents(ui, bench));
+}
+
+/// The inspector's contents, for any container.
+pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
+    let simulation = &bench.simulation;
+    let method = simulation.settings().method;
+    if let Some(projection) = bench.stepping.and_then(|s| s.pending(simulation)) {
+        ui.heading("Next projection");
+        let inspection = inspect(simulation, projection.family, projection.constraint);
+        formula(ui, projection.family);
+        constraint(ui, &inspection, method);
+        ui.separator();
+    }
+    let Some(tet) = bench.selected_tet else {
+        ui.label("Select a tet (click a particle) to inspect its constraints.");
+        return;
+    };
+    ui.heading(format!("Tet {tet}: particles {:?}", simulation.tets()[tet]));
+    let mut inspections = Vec::new();
+    inspect_tet(simulation, tet, &mut inspections);
+    if inspections.is_empty() {
+        ui.label("No constraint family is active.");
+    }
+    for family in Family::ALL {
+        let of_family: Vec<&Inspection> = inspections
+            .iter()
+            .filter(|i| i.projection.family == family)
+            .collect();
+        if of_family.is_empty() {
+            continue;
+        }
+        egui::CollapsingHeader::new(format!("{} ({})", title(family), of_family.len()))
+            .id_salt(family.name())
+            .default_open(family == Family::Volume)
+            .show(ui, |ui| {
+                formula(ui, family);
+                for inspection in of_family {
+                    ui.separator();
+                    constraint(ui, inspection, method);
+                }
+            });
+    }
+}
+
+fn title(family: Family) -> &'static str {
+    match family {
+        Family::Distance => "Edge distance",
+        Family::Plane => "Heights above the opposite face",
+        Family::Volume => "Signed volume",
+    }
+}
+
+/// The family's constraint and gradients, one line of math each.
+fn formula(ui: &mut egui::Ui, family: Family) {
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        for line in family.formula() {
+            ui.label(egui::RichText::new(*line).monospace().size(14.0));
+        }
+    });
+}
+
+/// One constraint's numbers: C, rest value, λ and the next Δλ; per particle w, ∇C and its
+/// central-difference check.
+fn constraint(ui: &mut egui::Ui, inspection: &Inspection, method: Method) {
+    let p = &inspection.projection;
+    let rest_name = if p.family == Family::Volume { "V" } else { "d" };
+    let step = match (p.delta_lambda, method) {
+        (Some(d), Method::Xpbd) => format!("next Δλ = {d:+.4e}"),
+        (Some(d), Method::Pbd) => format!("next k′s = {d:+.4e}"),
+        (None, _) if p.degenerate => "skipped: ∇C undefined (degenerate)".to_owned(),
+        (None, _) => "skipped: every particle fixed".to_owned(),
+    };
+    ui.label(
+        egui::RichText::new(format!(
+            "{} #{}   C = {:+.4e}   {rest_name} = {:+.4e}   λ = {:+.4e}   {step}",
+            p.family.name(),
+            p.constraint,
+            p.value,
+            p.rest,
+            p.lambda,
+        ))
+        .monospace(),
+    );
+    egui::Grid::new(("inspection", p.family.name(), p.constraint))
+        .striped(true)
+        .show(ui, |ui| {
+            for header in [
+                "",
+                "particle",
+                "w",
+                "∇C",
+                "∇C by finite differences",
+                "Δx if projected now",
+            ] {
+                ui.label(egui::RichText::new(header).strong());
+            }
+            ui.end_row();
+            for k in 0..p.len {
+                ui.monospace(format!("p{}", subscript(k)));
+                ui.monospace(p.particles[k].to_string());
+                ui.monospace(format!("{:.3e}", p.inverse_masses[k]));
+                ui.monospace(vector(p.gradients[k]));
+                ui.monospace(vector(inspection.numeric_gradients[k]));
+                ui.monospace(vector(p.delta_x[k]));
+                ui.end_row();
+            }
+        });
+    ui.monospace(format!(
+        "Σ|∇C|² = {:.4e}   Σ w|∇C|² = {:.4e}   finite-difference relative error {:.1e}",
+        inspection.gradient_norm_squared(),
+        p.weighted_norm,
+        inspection.relative_error
+    ));
+}
+
+fn subscript(k: usize) -> char {
+    ['₀', '₁', '₂', '₃'][k.min(3)]
+}
+
+fn vector(v: DVec3) -> String {
+    format!("({:+.4}, {:+.4}, {:+.4})", v.x, v.y, v.z)
+}
