@@ -404,3 +404,122 @@ fn the_inspector_shows_the_numbers_of_the_selected_tet() {
     harness.get_by_label_contains("finite-difference relative error");
     harness.snapshot("inspector");
 }
+
+fn open_lesson_file(harness: &mut Harness<'static, TetlabApp>, file: &str) {
+    let path = format!("{}/../assets/lessons/{file}", env!("CARGO_MANIFEST_DIR"));
+    harness.key_press(egui::Key::L);
+    harness.run_steps(1);
+    harness.get_by_label("lesson file").click();
+    harness.run_steps(1);
+    harness.get_by_label("lesson file").type_text(&path);
+    harness.run_steps(1);
+    harness.get_by_label("Open lesson").click();
+    harness.run_steps(2);
+}
+
+/// A lesson opened from its file: the step's text, "do it" with Enter, the expected observation
+/// checked live, and a later step that compares two constraint sets side by side.
+#[test]
+fn a_lesson_page_checks_its_observations_live_and_compares_side_by_side() {
+    let mut harness = workbench("cube", 2);
+    open_lesson_file(&mut harness, "02-edges-cannot-uninvert.toml");
+    assert_eq!(harness.state().bench.scene.name, "tet");
+    harness.get_by_label_contains("Why edges alone cannot un-invert a tet");
+    harness.get_by_label_contains("[..] expect inverted_tets == 1");
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(2);
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 1);
+    harness.get_by_label_contains("[ok] expect inverted_tets == 1");
+    harness.snapshot("lesson_page");
+
+    harness.key_press(egui::Key::ArrowRight);
+    harness.key_press(egui::Key::ArrowRight);
+    harness.run_steps(1);
+    harness.get_by_label_contains("step 3 of 3");
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(70);
+    let app = harness.state();
+    let comparison = app.comparison.as_ref().expect("the step compares");
+    assert!(
+        !app.bench.playing,
+        "the step's 60 frames played, then it paused"
+    );
+    assert_eq!(
+        app.bench.metrics.inverted_tets, 1,
+        "edges only: still inverted"
+    );
+    assert_eq!(
+        comparison.bench.metrics.inverted_tets, 0,
+        "edges + volume: recovered"
+    );
+    harness.get_by_label_contains("[ok] expect compare.inverted_tets == 0");
+    harness.snapshot("lesson_comparison");
+}
+
+/// Classroom mode (F5): larger, the 3D view and the lesson only, driven by the keyboard.
+#[test]
+fn classroom_mode_shows_the_view_and_the_lesson_only() {
+    let mut harness = workbench("cube", 2);
+    open_lesson_file(&mut harness, "03-heights.toml");
+    harness.key_press(egui::Key::F5);
+    harness.run_steps(2);
+    assert!(harness.state().classroom);
+    assert!(
+        harness.query_by_label("Playback").is_none(),
+        "no side panels"
+    );
+    harness.key_press(egui::Key::ArrowRight);
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(2);
+    harness.get_by_label_contains("step 2 of 4");
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 1);
+    harness.key_press(egui::Key::V);
+    harness.run_steps(2);
+    assert!(
+        pixels_like(&mut harness, visual::INVERTED) > 1000,
+        "the inverted tet is large and red"
+    );
+    harness.snapshot("classroom");
+    harness.key_press(egui::Key::F5);
+    harness.run_steps(2);
+    assert!(!harness.state().classroom);
+    harness.get_by_label("Playback");
+}
+
+/// The compare panel: a second view of the same scene with other families, driven by the same
+/// keys.
+#[test]
+fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
+    let mut harness = workbench("cube", 2);
+    // The compare panel's "edges" checkbox, below the solver panel's.
+    harness
+        .get_all_by_label("edges")
+        .last()
+        .expect("two edges checkboxes")
+        .click();
+    harness.get_by_label("Compare side by side").click();
+    harness.run_steps(2);
+    let families = |harness: &Harness<'static, TetlabApp>| {
+        let comparison = harness.state().comparison.as_ref().expect("comparing");
+        comparison.bench.simulation.settings().active.describe()
+    };
+    assert_eq!(families(&harness), "plane+volume");
+    harness.get_by_label("plane+volume");
+    harness.get_by_label("edges+volume");
+    harness.key_press(egui::Key::M);
+    harness.run_steps(1);
+    let comparison = harness.state().comparison.as_ref().unwrap();
+    assert_eq!(comparison.bench.metrics.inverted_tets, 48, "M mirrors both");
+    harness.key_press(egui::Key::Space);
+    harness.run_steps(30);
+    let app = harness.state();
+    let comparison = app.comparison.as_ref().unwrap();
+    assert_eq!(
+        comparison.bench.simulation.frame(),
+        app.bench.simulation.frame()
+    );
+    assert_eq!(comparison.bench.metrics.inverted_tets, 0);
+    harness.get_by_label("Stop comparing").click();
+    harness.run_steps(1);
+    assert!(harness.state().comparison.is_none());
+}

@@ -12,6 +12,7 @@
 pub mod constraints;
 pub mod finite_difference;
 pub mod inspector;
+pub mod lesson;
 pub mod mesh;
 pub mod metrics;
 pub mod random;

@@ -31,8 +31,7 @@ use crate::scene::Scene;
 use glam::DVec3;
 
 /// XPBD or PBD.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Method {
     /// Extended PBD: compliance per family, λ accumulated within a substep.
     Xpbd,
@@ -40,9 +39,27 @@ pub enum Method {
     Pbd,
 }
 
+impl Method {
+    /// `xpbd` or `pbd`.
+    pub fn parse(text: &str) -> Result<Method, String> {
+        match text.trim() {
+            "xpbd" => Ok(Method::Xpbd),
+            "pbd" => Ok(Method::Pbd),
+            other => Err(format!("'{other}' is not a solver: expected xpbd or pbd")),
+        }
+    }
+
+    /// The name [`Method::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Xpbd => "xpbd",
+            Method::Pbd => "pbd",
+        }
+    }
+}
+
 /// One value per constraint family.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PerFamily<T> {
     /// Edge distance.
     pub edges: T,
@@ -50,6 +67,32 @@ pub struct PerFamily<T> {
     pub plane: T,
     /// Signed volume.
     pub volume: T,
+}
+
+impl PerFamily<bool> {
+    /// The families named in a comma-separated list (`edges,volume`), each as [`Family::parse`]
+    /// reads it.
+    pub fn parse_list(text: &str) -> Result<PerFamily<bool>, String> {
+        let mut active = PerFamily::splat(false);
+        for name in text.split(',') {
+            active.set(Family::parse(name)?, true);
+        }
+        Ok(active)
+    }
+
+    /// The active families as `edges+plane+volume`, or `none`.
+    pub fn describe(&self) -> String {
+        let names: Vec<&str> = Family::ALL
+            .into_iter()
+            .filter(|&f| self.get(f))
+            .map(Family::short_name)
+            .collect();
+        if names.is_empty() {
+            "none".into()
+        } else {
+            names.join("+")
+        }
+    }
 }
 
 impl<T: Copy> PerFamily<T> {
@@ -82,8 +125,7 @@ impl<T: Copy> PerFamily<T> {
 }
 
 /// How the simulation runs. Every field may change between steps.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Settings {
     /// XPBD or PBD.
     pub method: Method,

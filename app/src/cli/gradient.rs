@@ -12,7 +12,7 @@ use tetlab_core::verify::{analytic_and_numeric, max_abs_error};
 pub struct Args {
     /// The constraint: distance (2 points), plane (4: height of p1 above the plane of p0, p2, p3)
     /// or volume (4: signed volume).
-    #[arg(long, value_parser = family)]
+    #[arg(long, value_parser = Family::parse)]
     constraint: Family,
     /// The particles in the constraint's order, each X,Y,Z; negative numbers are fine.
     #[arg(long, value_name = "X,Y,Z", num_args = 1.., required = true, value_parser = args::point)]
@@ -23,11 +23,6 @@ pub struct Args {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
-}
-
-fn family(name: &str) -> Result<Family, String> {
-    Family::from_name(name)
-        .ok_or_else(|| format!("'{name}' is not a constraint; expected distance, plane or volume"))
 }
 
 /// What `--json` prints.

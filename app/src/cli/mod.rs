@@ -9,6 +9,8 @@ mod gradient;
 #[cfg(not(target_arch = "wasm32"))]
 mod inspect;
 #[cfg(not(target_arch = "wasm32"))]
+mod lesson;
+#[cfg(not(target_arch = "wasm32"))]
 mod record;
 mod run;
 mod simulation_args;
@@ -40,6 +42,9 @@ enum Command {
     /// Summarise a Rerun recording: entities, frames, metrics.
     #[cfg(not(target_arch = "wasm32"))]
     Inspect(inspect::Args),
+    /// Run a lesson headless: its steps, their text and checked observations (--record to log it).
+    #[cfg(not(target_arch = "wasm32"))]
+    Lesson(lesson::Args),
 }
 
 /// An error caused by the user's input: printed as `error: <message>`, exit status 2.
@@ -82,12 +87,18 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run(&args, &mut stdout),
         #[cfg(not(target_arch = "wasm32"))]
         Command::Record(args) => record::run(&args, &mut stdout).map(|ending| {
-            if let record::Ending::Interrupted(_) = ending {
+            if let record::Ending::Interrupted = ending {
                 success = ExitCode::from(record::INTERRUPTED);
             }
         }),
         #[cfg(not(target_arch = "wasm32"))]
         Command::Inspect(args) => inspect::run(&args, &mut stdout),
+        #[cfg(not(target_arch = "wasm32"))]
+        Command::Lesson(args) => lesson::run(&args, &mut stdout).map(|outcome| match outcome {
+            lesson::Outcome::Observed => {}
+            lesson::Outcome::NotObserved => success = ExitCode::FAILURE,
+            lesson::Outcome::Interrupted => success = ExitCode::from(record::INTERRUPTED),
+        }),
     };
     let flushed = outcome.and_then(|()| stdout.flush().map_err(UsageError::stdout));
     match flushed {

@@ -7,7 +7,7 @@
 
 use super::UsageError;
 use super::inspect::Summary;
-use super::simulation_args::{SimulationArgs, family_name};
+use super::simulation_args::SimulationArgs;
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rerun::RecordingStream;
@@ -75,8 +75,8 @@ pub const INTERRUPTED: u8 = 130;
 pub enum Ending {
     /// Every frame was recorded.
     Complete,
-    /// Stopped by a signal after this many frames; the file holds them all.
-    Interrupted(u64),
+    /// Stopped by a signal; the file holds every frame up to then.
+    Interrupted,
 }
 
 /// Records the run and writes or streams it. Returns how it ended.
@@ -90,62 +90,155 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
             tets - 1
         )));
     }
-    let interrupted = interrupt_flag()?;
-    let writer_errors = WriterErrors::install();
-    let target = Target::new(args)?;
-    let rec = target.open()?;
-    let mut recorder = Recorder::new(
-        &rec,
-        &scene,
-        &simulation,
-        args.arrows,
-        args.tet as usize,
-        &args.simulation,
-    );
-    let progress = Progress::new(args.simulation.frames, args.quiet);
+    let destination = match (&args.out, &args.connect) {
+        (_, Some(address)) => Destination::Viewer(address.clone()),
+        (Some(path), None) => Destination::File {
+            path: path.clone(),
+            flag: "--out",
+        },
+        (None, None) => unreachable!("clap requires --out or --connect"),
+    };
+    let session = Session::open(destination, args.simulation.frames, args.quiet)?;
+    let rec = session.rec();
+    send_layout(rec, &[""]);
+    describe(rec, &scene, &simulation, args);
+    let mut recorder = Recorder::new(rec, "", &scene, &simulation, args.arrows, args.tet as usize);
     recorder.log_frame(&simulation);
-    let mut ending = Ending::Complete;
     for _ in 0..args.simulation.frames {
-        if interrupted.load(Ordering::SeqCst) {
-            ending = Ending::Interrupted(simulation.frame());
+        if session.interrupted() {
             break;
         }
         if let Err(diverged) = SimulationArgs::step(&mut simulation) {
-            progress.finish();
-            target.close(rec, simulation.frame() - 1, &writer_errors, out)?;
+            session.close(simulation.frame() - 1, out)?;
             return Err(diverged);
         }
         recorder.log_frame(&simulation);
-        progress.advance();
+        session.advance();
     }
-    progress.finish();
-    target.close(rec, simulation.frame(), &writer_errors, out)?;
-    if let Ending::Interrupted(frame) = ending {
-        eprintln!("interrupted: the recording holds frames 0..={frame}");
+    session.close(simulation.frame(), out)
+}
+
+/// The static description of a run: scene, sizes, perturbation, settings, arrows.
+fn describe(rec: &RecordingStream, scene: &Scene, simulation: &Simulation, args: &Args) {
+    let perturbation = args
+        .simulation
+        .perturb
+        .map(|p| p.to_string())
+        .unwrap_or_else(|| "none".into());
+    let notes: String = scene.notes.iter().map(|n| format!("\n- {n}")).collect();
+    let text = format!(
+        "# tetlab run\n\nscene **{}**: {} particles, {} tets, {} edges{notes}\n\nperturbation: {perturbation}\n\n{}\n\ngradient arrows: {:?}, tet {}",
+        scene.name,
+        simulation.positions().len(),
+        simulation.tets().len(),
+        simulation.edges.len(),
+        args.simulation.describe(),
+        args.arrows,
+        args.tet
+    );
+    rec.log_static("run", &rerun::TextDocument::from_markdown(text))
+        .ok();
+}
+
+/// Where a recording goes.
+pub enum Destination {
+    /// A .rrd file, named by the option `flag` in messages.
+    File {
+        /// The file.
+        path: PathBuf,
+        /// The option that named it (`--out`, `--record`).
+        flag: &'static str,
+    },
+    /// A running viewer at this address.
+    Viewer(String),
+}
+
+/// A recording in progress: the stream, what watches it (write errors, Ctrl-C), a progress bar.
+/// A file is written as `FILE.partial` and moved into place by [`Session::close`] only once Rerun's
+/// decoder has read every frame back.
+pub struct Session {
+    target: Target,
+    rec: RecordingStream,
+    writer_errors: WriterErrors,
+    interrupted: Arc<AtomicBool>,
+    progress: Progress,
+}
+
+impl Session {
+    /// Opens the destination for a recording of about `frames` frames.
+    pub fn open(destination: Destination, frames: u64, quiet: bool) -> Result<Session, UsageError> {
+        let interrupted = interrupt_flag()?;
+        let writer_errors = WriterErrors::install();
+        let target = Target::new(destination)?;
+        let rec = target.open()?;
+        Ok(Session {
+            target,
+            rec,
+            writer_errors,
+            interrupted,
+            progress: Progress::new(frames, quiet),
+        })
     }
-    Ok(ending)
+
+    /// The stream to log to.
+    pub fn rec(&self) -> &RecordingStream {
+        &self.rec
+    }
+
+    /// Whether Ctrl-C (or SIGTERM) asked to stop.
+    pub fn interrupted(&self) -> bool {
+        self.interrupted.load(Ordering::SeqCst)
+    }
+
+    /// One more frame recorded.
+    pub fn advance(&self) {
+        self.progress.advance();
+    }
+
+    /// Flushes, checks and closes the recording, whose last frame is `last_frame`; says so on
+    /// `out`, and on stderr when it was interrupted.
+    pub fn close(self, last_frame: u64, out: &mut impl Write) -> Result<Ending, UsageError> {
+        self.progress.finish();
+        let interrupted = self.interrupted();
+        self.target
+            .close(self.rec, last_frame, &self.writer_errors, out)?;
+        if interrupted {
+            eprintln!("interrupted: the recording holds frames 0..={last_frame}");
+            Ok(Ending::Interrupted)
+        } else {
+            Ok(Ending::Complete)
+        }
+    }
 }
 
 /// Where the recording goes.
 enum Target {
-    File { path: PathBuf, partial: PathBuf },
-    Viewer { url: String },
+    File {
+        path: PathBuf,
+        partial: PathBuf,
+        flag: &'static str,
+    },
+    Viewer {
+        url: String,
+    },
 }
 
 impl Target {
-    fn new(args: &Args) -> Result<Target, UsageError> {
-        if let Some(address) = &args.connect {
-            let url = if address.contains("://") {
-                address.clone()
-            } else {
-                format!("rerun+http://{address}/proxy")
-            };
-            return Ok(Target::Viewer { url });
-        }
-        let path = args.out.clone().expect("clap requires --out or --connect");
+    fn new(destination: Destination) -> Result<Target, UsageError> {
+        let (path, flag) = match destination {
+            Destination::Viewer(address) => {
+                let url = if address.contains("://") {
+                    address
+                } else {
+                    format!("rerun+http://{address}/proxy")
+                };
+                return Ok(Target::Viewer { url });
+            }
+            Destination::File { path, flag } => (path, flag),
+        };
         if path.is_dir() {
             return Err(UsageError(format!(
-                "--out {}: is a directory",
+                "{flag} {}: is a directory",
                 path.display()
             )));
         }
@@ -154,15 +247,20 @@ impl Target {
         Ok(Target::File {
             path,
             partial: partial.into(),
+            flag,
         })
     }
 
     fn open(&self) -> Result<RecordingStream, UsageError> {
         let builder = rerun::RecordingStreamBuilder::new("tetlab");
         match self {
-            Target::File { path, partial } => builder.save(partial).map_err(|e| {
+            Target::File {
+                path,
+                partial,
+                flag,
+            } => builder.save(partial).map_err(|e| {
                 UsageError(format!(
-                    "--out {}: cannot create the file: {}",
+                    "{flag} {}: cannot create the file: {}",
                     path.display(),
                     io_cause(&e)
                 ))
@@ -190,7 +288,11 @@ impl Target {
                     "--connect {url}: the viewer did not receive the recording: {e}"
                 ))
             }),
-            Target::File { path, partial } => {
+            Target::File {
+                path,
+                partial,
+                flag,
+            } => {
                 let verified = flushed
                     .and_then(|()| Summary::read(&partial).map_err(|e| e.to_string()))
                     .and_then(|summary| match summary.frames {
@@ -204,14 +306,14 @@ impl Target {
                     Err(cause) => {
                         let _ = std::fs::remove_file(&partial);
                         return Err(UsageError(format!(
-                            "--out {}: the recording could not be written completely ({cause}); nothing was kept",
+                            "{flag} {}: the recording could not be written completely ({cause}); nothing was kept",
                             path.display()
                         )));
                     }
                 };
                 std::fs::rename(&partial, &path).map_err(|e| {
                     UsageError(format!(
-                        "--out {}: cannot move the finished recording into place: {e}",
+                        "{flag} {}: cannot move the finished recording into place: {e}",
                         path.display()
                     ))
                 })?;
@@ -329,14 +431,15 @@ impl Progress {
 
 /// Logs a simulation to a recording: static data once, what changes every frame.
 ///
-/// Entities: `world` (view coordinates, y up; the viewer draws its grid on y = 0, the ground),
-/// `world/particles`, `world/mesh`
-/// and `world/edges` (all faces and edges of a small mesh, the surface of a large one, as
-/// [`visual::display_faces`] and [`visual::display_edges`] choose), `world/gradients/<family>`,
-/// `world/corrections` (Δp of the last substep, at its true length),
-/// `metrics/<name>`, `run` (a description).
+/// Entities, under a root (empty, or e.g. `compare/` for a second simulation): `world` (view
+/// coordinates, y up; the viewer draws its grid on y = 0, the ground), `world/particles`,
+/// `world/mesh` and `world/edges` (all faces and edges of a small mesh, the surface of a large
+/// one, as [`visual::display_faces`] and [`visual::display_edges`] choose),
+/// `world/gradients/<family>`, `world/corrections` (Δp of the last substep, at its true length),
+/// `metrics/<name>`.
 pub struct Recorder<'a> {
     rec: &'a RecordingStream,
+    root: String,
     arrows: ArrowsMode,
     tet: usize,
     edge_strips: Vec<Vec<u32>>,
@@ -348,17 +451,17 @@ pub struct Recorder<'a> {
 }
 
 impl<'a> Recorder<'a> {
-    /// Logs the static parts: coordinates, layout, mesh topology, styles, a description.
+    /// Logs the static parts under `root`: coordinates, mesh topology, styles.
     pub fn new(
         rec: &'a RecordingStream,
+        root: &str,
         scene: &Scene,
         simulation: &Simulation,
         arrows: ArrowsMode,
         tet: usize,
-        args: &SimulationArgs,
     ) -> Self {
         let log = |path: &str, what: &dyn rerun::AsComponents| {
-            rec.log_static(path, what).ok();
+            rec.log_static(format!("{root}{path}"), what).ok();
         };
         log("world", &rerun::ViewCoordinates::RIGHT_HAND_Y_UP());
         let size = visual::body_size(simulation.rest_positions());
@@ -386,26 +489,9 @@ impl<'a> Recorder<'a> {
                 &rerun::Arrows3D::update_fields().with_colors([rgba(quantity.colour())]),
             );
         }
-        let perturbation = args
-            .perturb
-            .map(|p| p.to_string())
-            .unwrap_or_else(|| "none".into());
-        let notes: String = scene.notes.iter().map(|n| format!("\n- {n}")).collect();
-        log(
-            "run",
-            &rerun::TextDocument::from_markdown(format!(
-                "# tetlab run\n\nscene **{}**: {} particles, {} tets, {} edges{notes}\n\nperturbation: {perturbation}\n\n{}\n\ngradient arrows: {:?}, tet {tet}",
-                scene.name,
-                simulation.positions().len(),
-                simulation.tets().len(),
-                simulation.edges.len(),
-                args.describe(),
-                arrows
-            )),
-        );
-        send_layout(rec);
         Recorder {
             rec,
+            root: root.to_owned(),
             arrows,
             tet,
             edge_strips: visual::edge_strips(&visual::display_edges(&scene.mesh)),
@@ -417,14 +503,26 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// The tet whose arrows are logged with [`ArrowsMode::Selected`].
+    pub fn set_tet(&mut self, tet: usize) {
+        self.tet = tet;
+    }
+
     /// Logs the current state at the simulation's frame and time. Colours are logged only when
     /// they change: the viewer shows the latest value at each frame.
     pub fn log_frame(&mut self, simulation: &Simulation) {
+        self.log_frame_at(simulation.frame(), simulation.time(), simulation);
+    }
+
+    /// Logs the current state at a given frame and time (for runs whose simulation is reset
+    /// along the way, like lessons, but whose recording goes on).
+    pub fn log_frame_at(&mut self, frame: u64, time: f64, simulation: &Simulation) {
         let rec = self.rec;
-        rec.set_time_sequence("frame", simulation.frame() as i64);
-        rec.set_duration_secs("sim_time", simulation.time());
+        rec.set_time_sequence("frame", frame as i64);
+        rec.set_duration_secs("sim_time", time);
+        let root = self.root.clone();
         let log = |path: &str, what: &dyn rerun::AsComponents| {
-            rec.log(path, what).ok();
+            rec.log(format!("{root}{path}"), what).ok();
         };
 
         self.points.clear();
@@ -506,7 +604,7 @@ impl<'a> Recorder<'a> {
             let arrows = self.arrow_scratch.iter().filter(|a| a.quantity == quantity);
             self.rec
                 .log(
-                    arrow_path(quantity),
+                    format!("{}{}", self.root, arrow_path(quantity)),
                     &rerun::Arrows3D::update_fields()
                         .with_origins(arrows.clone().map(|a| a.origin.as_vec3()))
                         .with_vectors(arrows.map(|a| a.vector.as_vec3())),
@@ -519,7 +617,7 @@ impl<'a> Recorder<'a> {
 /// Where arrows of `quantity` are logged.
 fn arrow_path(quantity: Quantity) -> String {
     match quantity {
-        Quantity::Gradient(family) => format!("world/gradients/{}", family_name(family)),
+        Quantity::Gradient(family) => format!("world/gradients/{}", family.short_name()),
         Quantity::Correction => "world/corrections".to_owned(),
     }
 }
@@ -528,21 +626,33 @@ fn rgba(c: Rgba) -> rerun::Color {
     rerun::Color::from_unmultiplied_rgba(c[0], c[1], c[2], c[3])
 }
 
-/// The default layout: the 3D view on the left, the four metrics stacked on the right.
-fn send_layout(rec: &RecordingStream) {
+/// The default layout: a 3D view per root (side by side) on the left, the four metrics stacked on
+/// the right (each plot shows the metric of every root).
+pub fn send_layout(rec: &RecordingStream, roots: &[&str]) {
     use rerun::blueprint::{
         Blueprint, BlueprintActivation, Horizontal, Spatial3DView, TimeSeriesView, Vertical,
     };
     let plots = Metrics::default().headline().map(|(name, _)| {
+        let contents: Vec<String> = roots
+            .iter()
+            .map(|root| format!("+ {root}metrics/{name}"))
+            .collect();
         TimeSeriesView::new(name.replace('_', " "))
-            .with_origin(format!("metrics/{name}"))
+            .with_contents(contents)
             .into()
     });
-    let layout = Horizontal::new([
-        Spatial3DView::new("soft body").with_origin("world").into(),
-        Vertical::new(plots).into(),
-    ])
-    .with_column_shares([3.0, 2.0]);
+    let views = roots.iter().map(|root| {
+        let title = if root.is_empty() {
+            "soft body"
+        } else {
+            root.trim_end_matches('/')
+        };
+        Spatial3DView::new(title)
+            .with_origin(format!("{root}world"))
+            .into()
+    });
+    let layout = Horizontal::new([Horizontal::new(views).into(), Vertical::new(plots).into()])
+        .with_column_shares([3.0, 2.0]);
     Blueprint::new(layout)
         .send(rec, BlueprintActivation::default())
         .ok();

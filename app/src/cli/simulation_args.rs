@@ -19,10 +19,10 @@ pub struct SimulationArgs {
     #[arg(long, value_parser = Perturbation::parse)]
     pub perturb: Option<Perturbation>,
     /// Active constraint families, comma-separated: edges, plane, volume.
-    #[arg(long, default_value = "edges,volume", value_parser = families)]
+    #[arg(long, default_value = "edges,volume", value_parser = PerFamily::parse_list)]
     pub constraints: PerFamily<bool>,
     /// xpbd or pbd.
-    #[arg(long, default_value = "xpbd", value_parser = method)]
+    #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
     pub solver: Method,
     /// Substeps per frame (1..=1000).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=1000), allow_hyphen_values = true)]
@@ -109,11 +109,8 @@ impl SimulationArgs {
         let s = self.settings();
         let mut text = format!(
             "{}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
-            match s.method {
-                Method::Xpbd => "xpbd",
-                Method::Pbd => "pbd",
-            },
-            family_list(s.active),
+            s.method.name(),
+            s.active.describe(),
             s.substeps,
             s.iterations,
             if s.iterations == 1 { "" } else { "s" },
@@ -124,10 +121,10 @@ impl SimulationArgs {
             text += ", settle edits";
         }
         for (family, alpha) in &self.compliance {
-            text += &format!(", compliance {}={alpha}", family_name(*family));
+            text += &format!(", compliance {}={alpha}", family.short_name());
         }
         for (family, k) in &self.stiffness {
-            text += &format!(", stiffness {}={k}", family_name(*family));
+            text += &format!(", stiffness {}={k}", family.short_name());
         }
         text
     }
@@ -140,56 +137,6 @@ fn short_number(x: f64) -> String {
         plain
     } else {
         format!("{x:e}")
-    }
-}
-
-/// The command-line name of a family in `--constraints`: edges, plane or volume.
-pub fn family_name(family: Family) -> &'static str {
-    match family {
-        Family::Distance => "edges",
-        Family::Plane => "plane",
-        Family::Volume => "volume",
-    }
-}
-
-/// "edges+plane+volume", or "none".
-pub fn family_list(active: PerFamily<bool>) -> String {
-    let names: Vec<&str> = Family::ALL
-        .into_iter()
-        .filter(|&f| active.get(f))
-        .map(family_name)
-        .collect();
-    if names.is_empty() {
-        "none".into()
-    } else {
-        names.join("+")
-    }
-}
-
-fn family(name: &str) -> Result<Family, String> {
-    match name.trim() {
-        "edges" | "edge" | "distance" => Ok(Family::Distance),
-        "plane" | "height" => Ok(Family::Plane),
-        "volume" => Ok(Family::Volume),
-        other => Err(format!(
-            "'{other}' is not a constraint family: expected edges, plane or volume"
-        )),
-    }
-}
-
-fn families(text: &str) -> Result<PerFamily<bool>, String> {
-    let mut active = PerFamily::splat(false);
-    for name in text.split(',') {
-        active.set(family(name)?, true);
-    }
-    Ok(active)
-}
-
-fn method(text: &str) -> Result<Method, String> {
-    match text {
-        "xpbd" => Ok(Method::Xpbd),
-        "pbd" => Ok(Method::Pbd),
-        other => Err(format!("'{other}' is not a solver: expected xpbd or pbd")),
     }
 }
 
@@ -215,7 +162,7 @@ fn family_value(text: &str) -> Result<(Family, f64), String> {
     let (name, value) = text
         .split_once('=')
         .ok_or_else(|| format!("'{text}' is not FAMILY=VALUE (e.g. edges=1e-6)"))?;
-    Ok((family(name)?, args::finite_number(value)?))
+    Ok((Family::parse(name)?, args::finite_number(value)?))
 }
 
 fn compliance(text: &str) -> Result<(Family, f64), String> {

@@ -30,18 +30,23 @@ impl Default for OrbitCamera {
 }
 
 impl OrbitCamera {
-    /// A camera at the default angles that shows the whole box [lo, hi].
-    pub fn framing(lo: Vec3, hi: Vec3) -> Self {
+    /// A camera at the default angles that shows the whole box [lo, hi] in a view of the given
+    /// aspect ratio (width / height).
+    pub fn framing(lo: Vec3, hi: Vec3, aspect: f32) -> Self {
         let mut camera = OrbitCamera::default();
-        camera.frame(lo, hi);
+        camera.frame(lo, hi, aspect);
         camera
     }
 
-    /// Keeps the angles and moves so that the box [lo, hi] fills the view.
-    pub fn frame(&mut self, lo: Vec3, hi: Vec3) {
+    /// Keeps the angles and moves so that the box [lo, hi] fills a view of the given aspect
+    /// ratio: its bounding sphere, with a margin for arrows, fits the narrower of the two fields
+    /// of view.
+    pub fn frame(&mut self, lo: Vec3, hi: Vec3, aspect: f32) {
         let radius = ((hi - lo).length() * 0.5).max(1e-3);
+        let half_y = FOV_Y * 0.5;
+        let half_x = (half_y.tan() * aspect.max(1e-3)).atan();
         self.target = (lo + hi) * 0.5;
-        self.distance = radius / (FOV_Y * 0.5).sin() * 1.1;
+        self.distance = radius / half_x.min(half_y).sin() * 1.25;
     }
 
     /// The camera's position.
@@ -108,7 +113,8 @@ mod tests {
 
     #[test]
     fn the_target_projects_to_the_centre_and_the_ray_there_hits_it() {
-        let camera = OrbitCamera::framing(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 2.0, 1.0));
+        let camera =
+            OrbitCamera::framing(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 2.0, 1.0), 1.5);
         let clip = camera.view_projection(1.5).project_point3(camera.target);
         assert!(clip.truncate().length() < 1e-5);
         let (origin, direction) = camera.ray(Vec2::ZERO, 1.5);
@@ -119,19 +125,21 @@ mod tests {
     #[test]
     fn framing_keeps_the_whole_box_in_view() {
         let (lo, hi) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.5, 0.5));
-        let camera = OrbitCamera::framing(lo, hi);
-        let m = camera.view_projection(1.0);
-        for corner in 0..8 {
-            let p = Vec3::new(
-                if corner & 1 == 0 { lo.x } else { hi.x },
-                if corner & 2 == 0 { lo.y } else { hi.y },
-                if corner & 4 == 0 { lo.z } else { hi.z },
-            );
-            let ndc = m.project_point3(p);
-            assert!(
-                ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
-                "corner {p} at {ndc}"
-            );
+        for aspect in [0.4, 1.0, 2.5] {
+            let camera = OrbitCamera::framing(lo, hi, aspect);
+            let m = camera.view_projection(aspect);
+            for corner in 0..8 {
+                let p = Vec3::new(
+                    if corner & 1 == 0 { lo.x } else { hi.x },
+                    if corner & 2 == 0 { lo.y } else { hi.y },
+                    if corner & 4 == 0 { lo.z } else { hi.z },
+                );
+                let ndc = m.project_point3(p);
+                assert!(
+                    ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
+                    "aspect {aspect}: corner {p} at {ndc}"
+                );
+            }
         }
     }
 

@@ -12,12 +12,15 @@ pub mod viewport;
 pub mod workbench;
 
 use eframe::egui;
+use files::Opened;
 use geometry::{SceneCache, ViewOptions};
 use panels::controls::{SceneChoice, SceneRequest};
+use panels::lesson::{LessonRequest, LessonState};
 use shortcuts::{Action, SHORTCUTS};
 use std::time::Duration;
+use tetlab_core::lesson::{Action as LessonAction, Lesson};
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::Settings;
+use tetlab_core::solver::{PerFamily, Settings};
 use viewport::Viewport;
 use web_time::Instant;
 use workbench::Workbench;
@@ -71,6 +74,14 @@ pub fn install_fonts(ctx: &egui::Context) {
     ctx.set_fonts(fonts);
 }
 
+/// The right half of a side-by-side comparison: the same scene with other constraint families.
+pub struct Comparison {
+    /// Its simulation and selection.
+    pub bench: Workbench,
+    /// Its view.
+    pub viewport: Viewport,
+}
+
 /// The workbench application.
 pub struct TetlabApp {
     /// The simulation and selection.
@@ -86,7 +97,20 @@ pub struct TetlabApp {
     show_help: bool,
     /// Whether the inspector window is open.
     pub show_inspector: bool,
+    /// Whether the lesson window is open.
+    pub show_lesson: bool,
+    /// The lesson in progress.
+    pub lesson: Option<LessonState>,
+    /// The second simulation shown beside the first, if any.
+    pub comparison: Option<Comparison>,
+    /// Classroom mode: large, the 3D view and the lesson only.
+    pub classroom: bool,
+    lesson_path: String,
+    compare_families: PerFamily<bool>,
 }
+
+/// How much larger everything is in classroom mode.
+pub const CLASSROOM_ZOOM: f32 = 1.5;
 
 impl TetlabApp {
     /// Sets up the renderer and restores the last session's preferences.
@@ -109,7 +133,7 @@ impl TetlabApp {
         let builtin = Builtin::from_name(&preferences.scene.builtin).unwrap_or(Builtin::Cube);
         let bench = Workbench::builtin(builtin, preferences.scene.resolution, preferences.settings);
         let cache = SceneCache::new(&bench.scene.mesh);
-        let viewport = Viewport::new(&bench);
+        let viewport = Viewport::default();
         TetlabApp {
             bench,
             cache,
@@ -119,49 +143,162 @@ impl TetlabApp {
             step_time: Duration::ZERO,
             show_help: false,
             show_inspector: false,
+            show_lesson: false,
+            lesson: None,
+            comparison: None,
+            classroom: false,
+            lesson_path: String::new(),
+            compare_families: PerFamily::splat(true),
         }
     }
 
-    /// Replaces the scene; keeps settings and view.
+    /// Replaces the scene; keeps settings and view; ends a comparison.
     pub fn load(&mut self, scene: Scene) {
         self.bench.load(scene);
         self.cache = SceneCache::new(&self.bench.scene.mesh);
-        self.viewport.frame(&self.bench);
+        self.viewport.frame();
+        self.comparison = None;
         self.error = None;
     }
 
-    fn request(&mut self, request: SceneRequest) {
-        let scene = match request {
-            SceneRequest::Builtin(builtin, resolution) => {
-                Scene::builtin(builtin, resolution).map_err(|e| e.to_string())
-            }
-            SceneRequest::File(path) => files::load_path(&path),
+    /// Opens a lesson at its first step: its scene, settings and tet.
+    pub fn open_lesson(&mut self, lesson: Lesson) {
+        self.load(lesson.scene());
+        self.bench.set_settings(lesson.settings);
+        self.bench.select_tet(lesson.tet);
+        self.viewport.reset_camera();
+        self.lesson = Some(LessonState {
+            lesson,
+            step: 0,
+            frames_left: 0,
+        });
+        self.show_lesson = true;
+    }
+
+    /// Does the current lesson step: its actions (on both simulations when comparing), then
+    /// plays its frames.
+    pub fn do_step(&mut self) {
+        let Some(step) = self.lesson.as_ref().map(|state| state.current().clone()) else {
+            return;
         };
-        match scene {
-            Ok(scene) => self.load(scene),
+        for action in step.actions {
+            match action {
+                LessonAction::Compare(families) => self.compare(families),
+                action => {
+                    self.bench.apply_lesson_action(action);
+                    if let Some(comparison) = &mut self.comparison {
+                        let active = comparison.bench.simulation.settings().active;
+                        comparison.bench.apply_lesson_action(action);
+                        let settings = Settings {
+                            active,
+                            ..*comparison.bench.simulation.settings()
+                        };
+                        comparison.bench.set_settings(settings);
+                    }
+                }
+            }
+        }
+        if let Some(state) = &mut self.lesson {
+            state.frames_left = step.frames;
+        }
+        if step.frames > 0 {
+            self.set_playing(true);
+        }
+    }
+
+    /// Starts comparing side by side with a twin of the current state using `families`, or
+    /// stops (`None`).
+    pub fn compare(&mut self, families: Option<PerFamily<bool>>) {
+        self.comparison = families.map(|active| {
+            let bench = self.bench.twin(active);
+            let mut viewport = Viewport::default();
+            viewport.view = 1;
+            viewport.camera = self.viewport.camera;
+            viewport.frame();
+            Comparison { bench, viewport }
+        });
+        // The main view changes width: frame it once laid out.
+        self.viewport.frame();
+    }
+
+    fn go_to_step(&mut self, forward: bool) {
+        if let Some(state) = &mut self.lesson {
+            let last = state.lesson.steps.len() - 1;
+            state.step = if forward {
+                (state.step + 1).min(last)
+            } else {
+                state.step.saturating_sub(1)
+            };
+            state.frames_left = 0;
+        }
+    }
+
+    fn set_playing(&mut self, playing: bool) {
+        self.bench.set_playing(playing);
+        if let Some(comparison) = &mut self.comparison {
+            comparison.bench.set_playing(playing);
+        }
+    }
+
+    fn request(&mut self, request: SceneRequest) {
+        let opened = match request {
+            SceneRequest::Builtin(builtin, resolution) => Scene::builtin(builtin, resolution)
+                .map(Opened::Scene)
+                .map_err(|e| e.to_string()),
+            SceneRequest::File(path) => files::open_path(&path),
+        };
+        self.opened(opened);
+    }
+
+    fn opened(&mut self, opened: Result<Opened, String>) {
+        match opened {
+            Ok(Opened::Scene(scene)) => self.load(scene),
+            Ok(Opened::Lesson(lesson)) => self.open_lesson(*lesson),
             Err(message) => self.error = Some(message),
         }
     }
 
-    fn act(&mut self, action: Action) {
-        let bench = &mut self.bench;
+    fn lesson_request(&mut self, request: LessonRequest) {
+        match request {
+            LessonRequest::Builtin(k) => match Lesson::builtin(k) {
+                Ok(lesson) => self.open_lesson(lesson),
+                Err(e) => self.error = Some(e.to_string()),
+            },
+            LessonRequest::File(path) => self.opened(files::open_path(&path)),
+            LessonRequest::Do => self.do_step(),
+            LessonRequest::Next => self.go_to_step(true),
+            LessonRequest::Previous => self.go_to_step(false),
+        }
+    }
+
+    /// Does what a key or a button asks; actions on the simulation go to both halves of a
+    /// comparison.
+    pub fn act(&mut self, action: Action) {
         match action {
-            Action::PlayPause => bench.set_playing(!bench.playing),
-            Action::StepFrame => bench.step_frame(),
-            Action::StepSubstep => bench.step_substep(),
-            Action::StepProjection => bench.step_projection(),
-            Action::FinishSubstep => bench.finish_substep(),
-            Action::Reset => bench.reset(),
-            Action::InvertSelected => bench.invert_selected(),
-            Action::Mirror => bench.perturb(Perturbation::Mirror),
-            Action::Flatten => bench.perturb(Perturbation::Flatten),
-            Action::Scramble => bench.scramble(),
-            Action::TogglePin => bench.toggle_pin(),
-            Action::NextTet => bench.next_tet_of_selected(),
-            Action::FrameView => self.viewport.frame(&self.bench),
-            Action::ResetCamera => self.viewport.reset_camera(&self.bench),
+            Action::FrameView => self.viewport.frame(),
+            Action::ResetCamera => self.viewport.reset_camera(),
             Action::Inspector => self.show_inspector = !self.show_inspector,
             Action::Help => self.show_help = !self.show_help,
+            Action::Lesson => self.show_lesson = !self.show_lesson,
+            Action::Classroom => {
+                self.classroom = !self.classroom;
+                self.viewport.frame();
+                if let Some(comparison) = &mut self.comparison {
+                    comparison.viewport.frame();
+                }
+            }
+            Action::NextStep => self.go_to_step(true),
+            Action::PreviousStep => self.go_to_step(false),
+            Action::DoStep => self.do_step(),
+            Action::PlayPause => self.set_playing(!self.bench.playing),
+            simulation => {
+                act_on(&mut self.bench, simulation);
+                if let Some(comparison) = &mut self.comparison {
+                    comparison.bench.selected_particle = self.bench.selected_particle;
+                    comparison.bench.selected_tet = self.bench.selected_tet;
+                    act_on(&mut comparison.bench, simulation);
+                }
+            }
         }
     }
 
@@ -180,11 +317,73 @@ impl TetlabApp {
         }
         let dropped = ctx.input(|i| i.raw.dropped_files.clone());
         for file in dropped {
-            match files::load_dropped(file.as_ref()) {
-                Ok(scene) => self.load(scene),
-                Err(message) => self.error = Some(message),
+            self.opened(files::open_dropped(file.as_ref()));
+        }
+    }
+
+    /// Plays a frame of each simulation while playing, and counts down a lesson step's frames.
+    fn advance(&mut self, ctx: &egui::Context) {
+        if !self.bench.playing {
+            return;
+        }
+        let started = Instant::now();
+        self.bench.step_frame();
+        self.step_time = started.elapsed();
+        if let Some(comparison) = &mut self.comparison
+            && comparison.bench.playing
+        {
+            comparison.bench.step_frame();
+        }
+        if let Some(state) = &mut self.lesson
+            && state.frames_left > 0
+        {
+            state.frames_left -= 1;
+            if state.frames_left == 0 {
+                self.set_playing(false);
             }
         }
+        ctx.request_repaint();
+    }
+
+    /// The 3D view, or two side by side when comparing, each titled with its families.
+    fn views(&mut self, ui: &mut egui::Ui) {
+        let view = self.preferences.view;
+        let Some(comparison) = &mut self.comparison else {
+            self.viewport.show(ui, &mut self.bench, &self.cache, &view);
+            return;
+        };
+        let size = if self.classroom { 20.0 } else { 14.0 };
+        ui.columns(2, |columns| {
+            let [left, right] = columns else {
+                unreachable!("two columns")
+            };
+            for (ui, bench, viewport) in [
+                (left, &mut self.bench, &mut self.viewport),
+                (right, &mut comparison.bench, &mut comparison.viewport),
+            ] {
+                let families = bench.simulation.settings().active.describe();
+                ui.label(egui::RichText::new(families).size(size).strong());
+                viewport.show(ui, bench, &self.cache, &view);
+            }
+        });
+    }
+}
+
+/// Does a simulation action on one workbench.
+fn act_on(bench: &mut Workbench, action: Action) {
+    match action {
+        Action::StepFrame => bench.step_frame(),
+        Action::StepSubstep => bench.step_substep(),
+        Action::StepProjection => bench.step_projection(),
+        Action::FinishSubstep => bench.finish_substep(),
+        Action::Reset => bench.reset(),
+        Action::InvertSelected => bench.invert_selected(),
+        Action::Mirror => bench.perturb(Perturbation::Mirror),
+        Action::Flatten => bench.perturb(Perturbation::Flatten),
+        Action::Scramble => bench.scramble(),
+        Action::TogglePin => bench.toggle_pin(),
+        Action::NextTet => bench.next_tet_of_selected(),
+        _ => {}
     }
 }
 
@@ -192,57 +391,121 @@ impl eframe::App for TetlabApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.handle_input(&ctx);
-        if self.bench.playing {
-            let started = Instant::now();
-            self.bench.step_frame();
-            self.step_time = started.elapsed();
-            ctx.request_repaint();
+        let zoom = if self.classroom { CLASSROOM_ZOOM } else { 1.0 };
+        if ctx.zoom_factor() != zoom {
+            ctx.set_zoom_factor(zoom);
         }
+        self.advance(&ctx);
+        let mut actions = Vec::new();
         let mut request = None;
-        let mut view_request = None;
-        egui::Panel::left("controls")
-            .default_size(300.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    ui.horizontal(|ui| {
-                        ui.heading("tetlab");
-                        if ui.button("Help (H)").clicked() {
-                            self.show_help = !self.show_help;
+        let mut lesson_request = None;
+        let mut compare_request = None;
+        let metrics = self.bench.metrics;
+        let comparison_metrics = self.comparison.as_ref().map(|c| c.bench.metrics);
+        if self.classroom {
+            egui::Panel::right("classroom lesson")
+                .default_size(ui.available_width() * 0.36)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        lesson_request = panels::lesson::show(
+                            ui,
+                            self.lesson.as_ref(),
+                            &mut self.lesson_path,
+                            true,
+                            &metrics,
+                            comparison_metrics.as_ref(),
+                        );
+                        ui.add_space(12.0);
+                        ui.label(
+                            "Left/Right: steps   Enter: do it   Space: play   F5: leave classroom",
+                        );
+                    });
+                });
+        } else {
+            egui::Panel::left("controls")
+                .default_size(300.0)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        ui.horizontal(|ui| {
+                            ui.heading("tetlab");
+                            for (label, action) in [
+                                ("Help (H)", Action::Help),
+                                ("Lessons (L)", Action::Lesson),
+                                ("Classroom (F5)", Action::Classroom),
+                            ] {
+                                if ui.button(label).clicked() {
+                                    actions.push(action);
+                                }
+                            }
+                        });
+                        if let Some(error) = &self.error {
+                            ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
+                        }
+                        request = panels::controls::show(
+                            ui,
+                            &mut self.bench,
+                            &mut self.preferences.scene,
+                            &mut actions,
+                        );
+                        ui.separator();
+                        panels::tools::show(ui, &self.bench, &mut actions);
+                        ui.separator();
+                        compare_request = panels::compare::show(
+                            ui,
+                            &mut self.compare_families,
+                            self.comparison.is_some(),
+                        );
+                    });
+                });
+            egui::Panel::right("readouts")
+                .default_size(300.0)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        panels::readouts::show(ui, &self.bench, self.step_time);
+                        ui.separator();
+                        if let Some(action) = panels::display::show(
+                            ui,
+                            &mut self.preferences.view,
+                            self.bench.simulation.tets().len(),
+                        ) {
+                            actions.push(action);
                         }
                     });
-                    if let Some(error) = &self.error {
-                        ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
-                    }
-                    request =
-                        panels::controls::show(ui, &mut self.bench, &mut self.preferences.scene);
-                    ui.separator();
-                    panels::tools::show(ui, &mut self.bench, &mut self.show_inspector);
                 });
-            });
-        egui::Panel::right("readouts")
-            .default_size(300.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    panels::readouts::show(ui, &self.bench, self.step_time);
-                    ui.separator();
-                    view_request = panels::display::show(
+            let mut open = self.show_lesson;
+            egui::Window::new("Lesson")
+                .open(&mut open)
+                .default_pos([330.0, 500.0])
+                .default_size([620.0, 280.0])
+                .vscroll(true)
+                .show(&ctx, |ui| {
+                    lesson_request = panels::lesson::show(
                         ui,
-                        &mut self.preferences.view,
-                        self.bench.simulation.tets().len(),
+                        self.lesson.as_ref(),
+                        &mut self.lesson_path,
+                        false,
+                        &metrics,
+                        comparison_metrics.as_ref(),
                     );
                 });
-            });
-        egui::CentralPanel::default_margins().show(ui, |ui| {
-            self.viewport
-                .show(ui, &mut self.bench, &self.cache, &self.preferences.view);
-        });
+            self.show_lesson = open;
+        }
+        egui::CentralPanel::default_margins().show(ui, |ui| self.views(ui));
         panels::help::show(&ctx, &mut self.show_help);
-        panels::inspector::show(&ctx, &mut self.show_inspector, &self.bench);
+        if !self.classroom {
+            panels::inspector::show(&ctx, &mut self.show_inspector, &self.bench);
+        }
+        for action in actions {
+            self.act(action);
+        }
         if let Some(request) = request {
             self.request(request);
         }
-        if let Some(action) = view_request {
-            self.act(action);
+        if let Some(request) = lesson_request {
+            self.lesson_request(request);
+        }
+        if let Some(families) = compare_request {
+            self.compare(families);
         }
         self.preferences.settings = *self.bench.simulation.settings();
     }

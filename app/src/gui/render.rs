@@ -133,14 +133,22 @@ struct Target {
     blit: wgpu::BindGroup,
 }
 
-/// The renderer's GPU objects, kept in egui_wgpu's callback resources.
+/// The renderer's GPU objects, kept in egui_wgpu's callback resources: pipelines shared by all
+/// views, and per view (the main view, the comparison) its own uniforms, buffers and target, so
+/// that two views drawn in one egui frame do not overwrite each other.
 pub struct Renderer {
     opaque: wgpu::RenderPipeline,
     transparent: wgpu::RenderPipeline,
     lines: wgpu::RenderPipeline,
     blit: wgpu::RenderPipeline,
     blit_layout: wgpu::BindGroupLayout,
+    uniform_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
+    views: Vec<ViewResources>,
+}
+
+/// What one view draws with.
+struct ViewResources {
     uniforms: wgpu::Buffer,
     uniform_group: wgpu::BindGroup,
     target: Option<Target>,
@@ -149,6 +157,35 @@ pub struct Renderer {
     line_buffer: VertexBuffer,
     overlay_triangle_buffer: VertexBuffer,
     overlay_line_buffer: VertexBuffer,
+}
+
+impl ViewResources {
+    fn new(device: &wgpu::Device, uniform_layout: &wgpu::BindGroupLayout) -> Self {
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tetlab uniforms"),
+            size: std::mem::size_of::<Uniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tetlab uniforms"),
+            layout: uniform_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniforms.as_entire_binding(),
+            }],
+        });
+        ViewResources {
+            uniforms,
+            uniform_group,
+            target: None,
+            triangle_buffer: VertexBuffer::new(device),
+            transparent_buffer: VertexBuffer::new(device),
+            line_buffer: VertexBuffer::new(device),
+            overlay_triangle_buffer: VertexBuffer::new(device),
+            overlay_line_buffer: VertexBuffer::new(device),
+        }
+    }
 }
 
 impl Renderer {
@@ -182,20 +219,6 @@ impl Renderer {
                     min_binding_size: None,
                 },
                 count: None,
-            }],
-        });
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("tetlab uniforms"),
-            size: std::mem::size_of::<Uniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tetlab uniforms"),
-            layout: &uniform_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniforms.as_entire_binding(),
             }],
         });
         let scene_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -335,20 +358,28 @@ impl Renderer {
             lines,
             blit,
             blit_layout,
+            uniform_layout,
             sampler,
-            uniforms,
-            uniform_group,
-            target: None,
-            triangle_buffer: VertexBuffer::new(device),
-            transparent_buffer: VertexBuffer::new(device),
-            line_buffer: VertexBuffer::new(device),
-            overlay_triangle_buffer: VertexBuffer::new(device),
-            overlay_line_buffer: VertexBuffer::new(device),
+            views: Vec::new(),
         }
     }
 
-    fn target(&mut self, device: &wgpu::Device, size: [u32; 2]) -> &Target {
-        if self.target.as_ref().is_none_or(|t| t.size != size) {
+    /// The resources of view `view`, made on first use.
+    fn view(&mut self, device: &wgpu::Device, view: usize) -> &mut ViewResources {
+        while self.views.len() <= view {
+            let resources = ViewResources::new(device, &self.uniform_layout);
+            self.views.push(resources);
+        }
+        &mut self.views[view]
+    }
+
+    /// Makes view `view`'s target `size` pixels large if it is not.
+    fn resize(&mut self, device: &wgpu::Device, view: usize, size: [u32; 2]) {
+        if self.views[view]
+            .target
+            .as_ref()
+            .is_none_or(|t| t.size != size)
+        {
             let texture = |label, format, usage| {
                 device
                     .create_texture(&wgpu::TextureDescriptor {
@@ -391,19 +422,20 @@ impl Renderer {
                     },
                 ],
             });
-            self.target = Some(Target {
+            self.views[view].target = Some(Target {
                 size,
                 color,
                 depth,
                 blit,
             });
         }
-        self.target.as_ref().expect("just made")
     }
 }
 
-/// One frame of the 3D view: what to draw and from where.
+/// One frame of a 3D view: what to draw and from where.
 pub struct ViewCallback {
+    /// Which view: 0 the main one, 1 the comparison.
+    pub view: usize,
     /// The geometry.
     pub geometry: Geometry,
     /// World to clip space.
@@ -436,25 +468,25 @@ impl egui_wgpu::CallbackTrait for ViewCallback {
             view_projection: self.view_projection.to_cols_array_2d(),
             light: self.light.extend(0.0).to_array(),
         };
-        queue.write_buffer(&renderer.uniforms, 0, bytemuck::bytes_of(&uniforms));
-        renderer
-            .triangle_buffer
-            .upload(device, queue, &self.geometry.triangles);
-        renderer
-            .transparent_buffer
-            .upload(device, queue, &self.geometry.transparent);
-        renderer
-            .line_buffer
-            .upload(device, queue, &self.geometry.lines);
-        renderer
-            .overlay_triangle_buffer
-            .upload(device, queue, &self.geometry.overlay_triangles);
-        renderer
-            .overlay_line_buffer
-            .upload(device, queue, &self.geometry.overlay_lines);
-        renderer.target(device, size);
+        let resources = renderer.view(device, self.view);
+        queue.write_buffer(&resources.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        let geometry = &self.geometry;
+        for (buffer, vertices) in [
+            (&mut resources.triangle_buffer, &geometry.triangles),
+            (&mut resources.transparent_buffer, &geometry.transparent),
+            (&mut resources.line_buffer, &geometry.lines),
+            (
+                &mut resources.overlay_triangle_buffer,
+                &geometry.overlay_triangles,
+            ),
+            (&mut resources.overlay_line_buffer, &geometry.overlay_lines),
+        ] {
+            buffer.upload(device, queue, vertices);
+        }
+        renderer.resize(device, self.view, size);
         let renderer = &*renderer;
-        let target = renderer.target.as_ref().expect("made above");
+        let resources = &renderer.views[self.view];
+        let target = resources.target.as_ref().expect("made above");
         let [r, g, b, a] = self.background;
         let background = wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a });
         // The scene, then the overlay over it on a fresh depth buffer.
@@ -462,17 +494,17 @@ impl egui_wgpu::CallbackTrait for ViewCallback {
             (
                 background,
                 [
-                    (&renderer.opaque, &renderer.triangle_buffer),
-                    (&renderer.lines, &renderer.line_buffer),
-                    (&renderer.transparent, &renderer.transparent_buffer),
+                    (&renderer.opaque, &resources.triangle_buffer),
+                    (&renderer.lines, &resources.line_buffer),
+                    (&renderer.transparent, &resources.transparent_buffer),
                 ]
                 .as_slice(),
             ),
             (
                 wgpu::LoadOp::Load,
                 [
-                    (&renderer.opaque, &renderer.overlay_triangle_buffer),
-                    (&renderer.lines, &renderer.overlay_line_buffer),
+                    (&renderer.opaque, &resources.overlay_triangle_buffer),
+                    (&renderer.lines, &resources.overlay_line_buffer),
                 ]
                 .as_slice(),
             ),
@@ -500,7 +532,7 @@ impl egui_wgpu::CallbackTrait for ViewCallback {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_bind_group(0, &renderer.uniform_group, &[]);
+            pass.set_bind_group(0, &resources.uniform_group, &[]);
             for (pipeline, buffer) in passes {
                 pass.set_pipeline(pipeline);
                 buffer.draw(&mut pass);
@@ -515,13 +547,16 @@ impl egui_wgpu::CallbackTrait for ViewCallback {
         pass: &mut wgpu::RenderPass<'static>,
         resources: &egui_wgpu::CallbackResources,
     ) {
-        let Some(target) = resources
-            .get::<Renderer>()
-            .and_then(|r| r.target.as_ref().map(|t| (r, t)))
+        let Some(renderer) = resources.get::<Renderer>() else {
+            return;
+        };
+        let Some(target) = renderer
+            .views
+            .get(self.view)
+            .and_then(|v| v.target.as_ref())
         else {
             return;
         };
-        let (renderer, target) = target;
         pass.set_pipeline(&renderer.blit);
         pass.set_bind_group(0, &target.blit, &[]);
         pass.draw(0..3, 0..1);

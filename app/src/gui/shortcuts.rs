@@ -35,12 +35,22 @@ pub enum Action {
     ResetCamera,
     /// Show or hide the inspector.
     Inspector,
+    /// Show or hide the lesson window.
+    Lesson,
+    /// Classroom mode on or off.
+    Classroom,
+    /// The lesson's next step.
+    NextStep,
+    /// The lesson's previous step.
+    PreviousStep,
+    /// Do what the lesson step does (its actions, then its frames).
+    DoStep,
     /// Show or hide the help.
     Help,
 }
 
 /// Every shortcut: key, action, what the help says.
-pub const SHORTCUTS: [(Key, Action, &str); 16] = [
+pub const SHORTCUTS: [(Key, Action, &str); 21] = [
     (Key::Space, Action::PlayPause, "play / pause"),
     (Key::N, Action::StepFrame, "step one frame"),
     (Key::U, Action::StepSubstep, "step one substep"),
@@ -72,5 +82,18 @@ pub const SHORTCUTS: [(Key, Action, &str); 16] = [
         Action::Inspector,
         "inspector (numbers of the selected tet)",
     ),
+    (Key::L, Action::Lesson, "lessons"),
+    (
+        Key::F5,
+        Action::Classroom,
+        "classroom mode (large, view and lesson only)",
+    ),
+    (Key::ArrowRight, Action::NextStep, "lesson: next step"),
+    (
+        Key::ArrowLeft,
+        Action::PreviousStep,
+        "lesson: previous step",
+    ),
+    (Key::Enter, Action::DoStep, "lesson: do this step"),
     (Key::H, Action::Help, "this help"),
 ];

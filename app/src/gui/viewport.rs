@@ -26,31 +26,60 @@ pub struct Viewport {
     drag_plane: Option<(Vec3, Vec3)>,
     /// Where the view was drawn last, in points.
     pub rect: Rect,
+    /// Which of the renderer's views this is: 0 the main one, 1 the comparison.
+    pub view: usize,
+    /// A camera change that waits for the view's size: frame the body, or reset the camera.
+    pending: Option<CameraChange>,
 }
 
-impl Viewport {
-    /// A view framing the rest body of `bench`.
-    pub fn new(bench: &Workbench) -> Self {
-        let mut viewport = Viewport {
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum CameraChange {
+    Frame,
+    Reset,
+}
+
+impl Default for Viewport {
+    /// A view that frames the rest body when first drawn.
+    fn default() -> Self {
+        Viewport {
             camera: OrbitCamera::default(),
             hovered: None,
             drag_plane: None,
             rect: Rect::NOTHING,
+            view: 0,
+            pending: Some(CameraChange::Reset),
+        }
+    }
+}
+
+impl Viewport {
+    /// Keeps the camera angles and frames the current body, when the view is next drawn (at its
+    /// size then).
+    pub fn frame(&mut self) {
+        self.pending = Some(CameraChange::Frame);
+    }
+
+    /// Back to the first view, when the view is next drawn: the default angles, framing the rest
+    /// shape.
+    pub fn reset_camera(&mut self) {
+        self.pending = Some(CameraChange::Reset);
+    }
+
+    /// Applies a pending camera change for a view of the size of `self.rect`.
+    fn apply_camera_change(&mut self, bench: &Workbench) {
+        let Some(change) = self.pending.take() else {
+            return;
         };
-        viewport.reset_camera(bench);
-        viewport
-    }
-
-    /// Keeps the camera angles and frames the current body.
-    pub fn frame(&mut self, bench: &Workbench) {
-        let (lo, hi) = tetlab_core::visual::bounds(bench.simulation.positions());
-        self.camera.frame(lo.as_vec3(), hi.as_vec3());
-    }
-
-    /// Back to the first view: the default angles, framing the rest shape.
-    pub fn reset_camera(&mut self, bench: &Workbench) {
-        let (lo, hi) = tetlab_core::visual::bounds(bench.simulation.rest_positions());
-        self.camera = OrbitCamera::framing(lo.as_vec3(), hi.as_vec3());
+        let aspect = self.rect.width() / self.rect.height().max(1.0);
+        let positions = match change {
+            CameraChange::Frame => bench.simulation.positions(),
+            CameraChange::Reset => bench.simulation.rest_positions(),
+        };
+        let (lo, hi) = tetlab_core::visual::bounds(positions);
+        if change == CameraChange::Reset {
+            self.camera = OrbitCamera::default();
+        }
+        self.camera.frame(lo.as_vec3(), hi.as_vec3(), aspect);
     }
 
     /// Shows the view in all the space `ui` has left.
@@ -63,6 +92,7 @@ impl Viewport {
     ) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         self.rect = rect;
+        self.apply_camera_change(bench);
         let aspect = rect.width() / rect.height().max(1.0);
         let pointer = response.hover_pos();
         self.hovered = pointer.and_then(|p| self.pick(bench, rect, p));
@@ -114,6 +144,7 @@ impl Viewport {
             [0.93, 0.94, 0.96, 1.0]
         };
         let callback = ViewCallback {
+            view: self.view,
             geometry,
             view_projection: self.camera.view_projection(aspect),
             light: (self.camera.eye() - self.camera.target + Vec3::Y * self.camera.distance)

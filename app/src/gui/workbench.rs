@@ -3,9 +3,10 @@
 
 use glam::DVec3;
 use std::collections::VecDeque;
+use tetlab_core::lesson::Action as LessonAction;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
-use tetlab_core::solver::{Settings, Simulation};
+use tetlab_core::solver::{PerFamily, Settings, Simulation};
 use tetlab_core::stepper::{Advanced, StepByStep};
 
 /// How many frames of metrics the plots keep.
@@ -73,6 +74,32 @@ impl Workbench {
         let resolution = resolution.clamp(1, 16);
         let scene = Scene::builtin(builtin, resolution).expect("resolution is in range");
         Workbench::new(scene, settings)
+    }
+
+    /// A second workbench in the same state (scene, positions, velocities, selection) but with
+    /// other constraint families: the right half of a comparison.
+    pub fn twin(&self, active: PerFamily<bool>) -> Workbench {
+        let mut simulation = self.simulation.clone();
+        simulation.set_settings(Settings {
+            active,
+            ..*self.simulation.settings()
+        });
+        let mut twin = Workbench {
+            scene: self.scene.clone(),
+            metrics: Metrics::measure(&simulation),
+            simulation,
+            playing: self.playing,
+            selected_particle: self.selected_particle,
+            selected_tet: self.selected_tet,
+            dragging: None,
+            history: VecDeque::with_capacity(HISTORY),
+            scramble_seed: self.scramble_seed,
+            stepping: None,
+            last_advance: None,
+        };
+        twin.simulation.release();
+        twin.record();
+        twin
     }
 
     /// Replaces the scene, keeping the settings.
@@ -255,6 +282,21 @@ impl Workbench {
             } else {
                 self.simulation.release();
                 self.simulation.place(particle, position);
+            }
+        }
+    }
+
+    /// Does one action of a lesson step (a [`LessonAction::Compare`] is the app's business).
+    pub fn apply_lesson_action(&mut self, action: LessonAction) {
+        match action {
+            LessonAction::Reset => self.reset(),
+            LessonAction::Select(tet) => self.select_tet(tet),
+            LessonAction::Compare(_) => {}
+            other => {
+                self.finish_substep();
+                let mut tet = self.selected_tet.unwrap_or(0);
+                other.apply(&mut self.simulation, &mut tet);
+                self.after_change();
             }
         }
     }

@@ -90,6 +90,34 @@ impl Family {
         Family::ALL.into_iter().find(|f| f.name() == name)
     }
 
+    /// The family a user means: `edges` (or `edge`, `distance`), `plane` (or `height`,
+    /// `heights`) or `volume`, as written on the command line and in lesson files.
+    ///
+    /// ```
+    /// use tetlab_core::constraints::Family;
+    /// assert_eq!(Family::parse(" edges"), Ok(Family::Distance));
+    /// assert!(Family::parse("edgy").unwrap_err().contains("'edgy'"));
+    /// ```
+    pub fn parse(name: &str) -> Result<Family, String> {
+        match name.trim() {
+            "edges" | "edge" | "distance" => Ok(Family::Distance),
+            "plane" | "height" | "heights" => Ok(Family::Plane),
+            "volume" => Ok(Family::Volume),
+            other => Err(format!(
+                "'{other}' is not a constraint family: expected edges, plane or volume"
+            )),
+        }
+    }
+
+    /// The name used for the family in `--constraints` and lesson files: edges, plane or volume.
+    pub fn short_name(self) -> &'static str {
+        match self {
+            Family::Distance => "edges",
+            Family::Plane => "plane",
+            Family::Volume => "volume",
+        }
+    }
+
     /// The constraint and its gradients as lines of math: [`distance::FORMULA`],
     /// [`plane::FORMULA`] or [`volume::FORMULA`].
     pub fn formula(self) -> &'static [&'static str] {

@@ -1,5 +1,6 @@
 //! Playback, the scene, and the solver settings.
 
+use crate::gui::shortcuts::Action;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
 use tetlab_core::constraints::Family;
@@ -39,14 +40,14 @@ impl Default for SceneChoice {
 }
 
 /// The step-by-step buttons and where the substep stands.
-fn step_by_step(ui: &mut egui::Ui, bench: &mut Workbench) {
+fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>) {
     ui.horizontal(|ui| {
         if ui
             .button("Next projection")
             .on_hover_text("J: one constraint at a time")
             .clicked()
         {
-            bench.step_projection();
+            actions.push(Action::StepProjection);
         }
         if ui
             .add_enabled(
@@ -56,7 +57,7 @@ fn step_by_step(ui: &mut egui::Ui, bench: &mut Workbench) {
             .on_hover_text("K")
             .clicked()
         {
-            bench.finish_substep();
+            actions.push(Action::FinishSubstep);
         }
     });
     let Some(stepper) = bench.stepping else {
@@ -88,26 +89,28 @@ fn step_by_step(ui: &mut egui::Ui, bench: &mut Workbench) {
     ui.label(egui::RichText::new(status).monospace());
 }
 
-/// Shows playback and solver controls; returns a scene to load, if the user asked for one.
+/// Shows playback and solver controls; playback buttons add to `actions`. Returns a scene to
+/// load, if the user asked for one.
 pub fn show(
     ui: &mut egui::Ui,
     bench: &mut Workbench,
     choice: &mut SceneChoice,
+    actions: &mut Vec<Action>,
 ) -> Option<SceneRequest> {
     ui.heading("Playback");
     ui.horizontal(|ui| {
         let label = if bench.playing { "Pause" } else { "Play" };
-        if ui.button(label).on_hover_text("Space").clicked() {
-            bench.set_playing(!bench.playing);
-        }
-        if ui.button("Step frame").on_hover_text("N").clicked() {
-            bench.step_frame();
-        }
-        if ui.button("Step substep").on_hover_text("U").clicked() {
-            bench.step_substep();
+        for (label, key, action) in [
+            (label, "Space", Action::PlayPause),
+            ("Step frame", "N", Action::StepFrame),
+            ("Step substep", "U", Action::StepSubstep),
+        ] {
+            if ui.button(label).on_hover_text(key).clicked() {
+                actions.push(action);
+            }
         }
     });
-    step_by_step(ui, bench);
+    step_by_step(ui, bench, actions);
 
     ui.separator();
     ui.heading("Scene");

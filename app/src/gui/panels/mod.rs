@@ -1,8 +1,10 @@
 //! The side panels of the workbench, one file each.
 
+pub mod compare;
 pub mod controls;
 pub mod display;
 pub mod help;
 pub mod inspector;
+pub mod lesson;
 pub mod readouts;
 pub mod tools;

@@ -1,11 +1,12 @@
-//! Tools that deform the body or change the selection.
+//! Tools that deform the body or change the selection. Each adds an [`Action`]; the app does it
+//! (to both simulations when two are compared).
 
+use crate::gui::shortcuts::Action;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
-use tetlab_core::scene::Perturbation;
 
-/// Shows the tools; "Inspect" opens the inspector.
-pub fn show(ui: &mut egui::Ui, bench: &mut Workbench, inspector_open: &mut bool) {
+/// Shows the tools.
+pub fn show(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>) {
     ui.heading("Tools");
     ui.horizontal_wrapped(|ui| {
         let has_selection = bench.selected_tet.is_some() && bench.selected_particle.is_some();
@@ -14,23 +15,17 @@ pub fn show(ui: &mut egui::Ui, bench: &mut Workbench, inspector_open: &mut bool)
             .on_hover_text("I: reflect the selected particle through the opposite face")
             .clicked()
         {
-            bench.invert_selected();
+            actions.push(Action::InvertSelected);
         }
-        if ui.button("Mirror all").on_hover_text("M").clicked() {
-            bench.perturb(Perturbation::Mirror);
-        }
-        if ui.button("Flatten all").on_hover_text("F").clicked() {
-            bench.perturb(Perturbation::Flatten);
-        }
-        if ui.button("Scramble").on_hover_text("S").clicked() {
-            bench.scramble();
-        }
-        if ui
-            .button("Reset")
-            .on_hover_text("R: back to the rest shape")
-            .clicked()
-        {
-            bench.reset();
+        for (label, hint, action) in [
+            ("Mirror all", "M", Action::Mirror),
+            ("Flatten all", "F", Action::Flatten),
+            ("Scramble", "S", Action::Scramble),
+            ("Reset", "R: back to the rest shape", Action::Reset),
+        ] {
+            if ui.button(label).on_hover_text(hint).clicked() {
+                actions.push(action);
+            }
         }
     });
     ui.separator();
@@ -48,26 +43,22 @@ pub fn show(ui: &mut egui::Ui, bench: &mut Workbench, inspector_open: &mut bool)
                 ));
             }
             ui.horizontal(|ui| {
-                if ui
-                    .button(if pinned { "Unpin" } else { "Pin" })
-                    .on_hover_text("P")
-                    .clicked()
-                {
-                    bench.toggle_pin();
-                }
-                if ui
-                    .button("Next tet")
-                    .on_hover_text("T: the next tet of this particle")
-                    .clicked()
-                {
-                    bench.next_tet_of_selected();
-                }
-                if ui
-                    .button("Inspect")
-                    .on_hover_text("E: C, grad C, w, lambda of this tet's constraints")
-                    .clicked()
-                {
-                    *inspector_open = !*inspector_open;
+                for (label, hint, action) in [
+                    (if pinned { "Unpin" } else { "Pin" }, "P", Action::TogglePin),
+                    (
+                        "Next tet",
+                        "T: the next tet of this particle",
+                        Action::NextTet,
+                    ),
+                    (
+                        "Inspect",
+                        "E: C, grad C, w, lambda of this tet's constraints",
+                        Action::Inspector,
+                    ),
+                ] {
+                    if ui.button(label).on_hover_text(hint).clicked() {
+                        actions.push(action);
+                    }
                 }
             });
         }

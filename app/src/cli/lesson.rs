@@ -1,0 +1,198 @@
+//! `tetlab lesson`: a lesson run headless. Each step's actions and frames run in order, its text
+//! and its expected observations (checked) are printed, and with `--record` everything the lesson
+//! shows is logged to a Rerun recording: the simulation, the comparison when a step shows one
+//! (under `compare/`), and the text of each step (`lesson`).
+
+use super::UsageError;
+use super::record::{ArrowsMode, Destination, Ending, Recorder, Session, send_layout};
+use std::io::Write;
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+use tetlab_core::lesson::{Action, BUILTIN, Lesson, LessonRun};
+
+/// Options of `tetlab lesson`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The lesson: a number (1 is the first built-in lesson) or a lesson file (.toml).
+    #[arg(value_name = "N|FILE", required_unless_present = "list")]
+    lesson: Option<String>,
+    /// List the built-in lessons.
+    #[arg(long, conflicts_with_all = ["lesson", "record"])]
+    list: bool,
+    /// Record what the lesson shows to this file (.rrd).
+    #[arg(long, value_name = "FILE.rrd")]
+    record: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// Whether every expected observation of the lesson was observed.
+pub enum Outcome {
+    /// All observed (or only listed).
+    Observed,
+    /// At least one was not; the report says which.
+    NotObserved,
+    /// Stopped by Ctrl-C while recording; the recording holds what ran.
+    Interrupted,
+}
+
+/// Frames and seconds the lesson has run, across resets.
+#[derive(Default)]
+struct Clock {
+    frame: u64,
+    time: f64,
+}
+
+impl Clock {
+    fn tick(&mut self, dt: f64) {
+        self.frame += 1;
+        self.time += dt;
+    }
+}
+
+/// Runs (and optionally records) the lesson, printing each step and its checks to `out`.
+pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
+    if args.list {
+        for (k, builtin) in BUILTIN.iter().enumerate() {
+            let lesson = Lesson::builtin(k + 1).map_err(|e| UsageError(e.to_string()))?;
+            writeln!(out, "{:>2}  {}  ({})", k + 1, lesson.title, builtin.file)
+                .map_err(UsageError::stdout)?;
+        }
+        return Ok(Outcome::Observed);
+    }
+    let spec = args.lesson.as_deref().expect("clap requires a lesson");
+    let lesson = Lesson::find(spec).map_err(|e| UsageError(e.to_string()))?;
+    let mut run = LessonRun::new(&lesson);
+    let frames: u64 = lesson.steps.iter().map(|s| s.frames).sum();
+    let compares = lesson
+        .steps
+        .iter()
+        .flat_map(|s| &s.actions)
+        .any(|a| matches!(a, Action::Compare(Some(_))));
+    let session = match &args.record {
+        Some(path) => {
+            let destination = Destination::File {
+                path: path.clone(),
+                flag: "--record",
+            };
+            Some(Session::open(destination, frames, args.quiet)?)
+        }
+        None => None,
+    };
+    let rec = session.as_ref().map(Session::rec);
+    if let Some(rec) = rec {
+        let roots: &[&str] = if compares { &["", "compare/"] } else { &[""] };
+        send_layout(rec, roots);
+    }
+    // The recording's clock runs on through resets: frame k is the k-th frame the lesson ran.
+    let mut clock = Clock::default();
+    let mut recorder = rec.map(|rec| {
+        Recorder::new(
+            rec,
+            "",
+            run.scene(),
+            &run.simulation,
+            ArrowsMode::Selected,
+            run.tet,
+        )
+    });
+    let mut comparison_recorder: Option<Recorder> = None;
+    if let Some(recorder) = &mut recorder {
+        recorder.log_frame_at(0, 0.0, &run.simulation);
+    }
+
+    writeln!(out, "# {}", lesson.title).map_err(UsageError::stdout)?;
+    let mut all_observed = true;
+    for (k, step) in lesson.steps.iter().enumerate() {
+        writeln!(
+            out,
+            "\n## step {} of {}\n\n{}\n",
+            k + 1,
+            lesson.steps.len(),
+            step.text
+        )
+        .map_err(UsageError::stdout)?;
+        if let Some(rec) = rec {
+            rec.set_time_sequence("frame", clock.frame as i64);
+            rec.set_duration_secs("sim_time", clock.time);
+            let text = format!(
+                "# {}\n\n## step {} of {}\n\n{}",
+                lesson.title,
+                k + 1,
+                lesson.steps.len(),
+                step.text
+            );
+            rec.log("lesson", &rerun::TextDocument::from_markdown(text))
+                .ok();
+        }
+        let outcome = run.run_step(step, |run| {
+            clock.tick(run.simulation.settings().dt);
+            if let (Some(rec), Some(recorder)) = (rec, &mut recorder) {
+                recorder.set_tet(run.tet);
+                recorder.log_frame_at(clock.frame, clock.time, &run.simulation);
+                if run.comparison.is_none() && comparison_recorder.take().is_some() {
+                    rec.log("compare", &rerun::Clear::recursive()).ok();
+                }
+                if let Some(comparison) = &run.comparison {
+                    let second = comparison_recorder.get_or_insert_with(|| {
+                        Recorder::new(
+                            rec,
+                            "compare/",
+                            run.scene(),
+                            comparison,
+                            ArrowsMode::Selected,
+                            run.tet,
+                        )
+                    });
+                    second.set_tet(run.tet);
+                    second.log_frame_at(clock.frame, clock.time, comparison);
+                }
+            }
+            match &session {
+                Some(session) if session.interrupted() => ControlFlow::Break(()),
+                Some(session) => {
+                    session.advance();
+                    ControlFlow::Continue(())
+                }
+                None => ControlFlow::Continue(()),
+            }
+        });
+        if !run.simulation.is_sound() {
+            return Err(UsageError(format!(
+                "lesson {}: the simulation diverged in step {}",
+                lesson.source.display(),
+                k + 1
+            )));
+        }
+        let Some(outcome) = outcome else {
+            break;
+        };
+        if step.frames > 0 {
+            writeln!(out, "(ran {} frames)", step.frames).map_err(UsageError::stdout)?;
+        }
+        for (expectation, value, observed) in &outcome.checks {
+            all_observed &= observed;
+            let measured = match value {
+                Some(v) => format!("measured {v}"),
+                None => "no comparison is shown".to_owned(),
+            };
+            let verdict = if *observed {
+                "observed:"
+            } else {
+                "NOT OBSERVED:"
+            };
+            writeln!(out, "{verdict} {expectation} ({measured})").map_err(UsageError::stdout)?;
+        }
+    }
+    if let Some(session) = session
+        && let Ending::Interrupted = session.close(clock.frame, out)?
+    {
+        return Ok(Outcome::Interrupted);
+    }
+    Ok(if all_observed {
+        Outcome::Observed
+    } else {
+        Outcome::NotObserved
+    })
+}

@@ -1,0 +1,169 @@
+//! The lesson: a picker, the current step's text, what it expects (checked live against the
+//! metrics) and the buttons to do it and move on. The same contents serve the lesson window and
+//! classroom mode (larger).
+
+use eframe::egui;
+use tetlab_core::lesson::{BUILTIN, Lesson, Step};
+use tetlab_core::metrics::Metrics;
+
+/// A lesson in progress in the workbench.
+pub struct LessonState {
+    /// The lesson.
+    pub lesson: Lesson,
+    /// The step shown, from 0.
+    pub step: usize,
+    /// Frames the step still plays after "do it".
+    pub frames_left: u64,
+}
+
+impl LessonState {
+    /// The step shown.
+    pub fn current(&self) -> &Step {
+        &self.lesson.steps[self.step]
+    }
+}
+
+/// What the user asked of the lesson panel.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LessonRequest {
+    /// Open built-in lesson k (from 1).
+    Builtin(usize),
+    /// Open a lesson file.
+    File(String),
+    /// Do the step's actions and play its frames.
+    Do,
+    /// The next step.
+    Next,
+    /// The previous step.
+    Previous,
+}
+
+/// Shows the lesson picker and, when a lesson is open, its current step. `large` is classroom
+/// mode. `metrics` and `comparison` are the current metrics of the two simulations.
+pub fn show(
+    ui: &mut egui::Ui,
+    state: Option<&LessonState>,
+    path: &mut String,
+    large: bool,
+    metrics: &Metrics,
+    comparison: Option<&Metrics>,
+) -> Option<LessonRequest> {
+    let mut request = None;
+    let size = if large { 22.0 } else { 14.0 };
+    if !large || state.is_none() {
+        ui.horizontal_wrapped(|ui| {
+            ui.label("Lesson:");
+            for k in 1..=BUILTIN.len() {
+                let chosen = state.is_some_and(|s| {
+                    s.lesson.source.file_name().and_then(|n| n.to_str())
+                        == Some(BUILTIN[k - 1].file)
+                });
+                if ui
+                    .selectable_label(chosen, k.to_string())
+                    .on_hover_text(BUILTIN[k - 1].file)
+                    .clicked()
+                {
+                    request = Some(LessonRequest::Builtin(k));
+                }
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::TextEdit::singleline(path)
+                    .hint_text("your-lesson.toml")
+                    .desired_width(200.0),
+            )
+            .labelled_by(ui.label("lesson file").id);
+            if ui
+                .add_enabled(!path.trim().is_empty(), egui::Button::new("Open lesson"))
+                .clicked()
+            {
+                request = Some(LessonRequest::File(path.trim().to_owned()));
+            }
+        });
+    }
+    let Some(state) = state else {
+        ui.label("Pick a lesson, or drop a lesson file (.toml) on the window.");
+        return request;
+    };
+    let step = state.current();
+    ui.label(
+        egui::RichText::new(&state.lesson.title)
+            .size(size * 1.3)
+            .strong(),
+    );
+    ui.label(
+        egui::RichText::new(format!(
+            "step {} of {}",
+            state.step + 1,
+            state.lesson.steps.len()
+        ))
+        .size(size * 0.8),
+    );
+    ui.add_space(size * 0.4);
+    ui.label(egui::RichText::new(&step.text).size(size));
+    ui.add_space(size * 0.4);
+    for expectation in &step.expect {
+        let (mark, colour, measured) = match expectation.check(metrics, comparison) {
+            Some((value, true)) => ("[ok]", egui::Color32::from_rgb(60, 180, 90), value),
+            Some((value, false)) => ("[..]", egui::Color32::from_rgb(220, 160, 40), value),
+            None => ("[..]", egui::Color32::GRAY, f64::NAN),
+        };
+        let now = if measured.is_nan() {
+            "no comparison shown".to_owned()
+        } else {
+            format!("now {measured:.4}")
+        };
+        ui.label(
+            egui::RichText::new(format!("{mark} expect {expectation}   ({now})"))
+                .size(size * 0.9)
+                .color(colour)
+                .monospace(),
+        );
+    }
+    ui.add_space(size * 0.4);
+    ui.horizontal(|ui| {
+        let text = |t: &str| egui::RichText::new(t).size(size);
+        if ui
+            .add_enabled(state.step > 0, egui::Button::new(text("< Previous")))
+            .on_hover_text("Left arrow")
+            .clicked()
+        {
+            request = Some(LessonRequest::Previous);
+        }
+        let what = describe(step);
+        if ui
+            .add_enabled(!what.is_empty(), egui::Button::new(text("Do it")))
+            .on_hover_text(format!("Enter: {what}"))
+            .clicked()
+        {
+            request = Some(LessonRequest::Do);
+        }
+        if ui
+            .add_enabled(
+                state.step + 1 < state.lesson.steps.len(),
+                egui::Button::new(text("Next >")),
+            )
+            .on_hover_text("Right arrow")
+            .clicked()
+        {
+            request = Some(LessonRequest::Next);
+        }
+    });
+    if state.frames_left > 0 {
+        ui.label(
+            egui::RichText::new(format!("playing: {} frames to go", state.frames_left))
+                .size(size * 0.8),
+        );
+    }
+    request
+}
+
+/// "mirror, then 60 frames", or empty when the step does nothing by itself.
+fn describe(step: &Step) -> String {
+    let mut parts: Vec<String> = step.actions.iter().map(|a| format!("{a:?}")).collect();
+    if step.frames > 0 {
+        parts.push(format!("{} frames", step.frames));
+    }
+    parts.join(", ")
+}

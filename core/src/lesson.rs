@@ -1,0 +1,882 @@
+//! Lessons: a scene, solver settings and a sequence of steps, written as TOML files so that a
+//! teacher can make one without Rust. Each step has text, the actions that show its point, how
+//! many frames to run after them, and the observations it expects, which are checked against the
+//! metrics (live in the workbench, at the end of the step when run headless).
+//!
+//! ```toml
+//! title = "Why edges alone cannot un-invert a tet"
+//! scene = "tet"              # a built-in (tet, cube, beam, ball) or a mesh path, relative to the file
+//! resolution = 1             # optional, for built-ins
+//! tet = 0                    # optional: the tet whose arrows are shown
+//!
+//! [settings]                 # optional; the names of the command line
+//! constraints = "edges"
+//! gravity = 0
+//!
+//! [[step]]
+//! text = "Mirror the tet: every edge keeps its length."
+//! actions = ["mirror"]
+//! frames = 60
+//! expect = ["inverted_tets == 1", "max_edge_strain < 1e-6"]
+//! ```
+//!
+//! Actions: `reset`, `invert` (the lesson's tet, through its first corner), `invert:K`, `mirror`,
+//! `flatten`, `scramble:SEED`, `select:K`, `constraints:LIST`, `solver:xpbd|pbd`,
+//! `compliance:FAMILY=α`, `stiffness:FAMILY=k`, `substeps:N`, `iterations:N`, `gravity:G`,
+//! `compare:LIST` (show a second simulation of the same scene with other constraint families
+//! beside the first) and `compare:off`. Expectations: `METRIC OP NUMBER` with a metric of
+//! [`Metrics::headline`] (`compare.METRIC` for the comparison's) and OP one of `==`, `!=`, `<`,
+//! `<=`, `>`, `>=`.
+
+use crate::constraints::Family;
+use crate::metrics::Metrics;
+use crate::scene::{Perturbation, Scene, reflect_through_opposite_face};
+use crate::solver::{Method, PerFamily, Settings, Simulation};
+use std::collections::BTreeMap;
+use std::fmt;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// A lesson, parsed and checked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lesson {
+    /// Its title.
+    pub title: String,
+    /// The file it came from (or the name it was given).
+    pub source: PathBuf,
+    /// The scene: a built-in name or a mesh path (already resolved against the lesson's folder).
+    pub scene: String,
+    /// The resolution of a built-in scene.
+    pub resolution: u32,
+    /// The tet whose arrows are shown at the start.
+    pub tet: usize,
+    /// The solver settings at the start.
+    pub settings: Settings,
+    /// The steps, in order.
+    pub steps: Vec<Step>,
+}
+
+/// One step of a lesson.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    /// What the step explains and asks the reader to try.
+    pub text: String,
+    /// What the step does when run ("Do it" in the workbench, always when headless).
+    pub actions: Vec<Action>,
+    /// Frames to run after the actions.
+    pub frames: u64,
+    /// What should be observed after the actions and frames.
+    pub expect: Vec<Expectation>,
+}
+
+/// Something a lesson step does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Action {
+    /// Back to the rest shape.
+    Reset,
+    /// A perturbation of the whole body (mirror, flatten, scramble) or of tet 0 (invert).
+    Perturb(Perturbation),
+    /// Invert tet K by reflecting its first corner through the opposite face.
+    InvertTet(usize),
+    /// Select tet K (its arrows are shown).
+    Select(usize),
+    /// Set the active constraint families.
+    Constraints(PerFamily<bool>),
+    /// XPBD or PBD.
+    Solver(Method),
+    /// XPBD compliance of a family.
+    Compliance(Family, f64),
+    /// PBD stiffness of a family.
+    Stiffness(Family, f64),
+    /// Substeps per frame.
+    Substeps(u32),
+    /// Iterations per substep.
+    Iterations(u32),
+    /// Gravity (0 also turns the ground off).
+    Gravity(f64),
+    /// Show a second simulation beside the first with these constraint families (`None`: stop).
+    Compare(Option<PerFamily<bool>>),
+}
+
+/// A relation a step expects between a metric and a number.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expectation {
+    /// Whether the metric is the comparison simulation's (written `compare.METRIC`).
+    pub of_comparison: bool,
+    /// The metric's name, one of [`Metrics::headline`].
+    pub metric: String,
+    /// The comparison.
+    pub op: Op,
+    /// The number compared with.
+    pub value: f64,
+}
+
+/// A comparison.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// ==
+    Equal,
+    /// !=
+    NotEqual,
+    /// <
+    Less,
+    /// <=
+    LessOrEqual,
+    /// >
+    Greater,
+    /// >=
+    GreaterOrEqual,
+}
+
+impl Op {
+    const ALL: [(&'static str, Op); 6] = [
+        ("==", Op::Equal),
+        ("!=", Op::NotEqual),
+        ("<=", Op::LessOrEqual),
+        (">=", Op::GreaterOrEqual),
+        ("<", Op::Less),
+        (">", Op::Greater),
+    ];
+
+    fn symbol(self) -> &'static str {
+        Op::ALL
+            .iter()
+            .find(|(_, op)| *op == self)
+            .map(|(s, _)| *s)
+            .expect("every op has a symbol")
+    }
+
+    /// Whether `a OP b`.
+    pub fn holds(self, a: f64, b: f64) -> bool {
+        match self {
+            Op::Equal => a == b,
+            Op::NotEqual => a != b,
+            Op::Less => a < b,
+            Op::LessOrEqual => a <= b,
+            Op::Greater => a > b,
+            Op::GreaterOrEqual => a >= b,
+        }
+    }
+}
+
+impl Expectation {
+    /// The metric's current value, and whether the expectation holds for it; `None` when it is
+    /// about the comparison and there is none.
+    pub fn check(&self, metrics: &Metrics, comparison: Option<&Metrics>) -> Option<(f64, bool)> {
+        let metrics = if self.of_comparison {
+            comparison?
+        } else {
+            metrics
+        };
+        let value = metrics
+            .headline()
+            .into_iter()
+            .find(|(name, _)| *name == self.metric)
+            .map(|(_, v)| v)
+            .expect("the metric name was checked when the lesson was read");
+        Some((value, self.op.holds(value, self.value)))
+    }
+
+    fn parse(text: &str) -> Result<Expectation, String> {
+        let (symbol, op, at) = Op::ALL
+            .iter()
+            .find_map(|&(symbol, op)| text.find(symbol).map(|at| (symbol, op, at)))
+            .ok_or_else(|| format!("'{text}' is not METRIC OP NUMBER (e.g. inverted_tets == 0)"))?;
+        let metric = text[..at].trim();
+        let (of_comparison, metric) = match metric.strip_prefix("compare.") {
+            Some(metric) => (true, metric),
+            None => (false, metric),
+        };
+        let number = text[at + symbol.len()..].trim();
+        let names = Metrics::default().headline().map(|(name, _)| name);
+        if !names.contains(&metric) {
+            return Err(format!(
+                "'{metric}' is not a metric: expected one of {}",
+                names.join(", ")
+            ));
+        }
+        let value = finite(number)?;
+        Ok(Expectation {
+            of_comparison,
+            metric: metric.to_owned(),
+            op,
+            value,
+        })
+    }
+}
+
+impl fmt::Display for Expectation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let prefix = if self.of_comparison { "compare." } else { "" };
+        let v = self.value;
+        let number = if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+            format!("{v:e}")
+        } else {
+            v.to_string()
+        };
+        write!(f, "{prefix}{} {} {number}", self.metric, self.op.symbol())
+    }
+}
+
+impl Action {
+    fn parse(text: &str) -> Result<Action, String> {
+        let (name, argument) = match text.split_once(':') {
+            Some((name, argument)) => (name.trim(), Some(argument.trim())),
+            None => (text.trim(), None),
+        };
+        let need =
+            |what: &str| argument.ok_or_else(|| format!("'{text}' needs a value: {name}:{what}"));
+        let whole = |what: &str| -> Result<u64, String> {
+            let argument = need(what)?;
+            argument
+                .parse()
+                .map_err(|_| format!("'{argument}' is not a whole number in '{text}'"))
+        };
+        let family_value = |what: &str| -> Result<(Family, f64), String> {
+            let argument = need(what)?;
+            let (family, value) = argument
+                .split_once('=')
+                .ok_or_else(|| format!("'{text}' is not {name}:FAMILY=VALUE"))?;
+            Ok((Family::parse(family)?, finite(value)?))
+        };
+        let action = match name {
+            "reset" => Action::Reset,
+            "invert" => match argument {
+                None => Action::Perturb(Perturbation::Invert),
+                Some(_) => Action::InvertTet(whole("K")? as usize),
+            },
+            "mirror" | "flatten" | "scramble" => Action::Perturb(Perturbation::parse(text.trim())?),
+            "select" => Action::Select(whole("K")? as usize),
+            "constraints" => Action::Constraints(PerFamily::parse_list(need("LIST")?)?),
+            "solver" => Action::Solver(Method::parse(need("xpbd|pbd")?)?),
+            "compliance" => {
+                let (family, alpha) = family_value("FAMILY=α")?;
+                if alpha < 0.0 {
+                    return Err(format!("compliance {alpha} is negative in '{text}'"));
+                }
+                Action::Compliance(family, alpha)
+            }
+            "stiffness" => {
+                let (family, k) = family_value("FAMILY=k")?;
+                if !(0.0..=1.0).contains(&k) {
+                    return Err(format!("stiffness {k} is outside 0..=1 in '{text}'"));
+                }
+                Action::Stiffness(family, k)
+            }
+            "substeps" | "iterations" => {
+                let n = whole("N")?;
+                if !(1..=1000).contains(&n) {
+                    return Err(format!("{n} is outside 1..=1000 in '{text}'"));
+                }
+                if name == "substeps" {
+                    Action::Substeps(n as u32)
+                } else {
+                    Action::Iterations(n as u32)
+                }
+            }
+            "gravity" => Action::Gravity(finite(need("G")?)?),
+            "compare" => match need("LIST|off")? {
+                "off" => Action::Compare(None),
+                list => Action::Compare(Some(PerFamily::parse_list(list)?)),
+            },
+            _ => {
+                return Err(format!(
+                    "'{text}' is not an action: expected reset, invert, invert:K, mirror, \
+                     flatten, scramble:SEED, select:K, constraints:LIST, solver:NAME, \
+                     compliance:FAMILY=α, stiffness:FAMILY=k, substeps:N, iterations:N, \
+                     gravity:G or compare:LIST|off"
+                ));
+            }
+        };
+        Ok(action)
+    }
+
+    /// Applies the action to `simulation`. [`Action::Select`] sets `selected_tet`;
+    /// [`Action::Compare`] is for the front end and changes nothing here.
+    pub fn apply(self, simulation: &mut Simulation, selected_tet: &mut usize) {
+        let mut settings = *simulation.settings();
+        match self {
+            Action::Reset => simulation.reset(),
+            Action::Perturb(perturbation) => simulation.perturb(perturbation),
+            Action::InvertTet(tet) => {
+                let corners = simulation.tets()[tet];
+                let mut positions = simulation.positions().to_vec();
+                reflect_through_opposite_face(&mut positions, &corners, 0);
+                simulation.place(corners[0] as usize, positions[corners[0] as usize]);
+            }
+            Action::Select(tet) => *selected_tet = tet,
+            Action::Constraints(active) => settings.active = active,
+            Action::Solver(method) => settings.method = method,
+            Action::Compliance(family, alpha) => settings.compliance.set(family, alpha),
+            Action::Stiffness(family, k) => settings.stiffness.set(family, k),
+            Action::Substeps(n) => settings.substeps = n,
+            Action::Iterations(n) => settings.iterations = n,
+            Action::Gravity(g) => {
+                settings.gravity = g;
+                settings.ground = g != 0.0;
+            }
+            Action::Compare(_) => {}
+        }
+        simulation.set_settings(settings);
+    }
+
+    /// The tet this action refers to, if any (to check it against the scene).
+    fn tet(self) -> Option<usize> {
+        match self {
+            Action::InvertTet(tet) | Action::Select(tet) => Some(tet),
+            _ => None,
+        }
+    }
+}
+
+/// Why a lesson could not be read: the file, the line, and what is wrong there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LessonError {
+    /// The lesson file.
+    pub path: PathBuf,
+    /// The line (from 1), when the problem has one.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for LessonError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{line}: {}", self.path.display(), self.message),
+            None => write!(f, "{}: {}", self.path.display(), self.message),
+        }
+    }
+}
+
+impl std::error::Error for LessonError {}
+
+/// The file as written.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLesson {
+    title: String,
+    scene: Spanned<String>,
+    #[serde(default = "one")]
+    resolution: u32,
+    tet: Option<Spanned<usize>>,
+    #[serde(default)]
+    settings: RawSettings,
+    #[serde(default)]
+    step: Vec<RawStep>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+#[derive(serde::Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSettings {
+    constraints: Option<Spanned<String>>,
+    solver: Option<Spanned<String>>,
+    substeps: Option<u32>,
+    iterations: Option<u32>,
+    dt: Option<f64>,
+    gravity: Option<f64>,
+    damping: Option<f64>,
+    settle_edits: Option<bool>,
+    #[serde(default)]
+    compliance: BTreeMap<String, Spanned<f64>>,
+    #[serde(default)]
+    stiffness: BTreeMap<String, Spanned<f64>>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStep {
+    text: String,
+    #[serde(default)]
+    actions: Vec<Spanned<String>>,
+    frames: Option<Spanned<u64>>,
+    #[serde(default)]
+    expect: Vec<Spanned<String>>,
+}
+
+/// A lesson that comes with tetlab: a file of `assets/lessons`, built into the library.
+#[derive(Clone, Copy, Debug)]
+pub struct BuiltinLesson {
+    /// Its file name, e.g. `01-distance.toml`.
+    pub file: &'static str,
+    /// Where the file was when tetlab was built (mesh scenes are found relative to it).
+    pub path: &'static str,
+    /// The file's text.
+    pub text: &'static str,
+}
+
+include!(concat!(env!("OUT_DIR"), "/lessons.rs"));
+
+/// The most frames one step may run.
+pub const MAX_STEP_FRAMES: u64 = 100_000;
+
+impl Lesson {
+    /// Built-in lesson `number` (from 1), or a lesson file: what `tetlab lesson N|FILE` reads.
+    pub fn find(spec: &str) -> Result<Lesson, LessonError> {
+        match spec.parse::<usize>() {
+            Ok(number) => Lesson::builtin(number),
+            Err(_) => Lesson::load(Path::new(spec)),
+        }
+    }
+
+    /// Built-in lesson `number`, from 1 ([`BUILTIN`]).
+    pub fn builtin(number: usize) -> Result<Lesson, LessonError> {
+        let builtin = number
+            .checked_sub(1)
+            .and_then(|k| BUILTIN.get(k))
+            .ok_or_else(|| LessonError {
+                path: PathBuf::from(format!("lesson {number}")),
+                line: None,
+                message: format!(
+                    "no such lesson: the built-in lessons are 1..={}",
+                    BUILTIN.len()
+                ),
+            })?;
+        Lesson::parse(Path::new(builtin.path), builtin.text)
+    }
+
+    /// Reads a lesson file; a mesh scene path is taken relative to the file's folder.
+    pub fn load(path: &Path) -> Result<Lesson, LessonError> {
+        let text = std::fs::read_to_string(path).map_err(|e| LessonError {
+            path: path.to_owned(),
+            line: None,
+            message: format!("cannot read: {e}"),
+        })?;
+        Lesson::parse(path, &text)
+    }
+
+    /// Parses lesson `text` that came from `path` (used for messages and relative scene paths).
+    pub fn parse(path: &Path, text: &str) -> Result<Lesson, LessonError> {
+        let error = |span: Option<std::ops::Range<usize>>, message: String| LessonError {
+            path: path.to_owned(),
+            line: span.map(|s| line_of(text, s.start)),
+            message,
+        };
+        let raw: RawLesson =
+            toml::from_str(text).map_err(|e| error(e.span(), e.message().trim().to_owned()))?;
+        let at = |span: std::ops::Range<usize>| move |message: String| error(Some(span), message);
+
+        let mut settings = Settings::default();
+        let s = &raw.settings;
+        if let Some(list) = &s.constraints {
+            settings.active = PerFamily::parse_list(list.get_ref()).map_err(at(list.span()))?;
+        }
+        if let Some(solver) = &s.solver {
+            settings.method = Method::parse(solver.get_ref()).map_err(at(solver.span()))?;
+        }
+        let range = |name: &str, value: Option<u32>| -> Result<Option<u32>, LessonError> {
+            match value {
+                Some(n) if !(1..=1000).contains(&n) => Err(error(
+                    None,
+                    format!("settings.{name} = {n} is outside 1..=1000"),
+                )),
+                other => Ok(other),
+            }
+        };
+        settings.substeps = range("substeps", s.substeps)?.unwrap_or(settings.substeps);
+        settings.iterations = range("iterations", s.iterations)?.unwrap_or(settings.iterations);
+        if let Some(dt) = s.dt {
+            if !(dt > 0.0 && dt <= 1.0) {
+                return Err(error(
+                    None,
+                    format!("settings.dt = {dt} is outside 0 < dt <= 1"),
+                ));
+            }
+            settings.dt = dt;
+        }
+        if let Some(g) = s.gravity {
+            if !g.is_finite() {
+                return Err(error(None, format!("settings.gravity = {g} is not finite")));
+            }
+            settings.gravity = g;
+            settings.ground = g != 0.0;
+        }
+        if let Some(damping) = s.damping {
+            if !(damping >= 0.0 && damping.is_finite()) {
+                return Err(error(
+                    None,
+                    format!("settings.damping = {damping} is negative"),
+                ));
+            }
+            settings.damping = damping;
+        }
+        settings.settle_edits = s.settle_edits.unwrap_or(settings.settle_edits);
+        for (name, value) in &s.compliance {
+            let family = Family::parse(name).map_err(at(value.span()))?;
+            let alpha = *value.get_ref();
+            if !(alpha >= 0.0 && alpha.is_finite()) {
+                return Err(error(
+                    Some(value.span()),
+                    format!("compliance {alpha} is negative"),
+                ));
+            }
+            settings.compliance.set(family, alpha);
+        }
+        for (name, value) in &s.stiffness {
+            let family = Family::parse(name).map_err(at(value.span()))?;
+            let k = *value.get_ref();
+            if !(0.0..=1.0).contains(&k) {
+                return Err(error(
+                    Some(value.span()),
+                    format!("stiffness {k} is outside 0..=1"),
+                ));
+            }
+            settings.stiffness.set(family, k);
+        }
+
+        let scene = resolve_scene(path, raw.scene.get_ref());
+        let mesh = Scene::from_spec(&scene, raw.resolution).map_err(|e| {
+            error(
+                Some(raw.scene.span()),
+                format!("scene '{}': {e}", raw.scene.get_ref()),
+            )
+        })?;
+        let tets = mesh.mesh.tets.len();
+        let check_tet = |tet: usize, span| {
+            if tet < tets {
+                Ok(())
+            } else {
+                Err(error(
+                    Some(span),
+                    format!(
+                        "tet {tet} is out of range: the scene has tets 0..={}",
+                        tets - 1
+                    ),
+                ))
+            }
+        };
+        let tet = match &raw.tet {
+            Some(tet) => {
+                check_tet(*tet.get_ref(), tet.span())?;
+                *tet.get_ref()
+            }
+            None => 0,
+        };
+
+        if raw.step.is_empty() {
+            return Err(error(None, "a lesson needs at least one [[step]]".into()));
+        }
+        let mut steps = Vec::new();
+        for step in &raw.step {
+            let mut actions = Vec::new();
+            for action in &step.actions {
+                let parsed = Action::parse(action.get_ref()).map_err(at(action.span()))?;
+                if let Some(tet) = parsed.tet() {
+                    check_tet(tet, action.span())?;
+                }
+                actions.push(parsed);
+            }
+            let frames = step.frames.as_ref().map_or(0, |f| *f.get_ref());
+            if frames > MAX_STEP_FRAMES {
+                return Err(error(
+                    step.frames.as_ref().map(|f| f.span()),
+                    format!("frames = {frames} is more than {MAX_STEP_FRAMES}"),
+                ));
+            }
+            let expect = step
+                .expect
+                .iter()
+                .map(|e| Expectation::parse(e.get_ref()).map_err(at(e.span())))
+                .collect::<Result<Vec<_>, _>>()?;
+            steps.push(Step {
+                text: reflow(&step.text),
+                actions,
+                frames,
+                expect,
+            });
+        }
+        Ok(Lesson {
+            title: raw.title,
+            source: path.to_owned(),
+            scene,
+            resolution: raw.resolution,
+            tet,
+            settings,
+            steps,
+        })
+    }
+
+    /// The lesson's scene.
+    pub fn scene(&self) -> Scene {
+        Scene::from_spec(&self.scene, self.resolution).expect("checked when the lesson was read")
+    }
+}
+
+/// A built-in name as it is; a mesh path relative to the lesson's folder.
+fn resolve_scene(lesson: &Path, scene: &str) -> String {
+    if crate::scene::Builtin::from_name(scene).is_some() || Path::new(scene).is_absolute() {
+        return scene.to_owned();
+    }
+    match lesson.parent() {
+        Some(folder) if !folder.as_os_str().is_empty() => {
+            folder.join(scene).to_string_lossy().into_owned()
+        }
+        _ => scene.to_owned(),
+    }
+}
+
+/// Paragraphs as written (separated by blank lines), each joined into one line, so that the
+/// front end wraps them to its own width.
+fn reflow(text: &str) -> String {
+    text.trim()
+        .split("\n\n")
+        .map(|paragraph| paragraph.split_whitespace().collect::<Vec<_>>().join(" "))
+        .filter(|paragraph| !paragraph.is_empty())
+        .collect::<Vec<_>>()
+        .join("\n\n")
+}
+
+/// The line (from 1) of byte offset `at`.
+fn line_of(text: &str, at: usize) -> usize {
+    text[..at.min(text.len())].matches('\n').count() + 1
+}
+
+fn finite(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{}' is not a number", text.trim()))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("'{}' is not a finite number", text.trim()))
+    }
+}
+
+/// One step's outcome when a lesson runs headless.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepOutcome {
+    /// Each expectation with the metric's value at the end of the step (`None`: about a
+    /// comparison that is not shown) and whether it held.
+    pub checks: Vec<(Expectation, Option<f64>, bool)>,
+}
+
+/// A lesson running headless: the simulation, the selected tet, and the comparison simulation
+/// when a step asked for one.
+pub struct LessonRun {
+    /// The lesson's simulation.
+    pub simulation: Simulation,
+    /// The second simulation, with other constraint families, while a step compares.
+    pub comparison: Option<Simulation>,
+    /// The selected tet.
+    pub tet: usize,
+    scene: Scene,
+}
+
+impl LessonRun {
+    /// The lesson's scene at rest with its settings.
+    pub fn new(lesson: &Lesson) -> LessonRun {
+        let scene = lesson.scene();
+        LessonRun {
+            simulation: Simulation::new(&scene, lesson.settings),
+            comparison: None,
+            tet: lesson.tet,
+            scene,
+        }
+    }
+
+    /// Applies one action to the simulation and to the comparison.
+    pub fn apply(&mut self, action: Action) {
+        if let Action::Compare(families) = action {
+            self.comparison = families.map(|active| {
+                let mut comparison = self.simulation.clone();
+                let settings = Settings {
+                    active,
+                    ..*self.simulation.settings()
+                };
+                comparison.set_settings(settings);
+                comparison
+            });
+            return;
+        }
+        let mut ignored = self.tet;
+        action.apply(&mut self.simulation, &mut self.tet);
+        if let Some(comparison) = &mut self.comparison {
+            let active = comparison.settings().active;
+            action.apply(comparison, &mut ignored);
+            let settings = Settings {
+                active,
+                ..*comparison.settings()
+            };
+            comparison.set_settings(settings);
+        }
+    }
+
+    /// Advances both simulations one frame.
+    pub fn step(&mut self) {
+        self.simulation.step();
+        if let Some(comparison) = &mut self.comparison {
+            comparison.step();
+        }
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Runs a whole step: actions, frames (calling `on_frame` after each; it may stop the step
+    /// early by returning [`ControlFlow::Break`]), then the checks. `None` when stopped early.
+    pub fn run_step(
+        &mut self,
+        step: &Step,
+        mut on_frame: impl FnMut(&LessonRun) -> ControlFlow<()>,
+    ) -> Option<StepOutcome> {
+        for &action in &step.actions {
+            self.apply(action);
+        }
+        for _ in 0..step.frames {
+            self.step();
+            if on_frame(self).is_break() {
+                return None;
+            }
+        }
+        Some(self.check(step))
+    }
+
+    /// The step's expectations against the current state.
+    pub fn check(&self, step: &Step) -> StepOutcome {
+        let metrics = Metrics::measure(&self.simulation);
+        let comparison = self.comparison.as_ref().map(Metrics::measure);
+        StepOutcome {
+            checks: step
+                .expect
+                .iter()
+                .map(|e| match e.check(&metrics, comparison.as_ref()) {
+                    Some((value, holds)) => (e.clone(), Some(value), holds),
+                    None => (e.clone(), None, false),
+                })
+                .collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Lesson, LessonError> {
+        Lesson::parse(Path::new("lessons/x.toml"), text)
+    }
+
+    #[test]
+    fn a_small_lesson_reads_and_runs() {
+        let lesson = parse(
+            r#"
+title = "mirror"
+scene = "tet"
+[settings]
+constraints = "edges"
+gravity = 0
+[[step]]
+text = "mirror it"
+actions = ["mirror"]
+frames = 30
+expect = ["inverted_tets == 1", "max_edge_strain < 1e-9"]
+"#,
+        )
+        .unwrap();
+        assert_eq!(
+            lesson.settings.active,
+            PerFamily::parse_list("edges").unwrap()
+        );
+        assert!(!lesson.settings.ground);
+        let mut run = LessonRun::new(&lesson);
+        let outcome = run
+            .run_step(&lesson.steps[0], |_| ControlFlow::Continue(()))
+            .unwrap();
+        assert!(
+            outcome.checks.iter().all(|(_, _, holds)| *holds),
+            "{outcome:?}"
+        );
+        assert_eq!(run.simulation.frame(), 30);
+    }
+
+    #[test]
+    fn mistakes_name_the_file_and_line() {
+        let cases = [
+            ("title = 1\nscene = \"tet\"\n", 1, "invalid type"),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[[step]]\ntext = \"x\"\nactions = [\"mirror\", \"twirl\"]\n",
+                5,
+                "'twirl' is not an action",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[[step]]\ntext = \"x\"\n\nexpect = [\"speed > 1\"]\n",
+                6,
+                "'speed' is not a metric",
+            ),
+            (
+                "title = \"t\"\nscene = \"nowhere.node\"\n[[step]]\ntext = \"x\"\n",
+                2,
+                "scene 'nowhere.node'",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[settings]\nconstraints = \"edges,glue\"\n[[step]]\ntext = \"x\"\n",
+                4,
+                "'glue' is not a constraint family",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[[step]]\ntext = \"x\"\nactions = [\"select:4\"]\n",
+                5,
+                "tet 4 is out of range",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\ncolour = \"red\"\n",
+                3,
+                "unknown field",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n",
+                0,
+                "at least one [[step]]",
+            ),
+        ];
+        for (text, line, message) in cases {
+            let error = parse(text).unwrap_err();
+            assert_eq!(error.line.unwrap_or(0), line, "{error}");
+            assert!(error.to_string().contains(message), "{error}");
+            assert!(error.to_string().starts_with("lessons/x.toml:"), "{error}");
+        }
+    }
+
+    #[test]
+    fn paragraphs_are_reflowed_into_lines() {
+        assert_eq!(reflow("\n one\ntwo  \n\n\nthree\n"), "one two\n\nthree");
+    }
+
+    #[test]
+    fn a_mesh_scene_is_found_next_to_the_lesson() {
+        assert_eq!(
+            resolve_scene(Path::new("assets/lessons/6.toml"), "../meshes/a.node"),
+            "assets/lessons/../meshes/a.node"
+        );
+        assert_eq!(
+            resolve_scene(Path::new("assets/lessons/6.toml"), "cube"),
+            "cube"
+        );
+    }
+
+    #[test]
+    fn the_comparison_gets_the_same_edits_and_keeps_its_families() {
+        let lesson = parse(
+            "title = \"t\"\nscene = \"cube\"\n[settings]\nconstraints = \"edges\"\n[[step]]\ntext = \"x\"\n",
+        )
+        .unwrap();
+        let mut run = LessonRun::new(&lesson);
+        run.apply(Action::Compare(Some(PerFamily::splat(true))));
+        run.apply(Action::Perturb(Perturbation::Mirror));
+        run.apply(Action::Substeps(3));
+        let comparison = run.comparison.as_ref().unwrap();
+        assert_eq!(comparison.positions(), run.simulation.positions());
+        assert_eq!(comparison.settings().active, PerFamily::splat(true));
+        assert_eq!(comparison.settings().substeps, 3);
+        run.apply(Action::Compare(None));
+        assert!(run.comparison.is_none());
+    }
+}
