@@ -25,6 +25,11 @@ pub fn show(ctx: &egui::Context, open: &mut bool) {
                     ("wheel", "zoom"),
                     ("click a particle", "select it and its tet"),
                     ("drop a .msh/.node/.ele file", "load it"),
+                    ("drop a lesson .toml file", "open the lesson"),
+                    (
+                        "two views (comparing)",
+                        "keys act on both; a drag moves particles in its own view",
+                    ),
                 ] {
                     ui.monospace(gesture);
                     ui.label(what);
