@@ -43,8 +43,14 @@ fn a_teachers_lesson_runs_and_a_wrong_expectation_fails_the_run() {
     let output = tetlab(&["lesson", path.to_str().unwrap()]);
     assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
     let text = stdout(&output);
-    assert!(text.contains("observed: inverted_tets == 48 (measured 48)"), "{text}");
-    assert!(text.contains("NOT OBSERVED: inverted_tets == 0 (measured 48)"), "{text}");
+    assert!(
+        text.contains("observed: inverted_tets == 48 (measured 48)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("NOT OBSERVED: inverted_tets == 0 (measured 48)"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -59,7 +65,10 @@ fn mistakes_in_a_lesson_file_name_the_file_and_line() {
     let line = assert_usage_error(&tetlab(&["lesson", path.to_str().unwrap()]), "typo.toml:5:");
     assert!(line.contains("'mirorr' is not an action"), "{line}");
     assert_usage_error(&tetlab(&["lesson", "7"]), "no such lesson");
-    assert_usage_error(&tetlab(&["lesson", "/nonexistent.toml"]), "/nonexistent.toml");
+    assert_usage_error(
+        &tetlab(&["lesson", "/nonexistent.toml"]),
+        "/nonexistent.toml",
+    );
     assert_usage_error(&tetlab(&["lesson"]), "<N|FILE>");
 }
 
@@ -67,13 +76,7 @@ fn mistakes_in_a_lesson_file_name_the_file_and_line() {
 fn a_recorded_lesson_holds_its_frames_its_text_and_the_comparison() {
     let dir = scratch("record");
     let path = dir.join("lesson2.rrd");
-    let output = tetlab(&[
-        "lesson",
-        "2",
-        "--record",
-        path.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let output = tetlab(&["lesson", "2", "--record", path.to_str().unwrap(), "--quiet"]);
     assert!(output.status.success(), "{}", stderr(&output));
     let output = tetlab(&["inspect", path.to_str().unwrap(), "--json"]);
     assert!(output.status.success(), "{}", stderr(&output));

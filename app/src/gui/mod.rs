@@ -362,7 +362,9 @@ impl TetlabApp {
                 (right, &mut comparison.bench, &mut comparison.viewport),
             ] {
                 let families = bench.simulation.settings().active.describe();
-                ui.label(egui::RichText::new(families).size(size).strong());
+                ui.add(
+                    egui::Label::new(egui::RichText::new(families).size(size).strong()).truncate(),
+                );
                 viewport.show(ui, bench, &self.cache, &view);
             }
         });
@@ -472,23 +474,32 @@ impl eframe::App for TetlabApp {
                         }
                     });
                 });
-            let mut open = self.show_lesson;
-            egui::Window::new("Lesson")
-                .open(&mut open)
-                .default_pos([330.0, 500.0])
-                .default_size([620.0, 280.0])
-                .vscroll(true)
-                .show(&ctx, |ui| {
-                    lesson_request = panels::lesson::show(
-                        ui,
-                        self.lesson.as_ref(),
-                        &mut self.lesson_path,
-                        false,
-                        &metrics,
-                        comparison_metrics.as_ref(),
-                    );
-                });
-            self.show_lesson = open;
+            if self.show_lesson {
+                egui::Panel::bottom("lesson")
+                    .resizable(true)
+                    .default_size(250.0)
+                    .min_size(120.0)
+                    .show(ui, |ui| {
+                        egui::ScrollArea::vertical()
+                            .auto_shrink([false, false])
+                            .show(ui, |ui| {
+                                ui.horizontal(|ui| {
+                                    ui.heading("Lesson");
+                                    if ui.button("Close (L)").clicked() {
+                                        actions.push(Action::Lesson);
+                                    }
+                                });
+                                lesson_request = panels::lesson::show(
+                                    ui,
+                                    self.lesson.as_ref(),
+                                    &mut self.lesson_path,
+                                    false,
+                                    &metrics,
+                                    comparison_metrics.as_ref(),
+                                );
+                            });
+                    });
+            }
         }
         egui::CentralPanel::default_margins().show(ui, |ui| self.views(ui));
         panels::help::show(&ctx, &mut self.show_help);
