@@ -276,16 +276,25 @@ pub fn projection_arrows(
     }
     scale_to_longest(&mut out[first..], gain * GRADIENT_ARROW_LENGTH * size);
     for (&particle, &delta) in particles.iter().zip(&projection.delta_x) {
-        if delta != DVec3::ZERO {
-            out.push(Arrow {
-                quantity: Quantity::Correction,
-                particle,
-                origin: positions[particle as usize],
-                value: delta,
-                vector: delta * correction_gain,
-            });
-        }
+        out.extend(correction_arrow(
+            positions,
+            particle,
+            delta,
+            correction_gain,
+        ));
     }
+}
+
+/// The arrow of a displacement `delta` at `particle`, `gain` times its true length; none for a
+/// zero displacement.
+fn correction_arrow(positions: &[DVec3], particle: u32, delta: DVec3, gain: f64) -> Option<Arrow> {
+    (delta != DVec3::ZERO).then(|| Arrow {
+        quantity: Quantity::Correction,
+        particle,
+        origin: positions[particle as usize],
+        value: delta,
+        vector: delta * gain,
+    })
 }
 
 /// The correction arrows of `particles`: Δp of the last substep at each, drawn `gain` times its
@@ -300,16 +309,8 @@ pub fn correction_arrows(
     let positions = simulation.positions();
     let corrections = simulation.corrections();
     for particle in particles {
-        let correction = corrections[particle as usize];
-        if correction != DVec3::ZERO {
-            out.push(Arrow {
-                quantity: Quantity::Correction,
-                particle,
-                origin: positions[particle as usize],
-                value: correction,
-                vector: correction * gain,
-            });
-        }
+        let delta = corrections[particle as usize];
+        out.extend(correction_arrow(positions, particle, delta, gain));
     }
 }
 
