@@ -10,8 +10,10 @@
 //! - [`solver`]: the XPBD/PBD simulation; [`stepper`]: the same, one projection at a time.
 
 pub mod constraints;
+pub mod fast;
 pub mod finite_difference;
 pub mod inspector;
+mod integrate;
 pub mod lesson;
 pub mod mesh;
 pub mod metrics;

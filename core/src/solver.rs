@@ -26,8 +26,10 @@
 //! nothing, and the same inputs give the same bits.
 
 use crate::constraints::{Evaluation, Family, distance, plane, volume};
+use crate::integrate;
 use crate::mesh::{TET_EDGES, TetMesh};
 use crate::scene::Scene;
+use crate::vector::{Real, Vector3};
 use glam::DVec3;
 
 /// XPBD or PBD.
@@ -237,36 +239,47 @@ impl<const N: usize> ConstraintSet<N> {
 
 /// The change one projection makes: Δλ (XPBD; the scaled step s for PBD) and Δx per particle.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Correction<const N: usize> {
-    /// The evaluation the correction was computed from.
-    pub evaluation: Evaluation<DVec3, N>,
+pub struct Correction<const N: usize, V: Vector3 = DVec3> {
     /// XPBD: Δλ. PBD: k′ s.
-    pub delta_lambda: f64,
+    pub delta_lambda: V::Real,
     /// Δx for each particle of the constraint.
-    pub delta_x: [DVec3; N],
+    pub delta_x: [V; N],
 }
 
-/// How a correction is scaled.
+/// How a correction is scaled: XPBD with α̃ = α / h², or PBD with the per-iteration stiffness k′.
 #[derive(Clone, Copy, Debug)]
-enum Rule {
-    Xpbd { alpha_tilde: f64 },
-    Pbd { k: f64 },
+pub(crate) enum Rule<R> {
+    Xpbd { alpha_tilde: R },
+    Pbd { k: R },
+}
+
+impl Rule<f64> {
+    /// The same rule in another precision.
+    pub(crate) fn to<R: Real>(self) -> Rule<R> {
+        match self {
+            Rule::Xpbd { alpha_tilde } => Rule::Xpbd {
+                alpha_tilde: R::from_f64(alpha_tilde),
+            },
+            Rule::Pbd { k } => Rule::Pbd { k: R::from_f64(k) },
+        }
+    }
 }
 
 /// The correction that projecting one constraint would make, or `None` when it is skipped
-/// (degenerate, or every particle pinned).
+/// (degenerate, or every particle pinned). In any precision: the f64 path and the fast f32 path
+/// share it.
 #[inline]
-fn correction<const N: usize>(
-    evaluation: Evaluation<DVec3, N>,
-    weights: [f64; N],
-    lambda: f64,
-    rule: Rule,
-) -> Option<Correction<N>> {
+pub(crate) fn correction<V: Vector3, const N: usize>(
+    evaluation: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: V::Real,
+    rule: Rule<V::Real>,
+) -> Option<Correction<N, V>> {
     if evaluation.degenerate {
         return None;
     }
     let weighted_norm = weighted_norm(&weights, &evaluation.gradients);
-    if weighted_norm <= 0.0 || !weighted_norm.is_finite() {
+    if weighted_norm <= V::Real::ZERO || !weighted_norm.is_finite() {
         return None;
     }
     let delta_lambda = match rule {
@@ -275,25 +288,43 @@ fn correction<const N: usize>(
         }
         Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
     };
-    let mut delta_x = [DVec3::ZERO; N];
+    let mut delta_x = [V::ZERO; N];
     for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
         *dx = *g * (w * delta_lambda);
     }
     Some(Correction {
-        evaluation,
         delta_lambda,
         delta_x,
     })
 }
 
+/// One rigid XPBD projection of a constraint at `points` with rest value `rest` and inverse
+/// masses `weights`, starting from λ = 0: Δx per particle (zero when skipped). The kernel the
+/// solvers run per constraint, for benchmarks (`core/benches/kernels.rs`).
+pub fn project_kernel<V: Vector3, const N: usize>(
+    evaluate: impl Fn(&[V; N], V::Real) -> Evaluation<V, N>,
+    points: &[V; N],
+    rest: V::Real,
+    weights: [V::Real; N],
+) -> [V; N] {
+    let rule = Rule::Xpbd {
+        alpha_tilde: V::Real::ZERO,
+    };
+    correction(evaluate(points, rest), weights, V::Real::ZERO, rule)
+        .map_or([V::ZERO; N], |c| c.delta_x)
+}
+
 /// Σ wᵢ |∇ₚᵢC|², the denominator of every projection.
 #[inline]
-fn weighted_norm<const N: usize>(weights: &[f64; N], gradients: &[DVec3; N]) -> f64 {
-    weights
-        .iter()
-        .zip(gradients)
-        .map(|(w, g)| w * g.length_squared())
-        .sum()
+fn weighted_norm<V: Vector3, const N: usize>(
+    weights: &[V::Real; N],
+    gradients: &[V; N],
+) -> V::Real {
+    let mut sum = V::Real::ZERO;
+    for (w, g) in weights.iter().zip(gradients) {
+        sum += *w * g.length_squared();
+    }
+    sum
 }
 
 /// A particle held by the user.
@@ -462,6 +493,28 @@ impl Simulation {
             .all(|v| v.abs().max_element() < SOUND_LIMIT)
     }
 
+    /// The bytes of memory the simulation's arrays take (their capacities).
+    pub fn heap_bytes(&self) -> usize {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * size_of::<T>()
+        }
+        fn set<const N: usize>(s: &ConstraintSet<N>) -> usize {
+            bytes(&s.particles) + bytes(&s.rest) + bytes(&s.lambda)
+        }
+        bytes(&self.rest_positions)
+            + bytes(&self.positions)
+            + bytes(&self.previous)
+            + bytes(&self.velocities)
+            + bytes(&self.inverse_masses)
+            + bytes(&self.pinned)
+            + bytes(&self.lumped_inverse_masses)
+            + bytes(&self.tets)
+            + bytes(&self.corrections)
+            + set(&self.edges)
+            + set(&self.planes)
+            + set(&self.volumes)
+    }
+
     /// Whether particle `i` is pinned.
     pub fn is_pinned(&self, i: usize) -> bool {
         self.pinned[i]
@@ -482,6 +535,12 @@ impl Simulation {
         perturbation.apply(&mut self.positions, &mesh);
         self.stop();
         self.settling = Some(0);
+    }
+
+    /// Puts every particle at the given positions, at rest (e.g. a state computed elsewhere).
+    pub fn set_positions(&mut self, positions: &[DVec3]) {
+        self.positions.copy_from_slice(positions);
+        self.stop();
     }
 
     /// Puts particle `i` at `position` at rest (a kinematic move, e.g. a drag while paused).
@@ -629,11 +688,7 @@ impl Simulation {
         let h = self.substep_length();
         self.project_soft_grab(h);
         if self.settings.ground {
-            for (p, &w) in self.positions.iter_mut().zip(&self.inverse_masses) {
-                if w > 0.0 && p.y < 0.0 {
-                    p.y = 0.0;
-                }
-            }
+            integrate::project_ground(&mut self.positions, &self.inverse_masses);
         }
     }
 
@@ -747,27 +802,22 @@ impl Simulation {
     }
 
     fn predict(&mut self, h: f64) {
-        let gravity = DVec3::new(0.0, -self.settings.gravity, 0.0);
-        let ground = self.settings.ground;
-        for i in 0..self.positions.len() {
-            self.previous[i] = self.positions[i];
-            if self.inverse_masses[i] == 0.0 {
-                continue;
-            }
-            self.velocities[i] += gravity * h;
-            self.positions[i] += self.velocities[i] * h;
-            if ground && self.positions[i].y < 0.0 {
-                self.positions[i] = self.previous[i];
-                self.positions[i].y = 0.0;
-            }
-        }
+        integrate::predict(
+            &mut self.positions,
+            &mut self.previous,
+            &mut self.velocities,
+            &self.inverse_masses,
+            self.settings.gravity,
+            h,
+            self.settings.ground,
+        );
         if let Some(grab) = self.rigid_grab() {
             self.positions[grab.particle] = grab.target;
         }
         self.corrections.copy_from_slice(&self.positions);
     }
 
-    fn rule(&self, family: Family, h: f64) -> Rule {
+    pub(crate) fn rule(&self, family: Family, h: f64) -> Rule<f64> {
         match self.settings.method {
             Method::Xpbd => Rule::Xpbd {
                 alpha_tilde: self.settings.compliance.get(family) / (h * h),
@@ -836,14 +886,14 @@ impl Simulation {
 
     /// v = (x − x_prev) / h, damped; when `settling`, no faster than the predicted velocity.
     fn update_velocities(&mut self, h: f64, settling: bool) {
-        let keep = (1.0 - self.settings.damping * h).max(0.0);
-        for i in 0..self.positions.len() {
-            let mut velocity = (self.positions[i] - self.previous[i]) / h;
-            if settling {
-                velocity = velocity.clamp_length_max(self.velocities[i].length());
-            }
-            self.velocities[i] = velocity * keep;
-        }
+        integrate::update_velocities(
+            &self.positions,
+            &self.previous,
+            &mut self.velocities,
+            h,
+            self.settings.damping,
+            settling,
+        );
     }
 }
 
@@ -853,7 +903,7 @@ fn project_all<const N: usize>(
     set: &mut ConstraintSet<N>,
     positions: &mut [DVec3],
     inverse_masses: &[f64],
-    rule: Rule,
+    rule: Rule<f64>,
     evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
 ) {
     for c in 0..set.particles.len() {
@@ -867,7 +917,7 @@ fn project_one<const N: usize>(
     set: &mut ConstraintSet<N>,
     positions: &mut [DVec3],
     inverse_masses: &[f64],
-    rule: Rule,
+    rule: Rule<f64>,
     evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
     c: usize,
 ) {
@@ -928,7 +978,7 @@ fn describe<const N: usize>(
     set: &ConstraintSet<N>,
     positions: &[DVec3],
     inverse_masses: &[f64],
-    rule: Rule,
+    rule: Rule<f64>,
     evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
 ) -> Projection {
     let idx = set.particles[c];

@@ -107,6 +107,10 @@ pub trait Vector3:
     fn from_f64s(x: f64, y: f64, z: f64) -> Self;
     /// The components widened to f64.
     fn to_dvec3(self) -> glam::DVec3;
+    /// The y (up) component.
+    fn y(self) -> Self::Real;
+    /// Sets the y (up) component.
+    fn set_y(&mut self, y: Self::Real);
 }
 
 macro_rules! impl_vector3 {
@@ -130,6 +134,14 @@ macro_rules! impl_vector3 {
             fn to_dvec3(self) -> glam::DVec3 {
                 glam::DVec3::new(self.x as f64, self.y as f64, self.z as f64)
             }
+            #[inline]
+            fn y(self) -> $t {
+                self.y
+            }
+            #[inline]
+            fn set_y(&mut self, y: $t) {
+                self.y = y;
+            }
         }
     };
 }
@@ -137,14 +149,16 @@ impl_vector3!(glam::Vec3, f32);
 impl_vector3!(glam::Vec3A, f32);
 impl_vector3!(glam::DVec3, f64);
 
-/// Whether `a` and `b` span no plane at working precision: |a×b| ≤ ε·|a|·|b|.
+/// Whether `a` and `b` span no plane at working precision: |a×b| ≤ ε·|a|·|b|, compared squared
+/// (no square roots; the squares overflow only for coordinates beyond about 10¹⁹ in f32).
 ///
 /// True when either vector is zero or the sine of the angle between them is below machine
 /// epsilon; the normal `a×b/|a×b|` is then meaningless.
 #[inline]
 pub fn spans_no_plane<V: Vector3>(a: V, b: V, a_cross_b: V) -> bool {
-    let lhs = a_cross_b.length();
-    let rhs = V::Real::EPSILON * a.length() * b.length();
+    let lhs = a_cross_b.length_squared();
+    let epsilon = V::Real::EPSILON;
+    let rhs = epsilon * epsilon * a.length_squared() * b.length_squared();
     // Anything but "greater" (also NaN from overflowing inputs) means no plane.
     lhs.partial_cmp(&rhs) != Some(std::cmp::Ordering::Greater)
 }

@@ -4,6 +4,7 @@
 //! exit status 2; nothing is written to stdout.
 
 mod args;
+mod bench;
 mod check_gradients;
 mod gradient;
 #[cfg(not(target_arch = "wasm32"))]
@@ -36,6 +37,8 @@ enum Command {
     CheckGradients(check_gradients::Args),
     /// Run a scene headless and print its metrics per frame (--json) or a summary.
     Run(run::Args),
+    /// Time the solver on a scene: projections, ns per projection, frames per second, memory.
+    Bench(bench::Args),
     /// Run a scene headless and log it to a Rerun recording (.rrd) or a running viewer.
     #[cfg(not(target_arch = "wasm32"))]
     Record(record::Args),
@@ -85,6 +88,7 @@ pub fn main() -> ExitCode {
         Command::Gradient(args) => gradient::run(&args, &mut stdout),
         Command::CheckGradients(args) => check_gradients::run(&args, &mut stdout),
         Command::Run(args) => run::run(&args, &mut stdout),
+        Command::Bench(args) => bench::run(&args, &mut stdout),
         #[cfg(not(target_arch = "wasm32"))]
         Command::Record(args) => record::run(&args, &mut stdout).map(|ending| {
             if let record::Ending::Interrupted = ending {

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Runs the benchmarks of docs/performance.md and prints their table in Markdown. Each row is one
+# `tetlab bench` command, shown in the row, run three times; the row keeps the fastest run (this
+# machine shares its cores, and the slower runs are other people's load, not tetlab's).
+# Usage: scripts/bench.sh > /tmp/table.md   (needs the shared meshes in ../shared/meshes)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release --quiet
+tetlab=target/release/tetlab
+bunny=../shared/meshes/bunny.node
+
+echo "| scene | tets | constraints | solver, threads | projections per frame | ms per frame | frames per second | ns per projection (edges / plane / volume) | bytes per tet | command |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+
+row() {
+  local args="$*"
+  for _ in 1 2 3; do "$tetlab" bench $args --json | tail -n 1; done | python3 -c '
+import json, sys
+args = sys.argv[1]
+runs = [json.loads(line) for line in sys.stdin]
+r = min(runs, key=lambda r: r["ms_per_frame"])
+f = r["ns_per_projection_by_family"]
+families = "—" if f is None else " / ".join(
+    "—" if f[k] == 0 else "%.1f" % f[k] for k in ("edges", "plane", "volume"))
+print("| %s | %d | %s | %s, %d | %d | %.3f | %.1f | %.1f (%s) | %.0f | `tetlab bench %s` |" % (
+    r["scene"], r["tets"], r["constraints"], r["solver"], r["threads"],
+    r["projections_per_frame"], r["ms_per_frame"], r["frames_per_second"],
+    r["ns_per_projection"], families, r["bytes_per_tet"], args))
+' "$args"
+}
+
+row --scene $bunny --frames 1000
+row --scene $bunny --frames 300 --reference
+row --scene $bunny --frames 300 --constraints edges,plane,volume
+row --scene cube --resolution 6 --frames 500
+row --scene cube --resolution 13 --frames 100
+row --scene cube --resolution 26 --frames 40
+row --scene cube --resolution 26 --frames 40 --threads 2
+row --scene cube --resolution 26 --frames 10 --constraints edges,plane,volume
+row --scene cube --resolution 55 --frames 5 --warmup 1
+row --scene cube --resolution 55 --frames 5 --warmup 1 --threads 2

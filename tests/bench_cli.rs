@@ -1,0 +1,91 @@
+//! `tetlab bench`: the report's numbers are there and consistent with the scene, for the fast and
+//! the reference solver; bad options are usage errors. (How fast is measured, not asserted: the
+//! figures are in docs/performance.md.)
+
+mod support;
+
+use serde_json::Value;
+use support::{assert_usage_error, stderr, stdout, tetlab};
+
+fn bench_json(args: &[&str]) -> Value {
+    let mut all = vec!["bench", "--json"];
+    all.extend_from_slice(args);
+    let output = tetlab(&all);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stdout(&output);
+    serde_json::from_str(text.lines().last().unwrap()).unwrap()
+}
+
+#[test]
+fn the_report_counts_the_work_of_a_frame() {
+    for extra in [&["--threads", "2"][..], &["--reference"][..]] {
+        let mut args = vec![
+            "--scene",
+            "cube",
+            "--resolution",
+            "3",
+            "--frames",
+            "5",
+            "--warmup",
+            "1",
+        ];
+        args.extend_from_slice(extra);
+        let report = bench_json(&args);
+        let tets = report["tets"].as_u64().unwrap();
+        let edges = report["edges"].as_u64().unwrap();
+        assert_eq!(tets, 162);
+        assert_eq!(
+            report["projections_per_frame"].as_u64().unwrap(),
+            (edges + tets) * 10,
+            "edges + volume, 10 substeps of 1 iteration"
+        );
+        for key in [
+            "ns_per_projection",
+            "frames_per_second",
+            "bytes_per_tet",
+            "ms_per_frame",
+        ] {
+            let value = report[key].as_f64().unwrap();
+            assert!(value.is_finite() && value > 0.0, "{key}: {value}");
+        }
+    }
+    let report = bench_json(&["--scene", "tet", "--frames", "2", "--threads", "2"]);
+    assert_eq!(report["threads"], 2);
+    assert_eq!(report["solver"], "fast (f32)");
+}
+
+#[test]
+fn the_heights_are_counted_and_timed_on_their_own() {
+    let report = bench_json(&[
+        "--scene",
+        "cube",
+        "--resolution",
+        "2",
+        "--constraints",
+        "edges,plane,volume",
+        "--frames",
+        "3",
+    ]);
+    let tets = report["tets"].as_u64().unwrap();
+    let edges = report["edges"].as_u64().unwrap();
+    assert_eq!(
+        report["projections_per_frame"].as_u64().unwrap(),
+        (edges + 4 * tets + tets) * 10
+    );
+    let by_family = &report["ns_per_projection_by_family"];
+    for family in ["edges", "plane", "volume"] {
+        assert!(by_family[family].as_f64().unwrap() > 0.0, "{family}");
+    }
+}
+
+#[test]
+fn bad_options_are_usage_errors() {
+    assert_usage_error(&tetlab(&["bench", "--frames", "0"]), "--frames");
+    assert_usage_error(&tetlab(&["bench", "--scene", "nowhere.msh"]), "--scene");
+    assert_usage_error(&tetlab(&["bench", "--threads", "0"]), "--threads");
+    assert_usage_error(&tetlab(&["bench", "--constraints", "glue"]), "glue");
+    assert_usage_error(
+        &tetlab(&["bench", "--reference", "--threads", "2"]),
+        "--threads",
+    );
+}
