@@ -27,7 +27,8 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
         ui.heading("Next projection");
         let inspection = inspect(simulation, projection.family, projection.constraint);
         formula(ui, projection.family);
-        constraint(ui, &inspection, method);
+        // One id for whichever constraint is next, so the table keeps its column widths.
+        constraint(ui, &inspection, method, "next projection");
         ui.separator();
     }
     let Some(tet) = bench.selected_tet else {
@@ -55,7 +56,8 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
                 formula(ui, family);
                 for inspection in of_family {
                     ui.separator();
-                    constraint(ui, inspection, method);
+                    let p = &inspection.projection;
+                    constraint(ui, inspection, method, (p.family.name(), p.constraint));
                 }
             });
     }
@@ -80,7 +82,12 @@ fn formula(ui: &mut egui::Ui, family: Family) {
 
 /// One constraint's numbers: C, rest value, λ and the next Δλ; per particle w, ∇C and its
 /// central-difference check.
-fn constraint(ui: &mut egui::Ui, inspection: &Inspection, method: Method) {
+fn constraint(
+    ui: &mut egui::Ui,
+    inspection: &Inspection,
+    method: Method,
+    id: impl std::hash::Hash + std::fmt::Debug,
+) {
     let p = &inspection.projection;
     let rest_name = if p.family == Family::Volume { "V" } else { "d" };
     let step = match (p.delta_lambda, method) {
@@ -100,7 +107,7 @@ fn constraint(ui: &mut egui::Ui, inspection: &Inspection, method: Method) {
         ))
         .monospace(),
     );
-    egui::Grid::new(("inspection", p.family.name(), p.constraint))
+    egui::Grid::new(("inspection", id))
         .striped(true)
         .show(ui, |ui| {
             for header in [
