@@ -525,3 +525,20 @@ fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
     harness.run_steps(1);
     assert!(harness.state().comparison.is_none());
 }
+
+/// "Open mesh file..." (O): a browser inside the workbench, opened in the folder of the last
+/// path; a click on a file loads it.
+#[test]
+fn open_mesh_file_browses_and_loads_a_mesh() {
+    let mut harness = workbench("cube", 2);
+    harness.state_mut().preferences.scene.path = "../assets/meshes/bipyramid.node".into();
+    harness.get_by_label("Open mesh file...").click();
+    harness.run_steps(4);
+    harness.get_by_label_contains("assets/meshes");
+    harness.get_by_label("bipyramid.ele");
+    harness.get_by_label("bipyramid.node").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().bench.scene.name, "bipyramid");
+    assert_eq!(harness.state().bench.simulation.tets().len(), 2);
+    assert!(harness.query_by_label("bipyramid.ele").is_none(), "the browser closed");
+}

@@ -2,6 +2,8 @@
 //! [`render`], what to draw in [`geometry`]), the state in [`workbench`], and each side panel in a
 //! file of its own under [`panels`].
 
+#[cfg(not(target_arch = "wasm32"))]
+pub mod browser;
 pub mod camera;
 pub mod files;
 pub mod geometry;
@@ -107,6 +109,9 @@ pub struct TetlabApp {
     pub classroom: bool,
     lesson_path: String,
     compare_families: PerFamily<bool>,
+    /// "Open mesh file…" while it is open.
+    #[cfg(not(target_arch = "wasm32"))]
+    browser: Option<browser::FileBrowser>,
 }
 
 /// How much larger everything is in classroom mode.
@@ -149,6 +154,8 @@ impl TetlabApp {
             classroom: false,
             lesson_path: String::new(),
             compare_families: PerFamily::splat(true),
+            #[cfg(not(target_arch = "wasm32"))]
+            browser: None,
         }
     }
 
@@ -221,6 +228,20 @@ impl TetlabApp {
         self.viewport.frame();
     }
 
+    /// Opens "Open mesh file…" in the folder of the last file, or the current folder.
+    fn open_browser(&mut self) {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let last = std::path::Path::new(&self.preferences.scene.path);
+            let folder = last
+                .parent()
+                .filter(|p| p.is_dir())
+                .map(std::path::Path::to_path_buf)
+                .unwrap_or_else(|| std::path::PathBuf::from("."));
+            self.browser = Some(browser::FileBrowser::new(&folder));
+        }
+    }
+
     fn go_to_step(&mut self, forward: bool) {
         if let Some(state) = &mut self.lesson {
             let last = state.lesson.steps.len() - 1;
@@ -280,6 +301,7 @@ impl TetlabApp {
             Action::Inspector => self.show_inspector = !self.show_inspector,
             Action::Help => self.show_help = !self.show_help,
             Action::Lesson => self.show_lesson = !self.show_lesson,
+            Action::OpenFile => self.open_browser(),
             Action::Classroom => {
                 self.classroom = !self.classroom;
                 self.viewport.frame();
@@ -318,6 +340,23 @@ impl TetlabApp {
         let dropped = ctx.input(|i| i.raw.dropped_files.clone());
         for file in dropped {
             self.opened(files::open_dropped(file.as_ref()));
+        }
+    }
+
+    /// The "Open mesh file…" window, when open; opens what is chosen in it.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn show_browser(&mut self, ctx: &egui::Context) {
+        let Some(browser) = &mut self.browser else {
+            return;
+        };
+        let mut open = true;
+        let chosen = browser.show(ctx, &mut open);
+        if !open {
+            self.browser = None;
+        }
+        if let Some(path) = chosen {
+            self.preferences.scene.path = path.display().to_string();
+            self.opened(files::open_path(&path.to_string_lossy()));
         }
     }
 
@@ -503,6 +542,8 @@ impl eframe::App for TetlabApp {
         }
         egui::CentralPanel::default_margins().show(ui, |ui| self.views(ui));
         panels::help::show(&ctx, &mut self.show_help);
+        #[cfg(not(target_arch = "wasm32"))]
+        self.show_browser(&ctx);
         if !self.classroom {
             panels::inspector::show(&ctx, &mut self.show_inspector, &self.bench);
         }

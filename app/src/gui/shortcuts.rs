@@ -37,6 +37,8 @@ pub enum Action {
     Inspector,
     /// Show or hide the lesson window.
     Lesson,
+    /// Open a mesh or lesson file.
+    OpenFile,
     /// Classroom mode on or off.
     Classroom,
     /// The lesson's next step.
@@ -50,7 +52,7 @@ pub enum Action {
 }
 
 /// Every shortcut: key, action, what the help says.
-pub const SHORTCUTS: [(Key, Action, &str); 21] = [
+pub const SHORTCUTS: [(Key, Action, &str); 22] = [
     (Key::Space, Action::PlayPause, "play / pause"),
     (Key::N, Action::StepFrame, "step one frame"),
     (Key::U, Action::StepSubstep, "step one substep"),
@@ -83,6 +85,7 @@ pub const SHORTCUTS: [(Key, Action, &str); 21] = [
         "inspector (numbers of the selected tet)",
     ),
     (Key::L, Action::Lesson, "lessons"),
+    (Key::O, Action::OpenFile, "open a mesh or lesson file"),
     (
         Key::F5,
         Action::Classroom,

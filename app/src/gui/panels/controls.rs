@@ -147,6 +147,14 @@ pub fn show(
             request = Some(SceneRequest::File(choice.path.trim().to_owned()));
         }
     });
+    if !cfg!(target_arch = "wasm32")
+        && ui
+            .button("Open mesh file...")
+            .on_hover_text("O: browse for a .node, .ele, .msh or lesson file")
+            .clicked()
+    {
+        actions.push(Action::OpenFile);
+    }
     ui.label(format!(
         "{}: {} particles, {} tets",
         bench.scene.name,
