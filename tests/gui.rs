@@ -540,5 +540,8 @@ fn open_mesh_file_browses_and_loads_a_mesh() {
     harness.run_steps(2);
     assert_eq!(harness.state().bench.scene.name, "bipyramid");
     assert_eq!(harness.state().bench.simulation.tets().len(), 2);
-    assert!(harness.query_by_label("bipyramid.ele").is_none(), "the browser closed");
+    assert!(
+        harness.query_by_label("bipyramid.ele").is_none(),
+        "the browser closed"
+    );
 }
