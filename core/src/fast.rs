@@ -17,7 +17,9 @@
 
 use crate::constraints::{Evaluation, Family, distance, plane, volume};
 use crate::integrate;
-use crate::solver::{Method, Rule, Settings, Simulation, correction};
+use crate::lanes::{F32x4, LANES, Vec3x4};
+use crate::solver::{Rule, Settings, Simulation, correction, correction_lanes};
+use crate::vector::Vector3;
 use glam::{DVec3, Vec3A};
 use std::ops::Range;
 use std::time::{Duration, Instant};
@@ -357,53 +359,34 @@ impl FastSimulation {
         }
     }
 
-    fn rule(&self, family: Family, h: f64) -> Rule<f32> {
-        let s = &self.settings;
-        let rule = match s.method {
-            Method::Xpbd => Rule::Xpbd {
-                alpha_tilde: s.compliance.get(family) / (h * h),
-            },
-            Method::Pbd => {
-                let k = s.stiffness.get(family).clamp(0.0, 1.0);
-                Rule::Pbd {
-                    k: 1.0 - (1.0 - k).powf(1.0 / s.iterations.max(1) as f64),
-                }
-            }
-        };
-        rule.to()
-    }
-
     fn sweep(&mut self, h: f64, parallel: bool) {
         let active = self.settings.active;
         for (k, family) in Family::ALL.into_iter().enumerate() {
             if !active.get(family) {
                 continue;
             }
-            let rule = self.rule(family, h);
+            let rule = Rule::for_settings(&self.settings, family, h);
             let started = Instant::now();
             let count = match family {
-                Family::Distance => project_family(
+                Family::Distance => project_family::<2, EdgeFormula>(
                     &mut self.edges,
                     &mut self.positions,
                     &self.inverse_masses,
                     rule,
-                    distance::evaluate,
                     parallel,
                 ),
-                Family::Plane => project_family(
+                Family::Plane => project_family::<4, PlaneFormula>(
                     &mut self.planes,
                     &mut self.positions,
                     &self.inverse_masses,
                     rule,
-                    plane::evaluate,
                     parallel,
                 ),
-                Family::Volume => project_family(
+                Family::Volume => project_family::<4, VolumeFormula>(
                     &mut self.volumes,
                     &mut self.positions,
                     &self.inverse_masses,
                     rule,
-                    volume::evaluate,
                     parallel,
                 ),
             };
@@ -416,21 +399,110 @@ impl FastSimulation {
     }
 }
 
-/// Projects every constraint of `batches`, colour by colour; with `parallel`, large colours are
-/// shared by the threads of the current pool.
-/// Returns how many constraints it projected.
+/// A constraint family's formula, for any vector type: one f32 constraint or four in lanes.
+trait Formula<const N: usize> {
+    fn evaluate<V: Vector3>(p: &[V; N], rest: V::Real) -> Evaluation<V, N>;
+}
+
+struct EdgeFormula;
+struct PlaneFormula;
+struct VolumeFormula;
+
+impl Formula<2> for EdgeFormula {
+    #[inline(always)]
+    fn evaluate<V: Vector3>(p: &[V; 2], rest: V::Real) -> Evaluation<V, 2> {
+        distance::evaluate(p, rest)
+    }
+}
+
+impl Formula<4> for PlaneFormula {
+    #[inline(always)]
+    fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
+        plane::evaluate(p, rest)
+    }
+}
+
+impl Formula<4> for VolumeFormula {
+    #[inline(always)]
+    fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
+        volume::evaluate(p, rest)
+    }
+}
+
+/// Where the kernels read and move particles.
+trait Positions {
+    fn get(&self, i: u32) -> Vec3A;
+    fn add(&mut self, i: u32, delta: Vec3A);
+}
+
+impl Positions for &mut [Vec3A] {
+    #[inline(always)]
+    fn get(&self, i: u32) -> Vec3A {
+        self[i as usize]
+    }
+    #[inline(always)]
+    fn add(&mut self, i: u32, delta: Vec3A) {
+        self[i as usize] += delta;
+    }
+}
+
+/// Projects a run of constraints that share no particle: four at a time in SIMD lanes, the last
+/// few one by one. Lanes and single constraints compute the same formula and rule.
 #[inline]
-fn project_family<const N: usize, E>(
-    batches: &mut Batches<N>,
-    positions: &mut [Vec3A],
+fn project_run<const N: usize, F: Formula<N>>(
+    particles: &[[u32; N]],
+    rest: &[f32],
+    lambda: &mut [f32],
+    positions: &mut impl Positions,
     inverse_masses: &[f32],
-    rule: Rule<f32>,
-    evaluate: E,
+    rule: Rule<f64>,
+) {
+    let in_lanes = particles.len() / LANES * LANES;
+    let lane_rule: Rule<F32x4> = rule.to();
+    for base in (0..in_lanes).step_by(LANES) {
+        let idx: [[u32; N]; LANES] = std::array::from_fn(|k| particles[base + k]);
+        let p: [Vec3x4; N] = std::array::from_fn(|i| {
+            Vec3x4::gather(std::array::from_fn(|k| positions.get(idx[k][i])))
+        });
+        let w: [F32x4; N] = std::array::from_fn(|i| {
+            F32x4::new(std::array::from_fn(|k| inverse_masses[idx[k][i] as usize]))
+        });
+        let r = F32x4::new(std::array::from_fn(|k| rest[base + k]));
+        let l = F32x4::new(std::array::from_fn(|k| lambda[base + k]));
+        let (_, d) = correction_lanes(F::evaluate(&p, r), w, l, lane_rule);
+        let delta_lambda = d.delta_lambda.to_array();
+        let delta_x = d.delta_x.map(Vec3x4::scatter);
+        for (k, particles) in idx.iter().enumerate() {
+            lambda[base + k] += delta_lambda[k];
+            for (i, &particle) in particles.iter().enumerate() {
+                positions.add(particle, delta_x[i][k]);
+            }
+        }
+    }
+    let one_rule: Rule<f32> = rule.to();
+    for c in in_lanes..particles.len() {
+        let idx = particles[c];
+        let p = idx.map(|i| positions.get(i));
+        let w = idx.map(|i| inverse_masses[i as usize]);
+        if let Some(d) = correction(F::evaluate(&p, rest[c]), w, lambda[c], one_rule) {
+            lambda[c] += d.delta_lambda;
+            for (&i, &delta) in idx.iter().zip(&d.delta_x) {
+                positions.add(i, delta);
+            }
+        }
+    }
+}
+
+/// Projects every constraint of `batches`, colour by colour; with `parallel`, large colours are
+/// shared by the threads of the current pool. Returns how many constraints it projected.
+#[inline]
+fn project_family<const N: usize, F: Formula<N>>(
+    batches: &mut Batches<N>,
+    mut positions: &mut [Vec3A],
+    inverse_masses: &[f32],
+    rule: Rule<f64>,
     parallel: bool,
-) -> usize
-where
-    E: Fn(&[Vec3A; N], f32) -> Evaluation<Vec3A, N> + Sync + Copy,
-{
+) -> usize {
     let Batches {
         particles,
         rest,
@@ -445,28 +517,22 @@ where
         );
         match parallel && range.len() >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
-            true => parallel::project_colour(
+            true => parallel::project_colour::<N, F>(
                 particles,
                 rest,
                 lambda,
                 positions,
                 inverse_masses,
                 rule,
-                evaluate,
             ),
-            _ => {
-                for c in 0..particles.len() {
-                    let idx = particles[c];
-                    let p = idx.map(|i| positions[i as usize]);
-                    let w = idx.map(|i| inverse_masses[i as usize]);
-                    if let Some(d) = correction(evaluate(&p, rest[c]), w, lambda[c], rule) {
-                        lambda[c] += d.delta_lambda;
-                        for (&i, &delta) in idx.iter().zip(&d.delta_x) {
-                            positions[i as usize] += delta;
-                        }
-                    }
-                }
-            }
+            _ => project_run::<N, F>(
+                particles,
+                rest,
+                lambda,
+                &mut positions,
+                inverse_masses,
+                rule,
+            ),
         }
     }
     particles.len()
@@ -482,10 +548,12 @@ mod parallel {
     use super::*;
     use rayon::prelude::*;
 
-    /// Constraints per task.
-    const CHUNK: usize = 256;
+    /// Constraints per task: a multiple of the lane count, so that the quadruples are the same as
+    /// on one thread and the result the same bits.
+    const CHUNK: usize = 64 * LANES;
 
     /// Positions written by several threads at once, each at particles no other thread touches.
+    /// Made only by `project_colour`, for the constraints of one colour.
     #[derive(Clone, Copy)]
     struct Disjoint {
         ptr: *mut Vec3A,
@@ -496,18 +564,20 @@ mod parallel {
     unsafe impl Send for Disjoint {}
     unsafe impl Sync for Disjoint {}
 
-    impl Disjoint {
-        /// # Safety
-        /// No other thread may access element `i` at the same time.
-        unsafe fn get(self, i: usize) -> Vec3A {
+    impl Positions for Disjoint {
+        #[inline(always)]
+        fn get(&self, i: u32) -> Vec3A {
+            let i = i as usize;
             assert!(i < self.len);
-            // SAFETY: in bounds (checked), and no concurrent access by the caller's contract.
+            // SAFETY: in bounds (checked); the constraints of one colour share no particle, so no
+            // other task of this colour reads or writes particle i, and `positions` is borrowed
+            // mutably for the whole of `project_colour`, so nothing else does either.
             unsafe { self.ptr.add(i).read() }
         }
 
-        /// # Safety
-        /// No other thread may access element `i` at the same time.
-        unsafe fn add(self, i: usize, delta: Vec3A) {
+        #[inline(always)]
+        fn add(&mut self, i: u32, delta: Vec3A) {
+            let i = i as usize;
             assert!(i < self.len);
             // SAFETY: as for `get`.
             unsafe {
@@ -517,45 +587,33 @@ mod parallel {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn project_colour<const N: usize, E>(
+    pub(super) fn project_colour<const N: usize, F: Formula<N>>(
         particles: &[[u32; N]],
         rest: &[f32],
         lambda: &mut [f32],
         positions: &mut [Vec3A],
         inverse_masses: &[f32],
-        rule: Rule<f32>,
-        evaluate: E,
-    ) where
-        E: Fn(&[Vec3A; N], f32) -> Evaluation<Vec3A, N> + Sync + Copy,
-    {
+        rule: Rule<f64>,
+    ) {
         let shared = Disjoint {
             ptr: positions.as_mut_ptr(),
             len: positions.len(),
         };
-        {
-            lambda
-                .par_chunks_mut(CHUNK)
-                .zip(particles.par_chunks(CHUNK))
-                .zip(rest.par_chunks(CHUNK))
-                .for_each(|((lambda, particles), rest)| {
-                    for c in 0..particles.len() {
-                        let idx = particles[c];
-                        // SAFETY: the constraints of one colour share no particle, so no other
-                        // task of this colour reads or writes these positions; `positions` is
-                        // borrowed mutably for the whole call, so nothing else does either.
-                        let p = idx.map(|i| unsafe { shared.get(i as usize) });
-                        let w = idx.map(|i| inverse_masses[i as usize]);
-                        if let Some(d) = correction(evaluate(&p, rest[c]), w, lambda[c], rule) {
-                            lambda[c] += d.delta_lambda;
-                            for (&i, &delta) in idx.iter().zip(&d.delta_x) {
-                                // SAFETY: as above.
-                                unsafe { shared.add(i as usize, delta) };
-                            }
-                        }
-                    }
-                });
-        }
+        lambda
+            .par_chunks_mut(CHUNK)
+            .zip(particles.par_chunks(CHUNK))
+            .zip(rest.par_chunks(CHUNK))
+            .for_each(|((lambda, particles), rest)| {
+                let mut positions = shared;
+                project_run::<N, F>(
+                    particles,
+                    rest,
+                    lambda,
+                    &mut positions,
+                    inverse_masses,
+                    rule,
+                );
+            });
     }
 }
 

@@ -14,7 +14,9 @@ pub(crate) fn predict<V: Vector3>(
     gravity: f64,
     h: f64,
     ground: bool,
-) {
+) where
+    V::Real: PartialOrd,
+{
     let pull = V::from_f64s(0.0, -gravity, 0.0) * V::Real::from_f64(h);
     let h = V::Real::from_f64(h);
     for i in 0..positions.len() {
@@ -32,7 +34,10 @@ pub(crate) fn predict<V: Vector3>(
 }
 
 /// The ground as a constraint: y ≥ 0 for every free particle.
-pub(crate) fn project_ground<V: Vector3>(positions: &mut [V], inverse_masses: &[V::Real]) {
+pub(crate) fn project_ground<V: Vector3>(positions: &mut [V], inverse_masses: &[V::Real])
+where
+    V::Real: PartialOrd,
+{
     for (p, &w) in positions.iter_mut().zip(inverse_masses) {
         if w > V::Real::ZERO && p.y() < V::Real::ZERO {
             p.set_y(V::Real::ZERO);
@@ -49,7 +54,9 @@ pub(crate) fn update_velocities<V: Vector3>(
     h: f64,
     damping: f64,
     cap: bool,
-) {
+) where
+    V::Real: PartialOrd,
+{
     let keep = V::Real::from_f64((1.0 - damping * h).max(0.0));
     let h = V::Real::from_f64(h);
     for i in 0..positions.len() {

@@ -1,19 +1,24 @@
 //! tetlab-core: the simulation side of tetlab, with no GUI dependencies.
 //!
 //! - [`constraints`]: the edge-distance, height-above-face ("plane") and signed-volume
-//!   constraints, their values and analytic gradients, written once for f32 and f64.
+//!   constraints, their values and analytic gradients, written once for f64, f32 and four f32
+//!   lanes ([`lanes`]).
 //! - [`finite_difference`]: numerical gradients to check the analytic ones against.
 //! - [`verify`]: analytic gradients against finite differences on random configurations;
 //!   [`inspector`]: the same check, live, on the constraints of one tet.
 //! - [`random`]: a seeded generator, so random inputs are the same everywhere.
 //! - [`vector`]: the small vector trait the formulas are generic over.
-//! - [`solver`]: the XPBD/PBD simulation; [`stepper`]: the same, one projection at a time.
+//! - [`solver`]: the XPBD/PBD simulation; [`stepper`]: the same, one projection at a time;
+//!   [`fast`]: the same in f32, coloured, in SIMD lanes and on threads, for big meshes.
+//! - [`mesh`], [`scene`]: tet meshes (TetGen, Gmsh) and the scenes built from them; [`metrics`]:
+//!   what a state is worth; [`visual`]: what front ends draw; [`lesson`]: lessons as TOML files.
 
 pub mod constraints;
 pub mod fast;
 pub mod finite_difference;
 pub mod inspector;
 mod integrate;
+pub mod lanes;
 pub mod lesson;
 pub mod mesh;
 pub mod metrics;

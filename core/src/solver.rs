@@ -254,6 +254,23 @@ pub(crate) enum Rule<R> {
 }
 
 impl Rule<f64> {
+    /// The rule `settings` give `family` in a substep of length h: XPBD α̃ = α / h², or PBD
+    /// k′ = 1 − (1 − k)^(1/iterations), so that the sweeps of a substep compound to k.
+    pub(crate) fn for_settings(settings: &Settings, family: Family, h: f64) -> Rule<f64> {
+        match settings.method {
+            Method::Xpbd => Rule::Xpbd {
+                alpha_tilde: settings.compliance.get(family) / (h * h),
+            },
+            Method::Pbd => {
+                let k = settings.stiffness.get(family).clamp(0.0, 1.0);
+                let n = settings.iterations.max(1) as f64;
+                Rule::Pbd {
+                    k: 1.0 - (1.0 - k).powf(1.0 / n),
+                }
+            }
+        }
+    }
+
     /// The same rule in another precision.
     pub(crate) fn to<R: Real>(self) -> Rule<R> {
         match self {
@@ -267,35 +284,53 @@ impl Rule<f64> {
 
 /// The correction that projecting one constraint would make, or `None` when it is skipped
 /// (degenerate, or every particle pinned). In any precision: the f64 path and the fast f32 path
-/// share it.
+/// share it, through [`correction_lanes`].
 #[inline]
 pub(crate) fn correction<V: Vector3, const N: usize>(
     evaluation: Evaluation<V, N>,
     weights: [V::Real; N],
     lambda: V::Real,
     rule: Rule<V::Real>,
-) -> Option<Correction<N, V>> {
-    if evaluation.degenerate {
-        return None;
-    }
+) -> Option<Correction<N, V>>
+where
+    V::Real: Real<Mask = bool>,
+{
+    let (skipped, correction) = correction_lanes(evaluation, weights, lambda, rule);
+    (!skipped).then_some(correction)
+}
+
+/// The projection rule without a branch, for one constraint or several in lanes:
+/// Σ wᵢ|∇ᵢC|²; XPBD Δλ = (−C − α̃λ) / (Σ wᵢ|∇ᵢC|² + α̃), PBD Δλ = −k′C / Σ wᵢ|∇ᵢC|²; Δxᵢ = wᵢ ∇ᵢC Δλ.
+/// Where the evaluation is degenerate or Σ wᵢ|∇ᵢC|² is not positive and finite (every particle
+/// fixed), the mask is set and the correction is zero.
+#[inline(always)]
+pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
+    evaluation: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: V::Real,
+    rule: Rule<V::Real>,
+) -> (<V::Real as Real>::Mask, Correction<N, V>) {
     let weighted_norm = weighted_norm(&weights, &evaluation.gradients);
-    if weighted_norm <= V::Real::ZERO || !weighted_norm.is_finite() {
-        return None;
-    }
+    let skipped =
+        evaluation.degenerate | !weighted_norm.gt(V::Real::ZERO) | !weighted_norm.finite();
     let delta_lambda = match rule {
         Rule::Xpbd { alpha_tilde } => {
             (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
         }
         Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
     };
+    let delta_lambda = V::Real::select(skipped, V::Real::ZERO, delta_lambda);
     let mut delta_x = [V::ZERO; N];
     for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
-        *dx = *g * (w * delta_lambda);
+        *dx = V::select(skipped, V::ZERO, *g * (w * delta_lambda));
     }
-    Some(Correction {
-        delta_lambda,
-        delta_x,
-    })
+    (
+        skipped,
+        Correction {
+            delta_lambda,
+            delta_x,
+        },
+    )
 }
 
 /// One rigid XPBD projection of a constraint at `points` with rest value `rest` and inverse
@@ -310,8 +345,9 @@ pub fn project_kernel<V: Vector3, const N: usize>(
     let rule = Rule::Xpbd {
         alpha_tilde: V::Real::ZERO,
     };
-    correction(evaluate(points, rest), weights, V::Real::ZERO, rule)
-        .map_or([V::ZERO; N], |c| c.delta_x)
+    correction_lanes(evaluate(points, rest), weights, V::Real::ZERO, rule)
+        .1
+        .delta_x
 }
 
 /// Σ wᵢ |∇ₚᵢC|², the denominator of every projection.
@@ -818,18 +854,7 @@ impl Simulation {
     }
 
     pub(crate) fn rule(&self, family: Family, h: f64) -> Rule<f64> {
-        match self.settings.method {
-            Method::Xpbd => Rule::Xpbd {
-                alpha_tilde: self.settings.compliance.get(family) / (h * h),
-            },
-            Method::Pbd => {
-                let k = self.settings.stiffness.get(family).clamp(0.0, 1.0);
-                let n = self.settings.iterations.max(1) as f64;
-                Rule::Pbd {
-                    k: 1.0 - (1.0 - k).powf(1.0 / n),
-                }
-            }
-        }
+        Rule::for_settings(&self.settings, family, h)
     }
 
     /// One Gauss–Seidel sweep over the active families, then the grab, then the ground.

@@ -1,17 +1,41 @@
 //! The small vector vocabulary the constraint formulas are written in.
 //!
 //! Every formula in [`crate::constraints`] is generic over [`Vector3`], so one implementation
-//! serves the f64 path used for checking and teaching ([`glam::DVec3`]) and the f32 path of a
-//! fast solver ([`glam::Vec3`], [`glam::Vec3A`]).
+//! serves the f64 path used for checking and teaching ([`glam::DVec3`]), the f32 path of the fast
+//! solver ([`glam::Vec3`], [`glam::Vec3A`]) and its SIMD path, four constraints at once
+//! ([`crate::lanes::Vec3x4`]). The formulas never branch on a value: a comparison gives a
+//! [`Mask`] (a `bool` for one number, one flag per lane for four), and [`Real::select`] picks.
 
 use std::fmt::Debug;
-use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
 
-/// A floating-point scalar: `f32` or `f64`.
+/// The result of a comparison: `bool`, or one flag per lane.
+pub trait Mask:
+    Copy + Debug + PartialEq + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
+{
+    /// Whether any flag is set.
+    fn any(self) -> bool;
+
+    /// `self & other()`, calling `other` only when some flag of `self` is set (for a rare
+    /// condition, most calls then skip the work).
+    #[inline(always)]
+    fn and_then(self, other: impl FnOnce() -> Self) -> Self {
+        if self.any() { self & other() } else { self }
+    }
+}
+
+impl Mask for bool {
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
+}
+
+/// A floating-point number, or several in lanes: `f32`, `f64`, [`crate::lanes::F32x4`].
 pub trait Real:
     Copy
     + Debug
-    + PartialOrd
+    + PartialEq
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<Output = Self>
@@ -20,6 +44,8 @@ pub trait Real:
     + AddAssign
     + SubAssign
 {
+    /// What comparing two of these gives.
+    type Mask: Mask;
     /// 0.
     const ZERO: Self;
     /// 1.
@@ -28,21 +54,24 @@ pub trait Real:
     const EPSILON: Self;
     /// The smallest positive normal number.
     const MIN_POSITIVE: Self;
-    /// The nearest value of this type to `x`.
+    /// The nearest value of this type to `x` (in every lane).
     fn from_f64(x: f64) -> Self;
-    /// This value widened (or kept) to f64.
-    fn to_f64(self) -> f64;
     /// √self.
     fn sqrt(self) -> Self;
-    /// |self|.
-    fn abs(self) -> Self;
     /// Neither infinite nor NaN.
-    fn is_finite(self) -> bool;
+    fn finite(self) -> Self::Mask;
+    /// self ≤ other (false with a NaN).
+    fn le(self, other: Self) -> Self::Mask;
+    /// self > other (false with a NaN).
+    fn gt(self, other: Self) -> Self::Mask;
+    /// `if_true` where `mask` is set, `if_false` elsewhere.
+    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
 }
 
 macro_rules! impl_real {
     ($t:ty) => {
         impl Real for $t {
+            type Mask = bool;
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
             const EPSILON: Self = <$t>::EPSILON;
@@ -52,20 +81,24 @@ macro_rules! impl_real {
                 x as $t
             }
             #[inline]
-            fn to_f64(self) -> f64 {
-                self as f64
-            }
-            #[inline]
             fn sqrt(self) -> Self {
                 <$t>::sqrt(self)
             }
             #[inline]
-            fn abs(self) -> Self {
-                <$t>::abs(self)
+            fn finite(self) -> bool {
+                <$t>::is_finite(self)
             }
             #[inline]
-            fn is_finite(self) -> bool {
-                <$t>::is_finite(self)
+            fn le(self, other: Self) -> bool {
+                self <= other
+            }
+            #[inline]
+            fn gt(self, other: Self) -> bool {
+                self > other
+            }
+            #[inline]
+            fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
+                if mask { if_true } else { if_false }
             }
         }
     };
@@ -105,12 +138,12 @@ pub trait Vector3:
     }
     /// The vector built from f64 components (rounded to the component type).
     fn from_f64s(x: f64, y: f64, z: f64) -> Self;
-    /// The components widened to f64.
-    fn to_dvec3(self) -> glam::DVec3;
     /// The y (up) component.
     fn y(self) -> Self::Real;
     /// Sets the y (up) component.
     fn set_y(&mut self, y: Self::Real);
+    /// `if_true` where `mask` is set, `if_false` elsewhere.
+    fn select(mask: <Self::Real as Real>::Mask, if_true: Self, if_false: Self) -> Self;
 }
 
 macro_rules! impl_vector3 {
@@ -131,12 +164,12 @@ macro_rules! impl_vector3 {
                 <$v>::new(x as $t, y as $t, z as $t)
             }
             #[inline]
-            fn to_dvec3(self) -> glam::DVec3 {
-                glam::DVec3::new(self.x as f64, self.y as f64, self.z as f64)
-            }
-            #[inline]
             fn y(self) -> $t {
                 self.y
+            }
+            #[inline]
+            fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
+                if mask { if_true } else { if_false }
             }
             #[inline]
             fn set_y(&mut self, y: $t) {
@@ -152,13 +185,13 @@ impl_vector3!(glam::DVec3, f64);
 /// Whether `a` and `b` span no plane at working precision: |a×b| ≤ ε·|a|·|b|, compared squared
 /// (no square roots; the squares overflow only for coordinates beyond about 10¹⁹ in f32).
 ///
-/// True when either vector is zero or the sine of the angle between them is below machine
+/// Set when either vector is zero or the sine of the angle between them is below machine
 /// epsilon; the normal `a×b/|a×b|` is then meaningless.
 #[inline]
-pub fn spans_no_plane<V: Vector3>(a: V, b: V, a_cross_b: V) -> bool {
+pub fn spans_no_plane<V: Vector3>(a: V, b: V, a_cross_b: V) -> <V::Real as Real>::Mask {
     let lhs = a_cross_b.length_squared();
     let epsilon = V::Real::EPSILON;
     let rhs = epsilon * epsilon * a.length_squared() * b.length_squared();
     // Anything but "greater" (also NaN from overflowing inputs) means no plane.
-    lhs.partial_cmp(&rhs) != Some(std::cmp::Ordering::Greater)
+    !lhs.gt(rhs)
 }

@@ -40,13 +40,7 @@ pub fn evaluate<V: Vector3>(p: &[V; 2], rest: V::Real) -> Evaluation<V, 2> {
     let delta = p[0] - p[1];
     let length = delta.length();
     let value = length - rest;
-    if !length.is_finite() || length <= V::Real::MIN_POSITIVE {
-        return Evaluation::degenerate(value);
-    }
+    let degenerate = !length.finite() | length.le(V::Real::MIN_POSITIVE);
     let direction = delta / length;
-    Evaluation {
-        value,
-        gradients: [direction, -direction],
-        degenerate: false,
-    }
+    Evaluation::unless_degenerate(degenerate, value, value, [direction, -direction])
 }

@@ -12,13 +12,13 @@
 //! | [`volume`] | p0, p1, p2, p3 | ⅙ (p1 − p0)·((p2 − p0)×(p3 − p0)) − V |
 //!
 //! When a gradient is undefined (coincident points, a face of zero area) the evaluation is
-//! flagged [`Evaluation::degenerate`], its gradients are zero and its value stays finite.
+//! flagged ([`Evaluation::degenerate`]), its gradients are zero and its value stays finite.
 
 pub mod distance;
 pub mod plane;
 pub mod volume;
 
-use crate::vector::Vector3;
+use crate::vector::{Real, Vector3};
 use glam::DVec3;
 
 /// A constraint evaluated at one configuration: C and ∇C for each of its N particles.
@@ -28,25 +28,35 @@ pub struct Evaluation<V: Vector3, const N: usize> {
     pub value: V::Real,
     /// ∇ₚᵢC for each particle pᵢ, in the constraint's particle order.
     pub gradients: [V; N],
-    /// True when ∇C is undefined here; the gradients are then all zero.
-    pub degenerate: bool,
+    /// Set when ∇C is undefined here (per lane, for lanes); the gradients are then zero.
+    pub degenerate: <V::Real as Real>::Mask,
 }
 
 impl<V: Vector3, const N: usize> Evaluation<V, N> {
-    /// An evaluation whose gradient is undefined: finite value, zero gradients, flagged.
-    #[inline]
-    pub fn degenerate(value: V::Real) -> Self {
+    /// C and ∇C, except where `degenerate` is set: there the value is `degenerate_value` and the
+    /// gradients zero.
+    #[inline(always)]
+    pub fn unless_degenerate(
+        degenerate: <V::Real as Real>::Mask,
+        value: V::Real,
+        degenerate_value: V::Real,
+        gradients: [V; N],
+    ) -> Self {
+        let mut kept = [V::ZERO; N];
+        for (k, g) in gradients.iter().enumerate() {
+            kept[k] = V::select(degenerate, V::ZERO, *g);
+        }
         Self {
-            value,
-            gradients: [V::ZERO; N],
-            degenerate: true,
+            value: V::Real::select(degenerate, degenerate_value, value),
+            gradients: kept,
+            degenerate,
         }
     }
 
     /// Σᵢ |∇ₚᵢC|², unweighted.
     #[inline]
     pub fn gradient_norm_squared(&self) -> V::Real {
-        let mut sum = <V::Real as crate::vector::Real>::ZERO;
+        let mut sum = V::Real::ZERO;
         for g in &self.gradients {
             sum += g.length_squared();
         }

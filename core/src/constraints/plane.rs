@@ -67,18 +67,14 @@ pub fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
     let e2 = p[2] - p[0];
     let e3 = p[3] - p[0];
     let c = e2.cross(e3);
-    if spans_no_plane(e2, e3, c) {
-        return Evaluation::degenerate(-rest);
-    }
+    let degenerate = spans_no_plane(e2, e3, c);
     let area2 = c.length();
     let n = c / area2;
     let height = e1.dot(n);
     let g1 = n;
     let g2 = (e3.cross(e1) + n.cross(e3) * height) / area2;
     let g3 = -(e2.cross(e1) + n.cross(e2) * height) / area2;
-    Evaluation {
-        value: height - rest,
-        gradients: first_from_rest(g1, g2, g3),
-        degenerate: false,
-    }
+    let gradients = first_from_rest(g1, g2, g3);
+    // A face of zero area has no normal: the height counts as 0.
+    Evaluation::unless_degenerate(degenerate, height - rest, -rest, gradients)
 }

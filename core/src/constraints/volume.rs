@@ -18,7 +18,7 @@
 //! flagged degenerate.
 
 use super::{Evaluation, first_from_rest};
-use crate::vector::{Real, Vector3, spans_no_plane};
+use crate::vector::{Mask, Real, Vector3, spans_no_plane};
 
 /// The constraint and its gradients as lines of math, for display (the inspector, lessons).
 pub const FORMULA: &[&str] = &[
@@ -75,14 +75,13 @@ pub fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
     let c12 = e1.cross(e2);
     let sixth = sixth::<V::Real>();
     let value = e1.dot(c23) * sixth - rest;
-    if spans_no_plane(e2, e3, c23) && spans_no_plane(e3, e1, c31) && spans_no_plane(e1, e2, c12) {
-        return Evaluation::degenerate(value);
-    }
-    Evaluation {
-        value,
-        gradients: first_from_rest(c23 * sixth, c31 * sixth, c12 * sixth),
-        degenerate: false,
-    }
+    // All four points on one line: no two edges span a plane (rarely the case, so the later
+    // checks only run when the earlier hold).
+    let degenerate = spans_no_plane(e2, e3, c23)
+        .and_then(|| spans_no_plane(e3, e1, c31))
+        .and_then(|| spans_no_plane(e1, e2, c12));
+    let gradients = first_from_rest(c23 * sixth, c31 * sixth, c12 * sixth);
+    Evaluation::unless_degenerate(degenerate, value, value, gradients)
 }
 
 #[inline]
