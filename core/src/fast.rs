@@ -4,7 +4,7 @@
 //!
 //! What is the same: the constraint formulas (the generic code of [`crate::constraints`] for
 //! [`Vec3A`]), the projection rule ([`crate::solver`]'s `correction`), the integration
-//! ([`crate::integrate`]), rest values, masses and pins (taken from a [`Simulation`]).
+//! (`integrate`), rest values, masses and pins (taken from a [`Simulation`]).
 //!
 //! What differs, for speed:
 //! - particles are renumbered along a Morton (Z-order) curve, so that particles close in space are

@@ -109,6 +109,11 @@ pub struct TetlabApp {
     pub classroom: bool,
     lesson_path: String,
     compare_families: PerFamily<bool>,
+    /// Frames drawn so far (the first one is announced in a browser).
+    frames_drawn: u64,
+    /// Dropped files read in the background.
+    #[cfg(target_arch = "wasm32")]
+    inbox: files::Inbox,
     /// "Open mesh file…" while it is open.
     #[cfg(not(target_arch = "wasm32"))]
     browser: Option<browser::FileBrowser>,
@@ -154,6 +159,9 @@ impl TetlabApp {
             classroom: false,
             lesson_path: String::new(),
             compare_families: PerFamily::splat(true),
+            frames_drawn: 0,
+            #[cfg(target_arch = "wasm32")]
+            inbox: files::Inbox::default(),
             #[cfg(not(target_arch = "wasm32"))]
             browser: None,
         }
@@ -339,7 +347,14 @@ impl TetlabApp {
         }
         let dropped = ctx.input(|i| i.raw.dropped_files.clone());
         for file in dropped {
+            #[cfg(not(target_arch = "wasm32"))]
             self.opened(files::open_dropped(file.as_ref()));
+            #[cfg(target_arch = "wasm32")]
+            files::open_dropped(file, &self.inbox);
+        }
+        #[cfg(target_arch = "wasm32")]
+        for opened in self.inbox.take() {
+            self.opened(opened);
         }
     }
 
@@ -560,6 +575,20 @@ impl eframe::App for TetlabApp {
             self.compare(families);
         }
         self.preferences.settings = *self.bench.simulation.settings();
+        self.frames_drawn += 1;
+        // The first frame is painted before the second runs: ask for a second, and announce then.
+        #[cfg(target_arch = "wasm32")]
+        if self.frames_drawn == 1 {
+            ctx.request_repaint();
+        }
+        #[cfg(target_arch = "wasm32")]
+        if self.frames_drawn == 2 {
+            crate::web::log(&format!(
+                "tetlab ready: {} with {} tets drawn",
+                self.bench.scene.name,
+                self.bench.simulation.tets().len()
+            ));
+        }
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# The browser end to end: builds the site (scripts/web.sh), serves it on localhost, opens it in
+# headless Chromium (installed with apt when missing) and checks that the workbench started and
+# drew the soft body: its "tetlab ready" line in the console, and a screenshot with the body's
+# colour in it. The screenshot is kept at $TETLAB_WEB_SCREENSHOT (default: a temporary folder).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if ! command -v chromium >/dev/null; then
+  echo "== installing chromium (headless browser for the web test)"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+fi
+work=$(mktemp -d)
+scripts/web.sh "$work/site"
+
+port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+python3 -m http.server --bind 127.0.0.1 --directory "$work/site" "$port" >/dev/null 2>&1 &
+server=$!
+trap 'kill $server 2>/dev/null || true' EXIT
+sleep 1
+
+shot="${TETLAB_WEB_SCREENSHOT:-$work/web.png}"
+echo "== opening http://127.0.0.1:$port/ in headless chromium"
+chromium --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking \
+  --disable-component-update --disable-sync --disable-quic --enable-unsafe-swiftshader \
+  --user-data-dir="$work/profile" --window-size=1280,800 --virtual-time-budget=15000 \
+  --enable-logging=stderr --v=0 --screenshot="$shot" "http://127.0.0.1:$port/" \
+  >"$work/chromium.log" 2>&1 || true
+
+if ! grep -q "tetlab ready" "$work/chromium.log"; then
+  echo "the page did not say \"tetlab ready\"; the browser's console:" >&2
+  grep -i "console\|error" "$work/chromium.log" | tail -20 >&2 || true
+  exit 1
+fi
+grep -o 'tetlab ready[^"]*' "$work/chromium.log" | head -1
+body=$(python3 scripts/png_colour_count.py "$shot" 150 180 210)
+echo "screenshot $shot: $body pixels of the body's colour"
+if [ "$body" -lt 20000 ]; then
+  echo "the screenshot does not show the soft body" >&2
+  exit 1
+fi
+echo "web page OK"

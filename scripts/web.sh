@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Builds the workbench as a static web page: the folder it writes (site/ by default, or $1) can be
+# served by any static file server, e.g. `python3 -m http.server -d site 8000`.
+# Installs what it needs when missing: the wasm32 target (rustup) and wasm-bindgen-cli of the
+# version in Cargo.lock (cargo install). Prints the size of the .wasm, plain and gzipped.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:-site}"
+
+rustup target list --installed | grep -q '^wasm32-unknown-unknown$' ||
+  rustup target add wasm32-unknown-unknown
+version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/[^0-9.]/, ""); print; exit }' Cargo.lock)
+if ! wasm-bindgen --version 2>/dev/null | grep -q " $version\$"; then
+  echo "== installing wasm-bindgen-cli $version"
+  cargo install --quiet wasm-bindgen-cli --version "$version"
+fi
+
+echo "== building the workbench for wasm32-unknown-unknown"
+cargo build --quiet --locked --profile web --target wasm32-unknown-unknown -p tetlab --bin tetlab
+target="${CARGO_TARGET_DIR:-target}"
+mkdir -p "$out"
+wasm-bindgen --target web --no-typescript --out-dir "$out" \
+  "$target/wasm32-unknown-unknown/web/tetlab.wasm"
+cp web/index.html "$out/index.html"
+
+wasm="$out/tetlab_bg.wasm"
+bytes=$(stat -c %s "$wasm")
+gzipped=$(gzip -9 -c "$wasm" | wc -c)
+echo "wrote $out: tetlab_bg.wasm $bytes bytes ($gzipped gzipped); serve it with: python3 -m http.server -d $out 8000"
