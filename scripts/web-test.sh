@@ -32,7 +32,7 @@ if ! grep -q "tetlab ready" "$work/chromium.log"; then
   grep -i "console\|error" "$work/chromium.log" | tail -20 >&2 || true
   exit 1
 fi
-grep -o 'tetlab ready[^"]*' "$work/chromium.log" | head -1
+grep -o 'tetlab: drawing with [^"]*\|tetlab ready[^"]*' "$work/chromium.log" | head -2
 body=$(python3 scripts/png_colour_count.py "$shot" 150 180 210)
 echo "screenshot $shot: $body pixels of the body's colour"
 if [ "$body" -lt 20000 ]; then

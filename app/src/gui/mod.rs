@@ -130,6 +130,11 @@ impl TetlabApp {
             .as_ref()
             .ok_or("tetlab's 3D view needs the wgpu renderer")?;
         render::Renderer::install(render_state);
+        #[cfg(target_arch = "wasm32")]
+        crate::web::log(&format!(
+            "tetlab: drawing with {:?}",
+            render_state.adapter.get_info().backend
+        ));
         install_fonts(&cc.egui_ctx);
         let preferences: Preferences = cc
             .storage

@@ -133,20 +133,25 @@ pub fn show(
         let builtin = Builtin::from_name(&choice.builtin).unwrap_or(Builtin::Cube);
         request = Some(SceneRequest::Builtin(builtin, choice.resolution));
     }
-    ui.horizontal(|ui| {
-        ui.add(
-            egui::TextEdit::singleline(&mut choice.path)
-                .hint_text(".msh, .node or .ele path")
-                .desired_width(170.0),
-        )
-        .labelled_by(ui.label("mesh file").id);
-        if ui
-            .add_enabled(!choice.path.trim().is_empty(), egui::Button::new("Open"))
-            .clicked()
-        {
-            request = Some(SceneRequest::File(choice.path.trim().to_owned()));
-        }
-    });
+    if cfg!(target_arch = "wasm32") {
+        // A page cannot open files by path: meshes and lessons are dropped on it.
+        ui.label("drop a .msh mesh or a lesson .toml on the page to open it");
+    } else {
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::TextEdit::singleline(&mut choice.path)
+                    .hint_text(".msh, .node or .ele path")
+                    .desired_width(170.0),
+            )
+            .labelled_by(ui.label("mesh file").id);
+            if ui
+                .add_enabled(!choice.path.trim().is_empty(), egui::Button::new("Open"))
+                .clicked()
+            {
+                request = Some(SceneRequest::File(choice.path.trim().to_owned()));
+            }
+        });
+    }
     if !cfg!(target_arch = "wasm32")
         && ui
             .button("Open mesh file...")
