@@ -768,6 +768,19 @@ impl Simulation {
         edges.chain(heights).chain(volume)
     }
 
+    /// Constraint projections one frame makes with the current settings: the active families'
+    /// constraints × substeps × iterations.
+    pub fn projections_per_frame(&self) -> u64 {
+        let per_sweep: usize = Family::ALL
+            .into_iter()
+            .filter(|&f| self.settings.active.get(f))
+            .map(|f| self.constraint_count(f))
+            .sum();
+        per_sweep as u64
+            * self.settings.substeps.max(1) as u64
+            * self.settings.iterations.max(1) as u64
+    }
+
     /// How many constraints `family` has.
     pub fn constraint_count(&self, family: Family) -> usize {
         match family {

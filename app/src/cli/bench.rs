@@ -112,17 +112,7 @@ fn time_reference(
     }
     let elapsed = started.elapsed();
     sound(simulation.is_sound())?;
-    let s = simulation.settings();
-    let per_sweep: usize = [
-        (s.active.edges, simulation.edges.len()),
-        (s.active.plane, simulation.planes.len()),
-        (s.active.volume, simulation.volumes.len()),
-    ]
-    .iter()
-    .filter(|(on, _)| *on)
-    .map(|(_, n)| n)
-    .sum();
-    let projections = per_sweep as u64 * s.substeps as u64 * s.iterations as u64;
+    let projections = simulation.projections_per_frame();
     Ok(report(
         args,
         scene,
