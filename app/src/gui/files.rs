@@ -12,19 +12,18 @@ pub enum Opened {
     Lesson(Box<Lesson>),
 }
 
-/// Opens a mesh or lesson file by path.
+/// Opens a mesh or lesson file by path. A TetGen mesh is read from its two files (`.node` and
+/// `.ele`); anything else is read here and opened by [`open_bytes`], as in a browser.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn open_path(path: &str) -> Result<Opened, String> {
     let path = std::path::Path::new(path);
-    if path.extension().is_some_and(|e| e == "toml") {
-        Lesson::load(path)
-            .map(|lesson| Opened::Lesson(Box::new(lesson)))
-            .map_err(|e| e.to_string())
-    } else {
-        Scene::load(path)
+    if path.extension().is_some_and(|e| e == "node" || e == "ele") {
+        return Scene::load(path)
             .map(Opened::Scene)
-            .map_err(|e| e.to_string())
+            .map_err(|e| e.to_string());
     }
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    open_bytes(path, &bytes)
 }
 
 /// Paths cannot be opened in a browser.
@@ -69,7 +68,6 @@ impl Inbox {
 
 /// Opens a file given by name and contents: a lesson (.toml) or a Gmsh mesh (.msh). A TetGen mesh
 /// is two files, which a browser hands over one by one.
-#[cfg(target_arch = "wasm32")]
 fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
     let text =
         std::str::from_utf8(bytes).map_err(|_| format!("{}: not a text file", name.display()))?;
@@ -95,5 +93,41 @@ fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
             "{}: not a mesh (.msh) or a lesson (.toml)",
             name.display()
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn opened_name(opened: Result<Opened, String>) -> String {
+        match opened {
+            Ok(Opened::Scene(scene)) => format!("scene {}", scene.name),
+            Ok(Opened::Lesson(lesson)) => format!("lesson {}", lesson.title),
+            Err(message) => message,
+        }
+    }
+
+    /// What a browser hands over (a name and the bytes) opens as on the desktop.
+    #[test]
+    fn dropped_bytes_open_meshes_and_lessons_and_explain_what_they_cannot() {
+        let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
+        let ball = std::fs::read(shared.join("ball_v41.msh")).unwrap();
+        assert_eq!(
+            opened_name(open_bytes(Path::new("ball_v41.msh"), &ball)),
+            "scene ball_v41"
+        );
+        let lesson = tetlab_core::lesson::BUILTIN[0];
+        assert!(
+            opened_name(open_bytes(Path::new(lesson.file), lesson.text.as_bytes()))
+                .starts_with("lesson 1.")
+        );
+        let node = opened_name(open_bytes(Path::new("bunny.node"), b"4 3 0 0\n"));
+        assert!(node.contains("two files"), "{node}");
+        let bad = opened_name(open_bytes(Path::new("bad.msh"), b"$MeshFormat\n9.9 0 8\n"));
+        assert!(bad.starts_with("bad.msh:2:"), "{bad}");
+        assert!(opened_name(open_bytes(Path::new("x.msh"), &[0xff, 0xfe])).contains("not a text"));
+        assert!(opened_name(open_bytes(Path::new("notes.txt"), b"hi")).contains("not a mesh"));
     }
 }
