@@ -361,6 +361,7 @@ fn step_by_step_projects_one_constraint_per_key_press() {
         .expect("the volume is next");
     assert_eq!(pending.family, tetlab_core::constraints::Family::Volume);
     harness.get_by_label_contains("next projects volume #0");
+    harness.get_by_label_contains("last: projected distance #5");
     assert!(
         pixels_like(&mut harness, tetlab::gui::geometry::PENDING) > 50,
         "the pending constraint is highlighted"

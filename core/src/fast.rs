@@ -18,7 +18,7 @@
 use crate::constraints::{Evaluation, Family, distance, plane, volume};
 use crate::integrate;
 use crate::lanes::{F32x4, LANES, Vec3x4};
-use crate::solver::{Rule, Settings, Simulation, correction, correction_lanes};
+use crate::solver::{PerFamily, Rule, Settings, Simulation, correction, correction_lanes};
 use crate::vector::Vector3;
 use glam::{DVec3, Vec3A};
 use std::ops::Range;
@@ -270,19 +270,11 @@ impl FastSimulation {
 
     /// Constraint projections one frame makes with the current settings.
     pub fn projections_per_frame(&self) -> u64 {
-        let active = self.settings.active;
-        let per_sweep: usize = [
-            (active.edges, self.edges.len()),
-            (active.plane, self.planes.len()),
-            (active.volume, self.volumes.len()),
-        ]
-        .iter()
-        .filter(|(on, _)| *on)
-        .map(|(_, n)| n)
-        .sum();
-        per_sweep as u64
-            * self.settings.substeps.max(1) as u64
-            * self.settings.iterations.max(1) as u64
+        self.settings.projections_per_frame(PerFamily {
+            edges: self.edges.len(),
+            plane: self.planes.len(),
+            volume: self.volumes.len(),
+        })
     }
 
     /// The bytes of memory the solver's arrays take.

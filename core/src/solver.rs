@@ -157,6 +157,19 @@ pub struct Settings {
     pub settle_edits: bool,
 }
 
+impl Settings {
+    /// Constraint projections in one frame, given how many constraints each family has: the
+    /// active families' counts × substeps × iterations.
+    pub fn projections_per_frame(&self, counts: PerFamily<usize>) -> u64 {
+        let per_sweep: usize = Family::ALL
+            .into_iter()
+            .filter(|&f| self.active.get(f))
+            .map(|f| counts.get(f))
+            .sum();
+        per_sweep as u64 * self.substeps.max(1) as u64 * self.iterations.max(1) as u64
+    }
+}
+
 impl Default for Settings {
     /// XPBD, edges + volume, rigid, 10 substeps of 1 iteration, Δt = 1/60 s, gravity 9.81 m/s²,
     /// ground on, no damping.
@@ -771,14 +784,11 @@ impl Simulation {
     /// Constraint projections one frame makes with the current settings: the active families'
     /// constraints × substeps × iterations.
     pub fn projections_per_frame(&self) -> u64 {
-        let per_sweep: usize = Family::ALL
-            .into_iter()
-            .filter(|&f| self.settings.active.get(f))
-            .map(|f| self.constraint_count(f))
-            .sum();
-        per_sweep as u64
-            * self.settings.substeps.max(1) as u64
-            * self.settings.iterations.max(1) as u64
+        self.settings.projections_per_frame(PerFamily {
+            edges: self.edges.len(),
+            plane: self.planes.len(),
+            volume: self.volumes.len(),
+        })
     }
 
     /// How many constraints `family` has.

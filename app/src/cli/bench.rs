@@ -103,14 +103,7 @@ fn time_reference(
     scene: &Scene,
     simulation: &mut Simulation,
 ) -> Result<Report, UsageError> {
-    for _ in 0..args.warmup {
-        simulation.step();
-    }
-    let started = Instant::now();
-    for _ in 0..args.frames {
-        simulation.step();
-    }
-    let elapsed = started.elapsed();
+    let elapsed = time(args, simulation, Simulation::step, |_| {});
     sound(simulation.is_sound())?;
     let projections = simulation.projections_per_frame();
     Ok(report(
@@ -128,15 +121,12 @@ fn time_reference(
 
 fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Report, UsageError> {
     let mut fast = FastSimulation::new(simulation, args.threads as usize);
-    for _ in 0..args.warmup {
-        fast.step();
-    }
-    fast.reset_timings();
-    let started = Instant::now();
-    for _ in 0..args.frames {
-        fast.step();
-    }
-    let elapsed = started.elapsed();
+    let elapsed = time(
+        args,
+        &mut fast,
+        FastSimulation::step,
+        FastSimulation::reset_timings,
+    );
     sound(fast.is_sound())?;
     let timings = fast.timings();
     let per = |k: usize| {
@@ -168,6 +158,20 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
         fast.heap_bytes(),
         Some(colours),
     ))
+}
+
+/// Runs `--warmup` frames, then `warmed` (e.g. to start per-family timings afresh), then times
+/// `--frames` frames.
+fn time<S>(args: &Args, solver: &mut S, step: fn(&mut S), warmed: fn(&mut S)) -> Duration {
+    for _ in 0..args.warmup {
+        step(solver);
+    }
+    warmed(solver);
+    let started = Instant::now();
+    for _ in 0..args.frames {
+        step(solver);
+    }
+    started.elapsed()
 }
 
 fn sound(sound: bool) -> Result<(), UsageError> {

@@ -6,7 +6,7 @@ use eframe::egui;
 use tetlab_core::constraints::Family;
 use tetlab_core::scene::Builtin;
 use tetlab_core::solver::Method;
-use tetlab_core::stepper::Next;
+use tetlab_core::stepper::{Advanced, Next};
 
 /// A scene the user asked for.
 #[derive(Clone, Debug, PartialEq)]
@@ -86,7 +86,27 @@ fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>)
         ),
         (_, None) => String::new(),
     };
+    let last = match bench.last_advance {
+        Some(Advanced::BeganSubstep) => "last: predicted x += v h (gravity)".to_owned(),
+        Some(Advanced::Projected(p)) => format!(
+            "last: projected {} #{}, C was {:+.3e}",
+            p.family.name(),
+            p.constraint,
+            p.value
+        ),
+        Some(Advanced::EndedSweep { ended_substep }) => {
+            if ended_substep {
+                "last: ground and velocities; substep done".to_owned()
+            } else {
+                "last: ground; sweep done".to_owned()
+            }
+        }
+        None => String::new(),
+    };
     ui.label(egui::RichText::new(status).monospace());
+    if !last.is_empty() {
+        ui.label(egui::RichText::new(last).monospace());
+    }
 }
 
 /// Shows playback and solver controls; playback buttons add to `actions`. Returns a scene to
