@@ -376,11 +376,11 @@ fn one() -> u32 {
 struct RawSettings {
     constraints: Option<Spanned<String>>,
     solver: Option<Spanned<String>>,
-    substeps: Option<u32>,
-    iterations: Option<u32>,
-    dt: Option<f64>,
-    gravity: Option<f64>,
-    damping: Option<f64>,
+    substeps: Option<Spanned<u32>>,
+    iterations: Option<Spanned<u32>>,
+    dt: Option<Spanned<f64>>,
+    gravity: Option<Spanned<f64>>,
+    damping: Option<Spanned<f64>>,
     settle_edits: Option<bool>,
     #[serde(default)]
     compliance: BTreeMap<String, Spanned<f64>>,
@@ -469,41 +469,52 @@ impl Lesson {
         if let Some(solver) = &s.solver {
             settings.method = Method::parse(solver.get_ref()).map_err(at(solver.span()))?;
         }
-        let range = |name: &str, value: Option<u32>| -> Result<Option<u32>, LessonError> {
+        // Each setting checked by `ok`; a failure names the file and line of the value.
+        let check = |name: &str,
+                     value: &Option<Spanned<f64>>,
+                     ok: fn(f64) -> bool,
+                     expected: &str|
+         -> Result<Option<f64>, LessonError> {
             match value {
-                Some(n) if !(1..=1000).contains(&n) => Err(error(
-                    None,
-                    format!("settings.{name} = {n} is outside 1..=1000"),
+                Some(v) if !ok(*v.get_ref()) => Err(error(
+                    Some(v.span()),
+                    format!("settings.{name} = {} is {expected}", v.get_ref()),
                 )),
-                other => Ok(other),
+                other => Ok(other.as_ref().map(|v| *v.get_ref())),
             }
         };
-        settings.substeps = range("substeps", s.substeps)?.unwrap_or(settings.substeps);
-        settings.iterations = range("iterations", s.iterations)?.unwrap_or(settings.iterations);
-        if let Some(dt) = s.dt {
-            if !(dt > 0.0 && dt <= 1.0) {
-                return Err(error(
-                    None,
-                    format!("settings.dt = {dt} is outside 0 < dt <= 1"),
-                ));
-            }
+        let whole = |v: &Option<Spanned<u32>>| {
+            v.as_ref()
+                .map(|v| Spanned::new(v.span(), *v.get_ref() as f64))
+        };
+        let in_range = |n: f64| (1.0..=1000.0).contains(&n);
+        if let Some(n) = check(
+            "substeps",
+            &whole(&s.substeps),
+            in_range,
+            "outside 1..=1000",
+        )? {
+            settings.substeps = n as u32;
+        }
+        if let Some(n) = check(
+            "iterations",
+            &whole(&s.iterations),
+            in_range,
+            "outside 1..=1000",
+        )? {
+            settings.iterations = n as u32;
+        }
+        let dt_ok = |dt: f64| dt > 0.0 && dt <= 1.0;
+        if let Some(dt) = check("dt", &s.dt, dt_ok, "outside 0 < dt <= 1")? {
             settings.dt = dt;
         }
-        if let Some(g) = s.gravity {
-            if !g.is_finite() {
-                return Err(error(None, format!("settings.gravity = {g} is not finite")));
-            }
+        if let Some(g) = check("gravity", &s.gravity, f64::is_finite, "not finite")? {
             settings.gravity = g;
             settings.ground = g != 0.0;
         }
-        if let Some(damping) = s.damping {
-            if !(damping >= 0.0 && damping.is_finite()) {
-                return Err(error(
-                    None,
-                    format!("settings.damping = {damping} is negative"),
-                ));
-            }
-            settings.damping = damping;
+        let damping_ok = |d: f64| d >= 0.0 && d.is_finite();
+        if let Some(d) = check("damping", &s.damping, damping_ok, "negative or not finite")? {
+            settings.damping = d;
         }
         settings.settle_edits = s.settle_edits.unwrap_or(settings.settle_edits);
         for (name, value) in &s.compliance {
@@ -835,6 +846,16 @@ expect = ["inverted_tets == 1", "max_edge_strain < 1e-9"]
                 "title = \"t\"\nscene = \"tet\"\n",
                 0,
                 "at least one [[step]]",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[settings]\ndt = nan\n[[step]]\ntext = \"x\"\n",
+                4,
+                "settings.dt = NaN is outside",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[settings]\n\nsubsteps = 0\n[[step]]\ntext = \"x\"\n",
+                5,
+                "settings.substeps = 0 is outside 1..=1000",
             ),
         ];
         for (text, line, message) in cases {
