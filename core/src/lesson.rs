@@ -321,6 +321,13 @@ impl Action {
         simulation.set_settings(settings);
     }
 
+    /// Whether a comparison shown beside the lesson's simulation gets this action too: every
+    /// action but [`Action::Constraints`] (each side keeps its own families) and
+    /// [`Action::Compare`] itself.
+    pub fn applies_to_comparison(self) -> bool {
+        !matches!(self, Action::Constraints(_) | Action::Compare(_))
+    }
+
     /// The tet this action refers to, if any (to check it against the scene).
     fn tet(self) -> Option<usize> {
         match self {
@@ -707,14 +714,10 @@ impl LessonRun {
         }
         let mut ignored = self.tet;
         action.apply(&mut self.simulation, &mut self.tet);
-        if let Some(comparison) = &mut self.comparison {
-            let active = comparison.settings().active;
+        if let Some(comparison) = &mut self.comparison
+            && action.applies_to_comparison()
+        {
             action.apply(comparison, &mut ignored);
-            let settings = Settings {
-                active,
-                ..*comparison.settings()
-            };
-            comparison.set_settings(settings);
         }
     }
 

@@ -206,14 +206,10 @@ impl TetlabApp {
                 LessonAction::Compare(families) => self.compare(families),
                 action => {
                     self.bench.apply_lesson_action(action);
-                    if let Some(comparison) = &mut self.comparison {
-                        let active = comparison.bench.simulation.settings().active;
+                    if let Some(comparison) = &mut self.comparison
+                        && action.applies_to_comparison()
+                    {
                         comparison.bench.apply_lesson_action(action);
-                        let settings = Settings {
-                            active,
-                            ..*comparison.bench.simulation.settings()
-                        };
-                        comparison.bench.set_settings(settings);
                     }
                 }
             }

@@ -79,26 +79,19 @@ impl Workbench {
     /// A second workbench in the same state (scene, positions, velocities, selection) but with
     /// other constraint families: the right half of a comparison.
     pub fn twin(&self, active: PerFamily<bool>) -> Workbench {
-        let mut simulation = self.simulation.clone();
-        simulation.set_settings(Settings {
+        let settings = Settings {
             active,
             ..*self.simulation.settings()
-        });
-        let mut twin = Workbench {
-            scene: self.scene.clone(),
-            metrics: Metrics::measure(&simulation),
-            simulation,
-            playing: self.playing,
-            selected_particle: self.selected_particle,
-            selected_tet: self.selected_tet,
-            dragging: None,
-            history: VecDeque::with_capacity(HISTORY),
-            scramble_seed: self.scramble_seed,
-            stepping: None,
-            last_advance: None,
         };
+        let mut twin = Workbench::new(self.scene.clone(), settings);
+        twin.simulation = self.simulation.clone();
+        twin.simulation.set_settings(settings);
         twin.simulation.release();
-        twin.record();
+        twin.playing = self.playing;
+        twin.selected_particle = self.selected_particle;
+        twin.selected_tet = self.selected_tet;
+        twin.scramble_seed = self.scramble_seed;
+        twin.after_change();
         twin
     }
 
