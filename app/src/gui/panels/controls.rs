@@ -233,7 +233,7 @@ pub fn show(
     ui.checkbox(&mut settings.ground, "ground (y = 0)");
     ui.add(egui::Slider::new(&mut settings.damping, 0.0..=10.0).text("damping"));
     ui.checkbox(&mut settings.settle_edits, "settle edits")
-        .on_hover_text("After an invert, mirror, flatten or drag, move particles back without giving them velocity");
+        .on_hover_text("After an invert, mirror, flatten or drag, corrections may move particles but not speed them up until the edit is undone");
     if settings != *bench.simulation.settings() {
         bench.set_settings(settings);
     }
