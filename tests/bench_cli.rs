@@ -52,6 +52,40 @@ fn the_report_counts_the_work_of_a_frame() {
     let report = bench_json(&["--scene", "tet", "--frames", "2", "--threads", "2"]);
     assert_eq!(report["threads"], 2);
     assert_eq!(report["solver"], "fast (f32)");
+    assert!(
+        report["lanes"]
+            .as_str()
+            .unwrap()
+            .starts_with("8 f32 per batch"),
+        "{}",
+        report["lanes"]
+    );
+    let error = &report["relative_error"];
+    assert!(error["edges"].as_f64().unwrap().is_finite());
+    assert!(error["plane"].is_null(), "heights not active");
+}
+
+#[test]
+fn jacobi_order_is_reported_with_how_well_it_holds_the_constraints() {
+    let run = |extra: &[&str]| {
+        let mut args = vec!["--scene", "cube", "--resolution", "4", "--frames", "30"];
+        args.extend_from_slice(extra);
+        bench_json(&args)
+    };
+    let gauss_seidel = run(&[]);
+    let jacobi = run(&["--jacobi", "--relaxation", "1.2"]);
+    assert_eq!(jacobi["solver"], "fast (f32), Jacobi");
+    assert_eq!(
+        jacobi["projections_per_frame"],
+        gauss_seidel["projections_per_frame"]
+    );
+    for family in ["edges", "volume"] {
+        let gs = gauss_seidel["relative_error"][family].as_f64().unwrap();
+        let j = jacobi["relative_error"][family].as_f64().unwrap();
+        assert!(j > gs, "{family}: Jacobi {j}, Gauss–Seidel {gs}");
+    }
+    let reference = bench_json(&["--scene", "tet", "--frames", "2", "--reference"]);
+    assert!(reference["relative_error"].is_null());
 }
 
 #[test]
@@ -88,4 +122,12 @@ fn bad_options_are_usage_errors() {
         &tetlab(&["bench", "--reference", "--threads", "2"]),
         "--threads",
     );
+    assert_usage_error(&tetlab(&["bench", "--reference", "--jacobi"]), "--jacobi");
+    assert_usage_error(&tetlab(&["bench", "--relaxation", "1.5"]), "--jacobi");
+    for omega in ["0", "2.5", "NaN", "-1", "x"] {
+        assert_usage_error(
+            &tetlab(&["bench", "--jacobi", &format!("--relaxation={omega}")]),
+            "--relaxation",
+        );
+    }
 }

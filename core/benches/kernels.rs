@@ -1,13 +1,17 @@
 //! The projection kernels alone: one constraint evaluated and its correction computed, in f32 (the
-//! fast solver), f64 (the reference) and four at once in f32 SIMD lanes (the fast solver's main
-//! loop), for each family. `cargo bench -p tetlab-core`.
+//! fast solver), f64 (the reference) and eight at once in f32 SIMD lanes (the fast solver's main
+//! loop), for each family; and one whole frame of the fast solver. `cargo bench -p tetlab-core`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3A};
 use std::hint::black_box;
+use std::path::Path;
 use tetlab_core::constraints::{distance, plane, volume};
-use tetlab_core::lanes::{F32x4, Vec3x4};
+use tetlab_core::fast::{FastSimulation, Order};
+use tetlab_core::lanes::{F32x8, LANES, Vec3x8};
+use tetlab_core::scene::{Builtin, Scene};
 use tetlab_core::solver::project_kernel;
+use tetlab_core::solver::{PerFamily, Settings, Simulation};
 
 fn kernels(c: &mut Criterion) {
     let tet = [
@@ -52,27 +56,27 @@ fn kernels(c: &mut Criterion) {
     group.bench_function("volume f64", |b| {
         b.iter(|| project_kernel(volume::evaluate::<DVec3>, black_box(&tet), 0.2, w))
     });
-    // Four constraints at once in SIMD lanes (time per four).
-    let lanes = tet32.map(|p| Vec3x4::gather([p; 4]));
-    let w4 = w32.map(|x| F32x4::new([x; 4]));
-    let rest4 = |r: f32| F32x4::new([r; 4]);
-    group.bench_function("distance f32 x4 lanes", |b| {
+    // Eight constraints at once in SIMD lanes (time per eight).
+    let lanes = tet32.map(|p| Vec3x8::gather([p; LANES]));
+    let w4 = w32.map(|x| F32x8::new([x; LANES]));
+    let rest4 = |r: f32| F32x8::new([r; LANES]);
+    group.bench_function("distance f32 x8 lanes", |b| {
         b.iter(|| {
             project_kernel(
-                distance::evaluate::<Vec3x4>,
+                distance::evaluate::<Vec3x8>,
                 black_box(&[lanes[0], lanes[1]]),
                 rest4(0.9),
                 [w4[0], w4[1]],
             )
         })
     });
-    group.bench_function("plane f32 x4 lanes", |b| {
-        b.iter(|| project_kernel(plane::evaluate::<Vec3x4>, black_box(&lanes), rest4(0.7), w4))
+    group.bench_function("plane f32 x8 lanes", |b| {
+        b.iter(|| project_kernel(plane::evaluate::<Vec3x8>, black_box(&lanes), rest4(0.7), w4))
     });
-    group.bench_function("volume f32 x4 lanes", |b| {
+    group.bench_function("volume f32 x8 lanes", |b| {
         b.iter(|| {
             project_kernel(
-                volume::evaluate::<Vec3x4>,
+                volume::evaluate::<Vec3x8>,
                 black_box(&lanes),
                 rest4(0.2),
                 w4,
@@ -82,5 +86,35 @@ fn kernels(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kernels);
+/// One frame of the fast solver (edges + volume, 10 substeps) on the bunny of ../shared/meshes, or
+/// on a cube of about the same size when the shared meshes are not there: Gauss–Seidel and
+/// Jacobi. The same work as `tetlab bench`, here so that builds for other CPUs are quick to
+/// compare (`RUSTFLAGS="-C target-cpu=x86-64" cargo bench -p tetlab-core -- frame`).
+fn frame(c: &mut Criterion) {
+    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes/bunny.node");
+    let (name, scene) = match Scene::load(&bunny) {
+        Ok(scene) => ("bunny", scene),
+        Err(_) => (
+            "cube 6",
+            Scene::builtin(Builtin::Cube, 6).expect("a built-in cube"),
+        ),
+    };
+    let settings = Settings {
+        active: PerFamily::parse_list("edges,volume").expect("two families"),
+        ..Settings::default()
+    };
+    let simulation = Simulation::new(&scene, settings);
+    let mut group = c.benchmark_group("frame");
+    for (order, label) in [
+        (Order::GaussSeidel, "Gauss-Seidel"),
+        (Order::Jacobi { relaxation: 1.0 }, "Jacobi"),
+    ] {
+        let mut fast = FastSimulation::new(&simulation, 1);
+        fast.set_order(order);
+        group.bench_function(format!("{name}, fast, {label}"), |b| b.iter(|| fast.step()));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, kernels, frame);
 criterion_main!(benches);

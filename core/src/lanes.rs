@@ -1,24 +1,39 @@
-//! Four f32 numbers (and 3-vectors) side by side, so that the generic constraint formulas run on
-//! four independent constraints at once: [`F32x4`] wraps `wide`'s SSE vector, [`Vec3x4`] holds
-//! four x, four y and four z. A lane computes the same IEEE operations as the formula on one f32.
+//! Eight f32 numbers (and 3-vectors) side by side, so that the generic constraint formulas run on
+//! eight independent constraints at once: [`F32x8`] wraps `wide`'s eight-lane vector (one AVX
+//! register where the build targets a CPU with AVX, two SSE registers otherwise), [`Vec3x8`] holds
+//! eight x, eight y and eight z. A lane computes the same IEEE operations as the formula on one
+//! f32, whatever the registers.
 
 use crate::vector::{Mask, Real, Vector3};
 use glam::Vec3A;
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
-use wide::f32x4;
+use wide::{f32x4, f32x8};
 
 /// How many lanes.
-pub const LANES: usize = 4;
+pub const LANES: usize = 8;
 
-/// Four f32, one per lane.
+/// How this build holds the lanes (chosen by `wide` from the CPU features the build targets).
+pub const REGISTERS: &str = if cfg!(target_feature = "avx") {
+    "one 256-bit AVX register"
+} else if cfg!(target_feature = "sse") {
+    "two 128-bit SSE registers"
+} else if cfg!(all(target_feature = "neon", target_arch = "aarch64")) {
+    "two 128-bit NEON registers"
+} else if cfg!(target_feature = "simd128") {
+    "two 128-bit WebAssembly SIMD registers"
+} else {
+    "arrays (no SIMD instructions)"
+};
+
+/// Eight f32, one per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct F32x4(pub f32x4);
+pub struct F32x8(pub f32x8);
 
 /// One flag per lane (all-ones or all-zeros bits, so that selecting is bitwise).
 #[derive(Clone, Copy, Debug)]
-pub struct Mask4(f32x4);
+pub struct Mask8(f32x8);
 
-impl F32x4 {
+impl F32x8 {
     /// The lanes as an array.
     #[inline]
     pub fn to_array(self) -> [f32; LANES] {
@@ -28,11 +43,11 @@ impl F32x4 {
     /// Lane k of the result is `values[k]`.
     #[inline]
     pub fn new(values: [f32; LANES]) -> Self {
-        F32x4(f32x4::new(values))
+        F32x8(f32x8::new(values))
     }
 }
 
-impl Mask4 {
+impl Mask8 {
     /// Whether lane k is set.
     #[inline]
     pub fn lane(self, k: usize) -> bool {
@@ -40,7 +55,7 @@ impl Mask4 {
     }
 }
 
-impl PartialEq for Mask4 {
+impl PartialEq for Mask8 {
     fn eq(&self, other: &Self) -> bool {
         self.0.to_bitmask() == other.0.to_bitmask()
     }
@@ -48,11 +63,11 @@ impl PartialEq for Mask4 {
 
 macro_rules! lane_op {
     ($trait:ident, $method:ident) => {
-        impl $trait for F32x4 {
-            type Output = F32x4;
+        impl $trait for F32x8 {
+            type Output = F32x8;
             #[inline(always)]
             fn $method(self, rhs: Self) -> Self {
-                F32x4($trait::$method(self.0, rhs.0))
+                F32x8($trait::$method(self.0, rhs.0))
             }
         }
     };
@@ -62,128 +77,153 @@ lane_op!(Sub, sub);
 lane_op!(Mul, mul);
 lane_op!(Div, div);
 
-impl Neg for F32x4 {
-    type Output = F32x4;
+impl Neg for F32x8 {
+    type Output = F32x8;
     #[inline(always)]
     fn neg(self) -> Self {
-        F32x4(-self.0)
+        F32x8(-self.0)
     }
 }
 
-impl AddAssign for F32x4 {
+impl AddAssign for F32x8 {
     #[inline(always)]
     fn add_assign(&mut self, rhs: Self) {
         self.0 = self.0 + rhs.0;
     }
 }
 
-impl SubAssign for F32x4 {
+impl SubAssign for F32x8 {
     #[inline(always)]
     fn sub_assign(&mut self, rhs: Self) {
         self.0 = self.0 - rhs.0;
     }
 }
 
-impl BitAnd for Mask4 {
-    type Output = Mask4;
+impl BitAnd for Mask8 {
+    type Output = Mask8;
     #[inline(always)]
     fn bitand(self, rhs: Self) -> Self {
-        Mask4(self.0 & rhs.0)
+        Mask8(self.0 & rhs.0)
     }
 }
 
-impl BitOr for Mask4 {
-    type Output = Mask4;
+impl BitOr for Mask8 {
+    type Output = Mask8;
     #[inline(always)]
     fn bitor(self, rhs: Self) -> Self {
-        Mask4(self.0 | rhs.0)
+        Mask8(self.0 | rhs.0)
     }
 }
 
-impl Not for Mask4 {
-    type Output = Mask4;
+impl Not for Mask8 {
+    type Output = Mask8;
     #[inline(always)]
     fn not(self) -> Self {
-        Mask4(!self.0)
+        Mask8(!self.0)
     }
 }
 
-impl Mask for Mask4 {
+impl Mask for Mask8 {
     #[inline(always)]
     fn any(self) -> bool {
         self.0.to_bitmask() != 0
     }
 }
 
-impl Real for F32x4 {
-    type Mask = Mask4;
-    const ZERO: Self = F32x4(f32x4::ZERO);
-    const ONE: Self = F32x4(f32x4::ONE);
-    const EPSILON: Self = F32x4(f32x4::EPSILON);
-    const MIN_POSITIVE: Self = F32x4(f32x4::MIN_POSITIVE);
+impl Real for F32x8 {
+    type Mask = Mask8;
+    const ZERO: Self = F32x8(f32x8::ZERO);
+    const ONE: Self = F32x8(f32x8::ONE);
+    const EPSILON: Self = F32x8(f32x8::EPSILON);
+    const MIN_POSITIVE: Self = F32x8(f32x8::MIN_POSITIVE);
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
-        F32x4(f32x4::splat(x as f32))
+        F32x8(f32x8::splat(x as f32))
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
-        F32x4(self.0.sqrt())
+        F32x8(self.0.sqrt())
     }
     #[inline(always)]
-    fn finite(self) -> Mask4 {
-        Mask4(self.0.is_finite())
+    fn finite(self) -> Mask8 {
+        Mask8(self.0.is_finite())
     }
     #[inline(always)]
-    fn le(self, other: Self) -> Mask4 {
-        Mask4(self.0.simd_le(other.0))
+    fn le(self, other: Self) -> Mask8 {
+        Mask8(self.0.simd_le(other.0))
     }
     #[inline(always)]
-    fn gt(self, other: Self) -> Mask4 {
-        Mask4(self.0.simd_gt(other.0))
+    fn gt(self, other: Self) -> Mask8 {
+        Mask8(self.0.simd_gt(other.0))
     }
     #[inline(always)]
-    fn select(mask: Mask4, if_true: Self, if_false: Self) -> Self {
-        F32x4(mask.0.bitselect(if_true.0, if_false.0))
+    fn select(mask: Mask8, if_true: Self, if_false: Self) -> Self {
+        F32x8(mask.0.bitselect(if_true.0, if_false.0))
     }
 }
 
-/// Four 3-vectors, one per lane, stored as the four x, the four y and the four z.
+/// Eight 3-vectors, one per lane, stored as the eight x, the eight y and the eight z.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Vec3x4 {
+pub struct Vec3x8 {
     /// The x components.
-    pub x: F32x4,
+    pub x: F32x8,
     /// The y components.
-    pub y: F32x4,
+    pub y: F32x8,
     /// The z components.
-    pub z: F32x4,
+    pub z: F32x8,
 }
 
-impl Vec3x4 {
+impl Vec3x8 {
     /// Lane k of the result is `vectors[k]`.
     #[inline(always)]
     pub fn gather(v: [Vec3A; LANES]) -> Self {
-        Vec3x4 {
-            x: F32x4::new([v[0].x, v[1].x, v[2].x, v[3].x]),
-            y: F32x4::new([v[0].y, v[1].y, v[2].y, v[3].y]),
-            z: F32x4::new([v[0].z, v[1].z, v[2].z, v[3].z]),
+        Self::from_rows(v.map(bytemuck::cast))
+    }
+
+    /// Lane k of the result is (x, y, z) of `rows[k]`, the register of a padded 3-vector (its
+    /// fourth component ignored): two 4 × 4 transposes.
+    #[inline(always)]
+    pub fn from_rows(rows: [f32x4; LANES]) -> Self {
+        let [r0, r1, r2, r3, r4, r5, r6, r7] = rows;
+        let [x0, y0, z0, _] = f32x4::transpose([r0, r1, r2, r3]);
+        let [x1, y1, z1, _] = f32x4::transpose([r4, r5, r6, r7]);
+        let join = |a: f32x4, b: f32x4| F32x8(bytemuck::cast([a, b]));
+        Vec3x8 {
+            x: join(x0, x1),
+            y: join(y0, y1),
+            z: join(z0, z1),
         }
     }
 
-    /// The four lanes.
+    /// The lanes as registers of padded 3-vectors (fourth component zero): the inverse of
+    /// [`Vec3x8::from_rows`].
     #[inline(always)]
-    pub fn scatter(self) -> [Vec3A; LANES] {
-        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        std::array::from_fn(|k| Vec3A::new(x[k], y[k], z[k]))
+    pub fn rows(self) -> [f32x4; LANES] {
+        let split = |a: F32x8| bytemuck::cast::<f32x8, [f32x4; 2]>(a.0);
+        let ([x0, x1], [y0, y1], [z0, z1]) = (split(self.x), split(self.y), split(self.z));
+        let [a0, a1, a2, a3] = f32x4::transpose([x0, y0, z0, f32x4::ZERO]);
+        let [b0, b1, b2, b3] = f32x4::transpose([x1, y1, z1, f32x4::ZERO]);
+        [a0, a1, a2, a3, b0, b1, b2, b3]
+    }
+
+    /// Lane k as a 3-vector.
+    #[inline]
+    pub fn lane(self, k: usize) -> Vec3A {
+        Vec3A::new(
+            self.x.to_array()[k],
+            self.y.to_array()[k],
+            self.z.to_array()[k],
+        )
     }
 }
 
 macro_rules! vector_op {
     ($trait:ident, $method:ident) => {
-        impl $trait for Vec3x4 {
+        impl $trait for Vec3x8 {
             type Output = Self;
             #[inline(always)]
             fn $method(self, r: Self) -> Self {
-                Vec3x4 {
+                Vec3x8 {
                     x: $trait::$method(self.x, r.x),
                     y: $trait::$method(self.y, r.y),
                     z: $trait::$method(self.z, r.z),
@@ -195,11 +235,11 @@ macro_rules! vector_op {
 vector_op!(Add, add);
 vector_op!(Sub, sub);
 
-impl Neg for Vec3x4 {
+impl Neg for Vec3x8 {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
-        Vec3x4 {
+        Vec3x8 {
             x: -self.x,
             y: -self.y,
             z: -self.z,
@@ -207,11 +247,11 @@ impl Neg for Vec3x4 {
     }
 }
 
-impl Mul<F32x4> for Vec3x4 {
+impl Mul<F32x8> for Vec3x8 {
     type Output = Self;
     #[inline(always)]
-    fn mul(self, s: F32x4) -> Self {
-        Vec3x4 {
+    fn mul(self, s: F32x8) -> Self {
+        Vec3x8 {
             x: self.x * s,
             y: self.y * s,
             z: self.z * s,
@@ -219,11 +259,11 @@ impl Mul<F32x4> for Vec3x4 {
     }
 }
 
-impl Div<F32x4> for Vec3x4 {
+impl Div<F32x8> for Vec3x8 {
     type Output = Self;
     #[inline(always)]
-    fn div(self, s: F32x4) -> Self {
-        Vec3x4 {
+    fn div(self, s: F32x8) -> Self {
+        Vec3x8 {
             x: self.x / s,
             y: self.y / s,
             z: self.z / s,
@@ -231,34 +271,34 @@ impl Div<F32x4> for Vec3x4 {
     }
 }
 
-impl AddAssign for Vec3x4 {
+impl AddAssign for Vec3x8 {
     #[inline(always)]
     fn add_assign(&mut self, r: Self) {
         *self = *self + r;
     }
 }
 
-impl SubAssign for Vec3x4 {
+impl SubAssign for Vec3x8 {
     #[inline(always)]
     fn sub_assign(&mut self, r: Self) {
         *self = *self - r;
     }
 }
 
-impl Vector3 for Vec3x4 {
-    type Real = F32x4;
-    const ZERO: Self = Vec3x4 {
-        x: F32x4::ZERO,
-        y: F32x4::ZERO,
-        z: F32x4::ZERO,
+impl Vector3 for Vec3x8 {
+    type Real = F32x8;
+    const ZERO: Self = Vec3x8 {
+        x: F32x8::ZERO,
+        y: F32x8::ZERO,
+        z: F32x8::ZERO,
     };
     #[inline(always)]
-    fn dot(self, r: Self) -> F32x4 {
+    fn dot(self, r: Self) -> F32x8 {
         self.x * r.x + self.y * r.y + self.z * r.z
     }
     #[inline(always)]
     fn cross(self, r: Self) -> Self {
-        Vec3x4 {
+        Vec3x8 {
             x: self.y * r.z - self.z * r.y,
             y: self.z * r.x - self.x * r.z,
             z: self.x * r.y - self.y * r.x,
@@ -266,26 +306,26 @@ impl Vector3 for Vec3x4 {
     }
     #[inline(always)]
     fn from_f64s(x: f64, y: f64, z: f64) -> Self {
-        Vec3x4 {
-            x: F32x4::from_f64(x),
-            y: F32x4::from_f64(y),
-            z: F32x4::from_f64(z),
+        Vec3x8 {
+            x: F32x8::from_f64(x),
+            y: F32x8::from_f64(y),
+            z: F32x8::from_f64(z),
         }
     }
     #[inline(always)]
-    fn y(self) -> F32x4 {
+    fn y(self) -> F32x8 {
         self.y
     }
     #[inline(always)]
-    fn set_y(&mut self, y: F32x4) {
+    fn set_y(&mut self, y: F32x8) {
         self.y = y;
     }
     #[inline(always)]
-    fn select(mask: Mask4, if_true: Self, if_false: Self) -> Self {
-        Vec3x4 {
-            x: F32x4::select(mask, if_true.x, if_false.x),
-            y: F32x4::select(mask, if_true.y, if_false.y),
-            z: F32x4::select(mask, if_true.z, if_false.z),
+    fn select(mask: Mask8, if_true: Self, if_false: Self) -> Self {
+        Vec3x8 {
+            x: F32x8::select(mask, if_true.x, if_false.x),
+            y: F32x8::select(mask, if_true.y, if_false.y),
+            z: F32x8::select(mask, if_true.z, if_false.z),
         }
     }
 }
@@ -310,10 +350,10 @@ mod tests {
             }
             // Lane 3 is degenerate: all four points on one line.
             points[3] = [Vec3A::ZERO, Vec3A::X, Vec3A::X * 2.0, Vec3A::X * 3.0];
-            let lanes: [Vec3x4; 4] =
-                std::array::from_fn(|i| Vec3x4::gather(std::array::from_fn(|k| points[k][i])));
-            let rest = [0.1, -0.2, 0.3, 0.05];
-            let r = F32x4::new(rest);
+            let lanes: [Vec3x8; 4] =
+                std::array::from_fn(|i| Vec3x8::gather(std::array::from_fn(|k| points[k][i])));
+            let rest = [0.1, -0.2, 0.3, 0.05, 0.2, -0.1, 0.0, 0.4];
+            let r = F32x8::new(rest);
             let v = volume::evaluate(&lanes, r);
             let h = plane::evaluate(&lanes, r);
             let d = distance::evaluate(&[lanes[0], lanes[1]], r);
@@ -327,14 +367,14 @@ mod tests {
                     assert!(close(lanes.value.to_array()[k], one.value));
                     assert_eq!(lanes.degenerate.lane(k), one.degenerate);
                     for (g, g1) in lanes.gradients.iter().zip(&one.gradients) {
-                        assert!((g.scatter()[k] - *g1).length() < 1e-4 * (1.0 + g1.length()));
+                        assert!((g.lane(k) - *g1).length() < 1e-4 * (1.0 + g1.length()));
                     }
                 }
                 assert!(close(d.value.to_array()[k], one_d.value));
-                assert!((d.gradients[0].scatter()[k] - one_d.gradients[0]).length() < 1e-5);
+                assert!((d.gradients[0].lane(k) - one_d.gradients[0]).length() < 1e-5);
             }
             assert!(v.degenerate.lane(3));
-            assert!(v.gradients.iter().all(|g| g.scatter()[3] == Vec3A::ZERO));
+            assert!(v.gradients.iter().all(|g| g.lane(3) == Vec3A::ZERO));
         }
     }
 }

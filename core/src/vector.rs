@@ -2,9 +2,9 @@
 //!
 //! Every formula in [`crate::constraints`] is generic over [`Vector3`], so one implementation
 //! serves the f64 path used for checking and teaching ([`glam::DVec3`]), the f32 path of the fast
-//! solver ([`glam::Vec3`], [`glam::Vec3A`]) and its SIMD path, four constraints at once
-//! ([`crate::lanes::Vec3x4`]). The formulas never branch on a value: a comparison gives a
-//! [`Mask`] (a `bool` for one number, one flag per lane for four), and [`Real::select`] picks.
+//! solver ([`glam::Vec3`], [`glam::Vec3A`]) and its SIMD path, eight constraints at once
+//! ([`crate::lanes::Vec3x8`]). The formulas never branch on a value: a comparison gives a
+//! [`Mask`] (a `bool` for one number, one flag per lane for eight), and [`Real::select`] picks.
 
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
@@ -31,7 +31,7 @@ impl Mask for bool {
     }
 }
 
-/// A floating-point number, or several in lanes: `f32`, `f64`, [`crate::lanes::F32x4`].
+/// A floating-point number, or several in lanes: `f32`, `f64`, [`crate::lanes::F32x8`].
 pub trait Real:
     Copy
     + Debug

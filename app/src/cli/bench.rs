@@ -6,7 +6,8 @@ use super::UsageError;
 use serde::Serialize;
 use std::io::Write;
 use std::time::{Duration, Instant};
-use tetlab_core::fast::FastSimulation;
+use tetlab_core::fast::{FastSimulation, Order};
+use tetlab_core::lanes::{LANES, REGISTERS};
 use tetlab_core::scene::Scene;
 use tetlab_core::solver::{Method, PerFamily, Settings, Simulation};
 
@@ -41,11 +42,26 @@ pub struct Args {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=256))]
     threads: u64,
     /// Time the reference f64 solver (the workbench's and `tetlab run`'s) instead of the fast one.
-    #[arg(long, conflicts_with = "threads")]
+    #[arg(long, conflicts_with_all = ["threads", "jacobi"])]
     reference: bool,
+    /// Fast solver in Jacobi order: each family projected from the same positions, each particle
+    /// then moved by ω × the mean of its corrections (instead of Gauss–Seidel).
+    #[arg(long)]
+    jacobi: bool,
+    /// ω for --jacobi (0 < ω ≤ 2).
+    #[arg(long, default_value_t = 1.0, requires = "jacobi", value_parser = relaxation)]
+    relaxation: f32,
     /// End with one JSON object.
     #[arg(long)]
     json: bool,
+}
+
+/// ω: a finite number in (0, 2].
+fn relaxation(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(omega) if omega > 0.0 && omega <= 2.0 => Ok(omega),
+        _ => Err(format!("`{text}` is not a number in (0, 2]")),
+    }
 }
 
 /// What `--json` prints.
@@ -69,6 +85,10 @@ struct Report {
     bytes_per_tet: f64,
     peak_rss_bytes: Option<u64>,
     colours: Option<ByFamily>,
+    /// How the fast solver's SIMD lanes are held on this build.
+    lanes: Option<String>,
+    /// After the run, per active family: √(mean (C / rest value)²).
+    relative_error: Option<PerFamily<Option<f64>>>,
 }
 
 #[derive(Debug, Serialize)]
@@ -121,6 +141,11 @@ fn time_reference(
 
 fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Report, UsageError> {
     let mut fast = FastSimulation::new(simulation, args.threads as usize);
+    if args.jacobi {
+        fast.set_order(Order::Jacobi {
+            relaxation: args.relaxation,
+        });
+    }
     let elapsed = time(
         args,
         &mut fast,
@@ -147,17 +172,25 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
         plane: fast.planes.colours.len() as f64,
         volume: fast.volumes.colours.len() as f64,
     };
-    Ok(report(
+    let solver = if args.jacobi {
+        "fast (f32), Jacobi"
+    } else {
+        "fast (f32)"
+    };
+    let mut report = report(
         args,
         scene,
-        "fast (f32)",
+        solver,
         fast.threads(),
         fast.projections_per_frame(),
         elapsed,
         Some(by_family),
         fast.heap_bytes(),
         Some(colours),
-    ))
+    );
+    report.lanes = Some(format!("{LANES} f32 per batch, in {REGISTERS}"));
+    report.relative_error = Some(fast.relative_error());
+    Ok(report)
 }
 
 /// Runs `--warmup` frames, then `warmed` (e.g. to start per-family timings afresh), then times
@@ -218,6 +251,8 @@ fn report(
         bytes_per_tet: heap_bytes as f64 / tets.max(1) as f64,
         peak_rss_bytes: peak_rss(),
         colours,
+        lanes: None,
+        relative_error: None,
     }
 }
 
@@ -268,6 +303,25 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
             out,
             "colours                edges {}, plane {}, volume {}",
             c.edges, c.plane, c.volume
+        )?;
+    }
+    if let Some(lanes) = &r.lanes {
+        writeln!(out, "SIMD lanes             {lanes}")?;
+    }
+    if let Some(error) = &r.relative_error {
+        let families = [
+            ("edges", error.edges),
+            ("plane", error.plane),
+            ("volume", error.volume),
+        ];
+        let shown: Vec<String> = families
+            .iter()
+            .filter_map(|(name, e)| e.map(|e| format!("{name} {e:.2e}")))
+            .collect();
+        writeln!(
+            out,
+            "error at the end       {} (RMS of C / rest value)",
+            shown.join(", ")
         )?;
     }
     if json {
