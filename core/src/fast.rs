@@ -634,6 +634,7 @@ impl Formula<4> for VolumeFormula {
 /// the sums.)
 #[allow(unsafe_code)]
 mod particles {
+    use crate::lanes::{padded, unpadded};
     use glam::Vec3A;
     use std::marker::PhantomData;
     use wide::f32x4;
@@ -666,7 +667,7 @@ mod particles {
         pub(super) fn get(self, i: u32) -> f32x4 {
             debug_assert!((i as usize) < self.len);
             // SAFETY: i is an index of the batches, below `len` (see the module).
-            bytemuck::cast(unsafe { self.ptr.add(i as usize).read() })
+            padded(unsafe { self.ptr.add(i as usize).read() })
         }
 
         /// Moves particle `i` by the first three lanes of `delta` (its fourth is zero).
@@ -676,7 +677,7 @@ mod particles {
             // SAFETY: as for `get`; and no other thread reads or writes particle i meanwhile.
             unsafe {
                 let p = self.ptr.add(i as usize);
-                p.write(p.read() + bytemuck::cast::<f32x4, Vec3A>(delta));
+                p.write(p.read() + unpadded(delta));
             }
         }
     }

@@ -25,6 +25,29 @@ pub const REGISTERS: &str = if cfg!(target_feature = "avx") {
     "arrays (no SIMD instructions)"
 };
 
+/// A padded 3-vector's register as four lanes: x, y, z and the padding (whose value the kernels
+/// ignore). Free where glam keeps `Vec3A` in an SSE register; elsewhere built from the
+/// components, with a zero fourth lane.
+#[inline(always)]
+pub fn padded(v: Vec3A) -> f32x4 {
+    #[cfg(target_feature = "sse2")]
+    return bytemuck::cast(v);
+    #[cfg(not(target_feature = "sse2"))]
+    return f32x4::new([v.x, v.y, v.z, 0.0]);
+}
+
+/// The 3-vector of the first three lanes: the inverse of [`padded`].
+#[inline(always)]
+pub fn unpadded(lanes: f32x4) -> Vec3A {
+    #[cfg(target_feature = "sse2")]
+    return bytemuck::cast(lanes);
+    #[cfg(not(target_feature = "sse2"))]
+    return {
+        let [x, y, z, _] = lanes.to_array();
+        Vec3A::new(x, y, z)
+    };
+}
+
 /// Eight f32, one per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct F32x8(pub f32x8);
@@ -177,7 +200,7 @@ impl Vec3x8 {
     /// Lane k of the result is `vectors[k]`.
     #[inline(always)]
     pub fn gather(v: [Vec3A; LANES]) -> Self {
-        Self::from_rows(v.map(bytemuck::cast))
+        Self::from_rows(v.map(padded))
     }
 
     /// Lane k of the result is (x, y, z) of `rows[k]`, the register of a padded 3-vector (its
