@@ -149,17 +149,25 @@ impl<const N: usize> Batches<N> {
 
     /// The particles and rest value of each constraint, colour by colour, padding left out.
     pub fn constraints(&self) -> impl Iterator<Item = ([u32; N], f32)> + '_ {
-        self.colours.iter().flat_map(|colour| {
-            colour
-                .batches
-                .clone()
-                .flat_map(|b| (0..LANES).map(move |k| (b, k)))
-                .take(colour.constraints)
-                .map(|(b, k)| {
-                    let particles = self.particles[b].map(|lanes| lanes[k]);
-                    (particles, self.rest[b].to_array()[k])
-                })
-        })
+        self.colours
+            .iter()
+            .flat_map(|colour| self.constraints_of(colour))
+    }
+
+    /// The particles and rest value of each constraint of `colour`, padding left out.
+    fn constraints_of<'a>(
+        &'a self,
+        colour: &'a Colour,
+    ) -> impl Iterator<Item = ([u32; N], f32)> + 'a {
+        colour
+            .batches
+            .clone()
+            .flat_map(|b| (0..LANES).map(move |k| (b, k)))
+            .take(colour.constraints)
+            .map(|(b, k)| {
+                let particles = self.particles[b].map(|lanes| lanes[k]);
+                (particles, self.rest[b].to_array()[k])
+            })
     }
 
     /// How many constraints each particle is in.
@@ -189,18 +197,13 @@ impl<const N: usize> Batches<N> {
     pub fn colouring_is_valid(&self, particle_count: usize) -> bool {
         let mut seen = vec![usize::MAX; particle_count];
         self.colours.iter().enumerate().all(|(k, colour)| {
-            let batches = colour.batches.clone();
-            batches
-                .flat_map(|b| (0..LANES).map(move |lane| (b, lane)))
-                .take(colour.constraints)
-                .all(|(b, lane)| {
-                    self.particles[b].iter().all(|slot| {
-                        let i = slot[lane] as usize;
-                        let fresh = seen[i] != k;
-                        seen[i] = k;
-                        fresh
-                    })
+            self.constraints_of(colour).all(|(particles, _)| {
+                particles.iter().all(|&i| {
+                    let fresh = seen[i as usize] != k;
+                    seen[i as usize] = k;
+                    fresh
                 })
+            })
         })
     }
 
