@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Everything a fresh machine needs, then every check and test of tetlab:
 # rustfmt and clippy (warnings are errors), the workbench built as a web page and opened in
-# headless Chromium, Rerun's own checker on a recording tetlab writes, then all tests of the
-# workspace (unit, doc, end to end). Exits non-zero on the first failure.
+# headless Chromium, Rerun's own checker on a recording tetlab writes, all tests of the workspace
+# (unit, doc, end to end, the abuse runs), then every fuzz target briefly. Exits non-zero on the
+# first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -24,6 +25,7 @@ fi
 
 echo "== cargo fmt --check"
 cargo fmt --all --check
+(cd fuzz && cargo fmt --check)
 echo "== cargo clippy --all-targets -- -D warnings"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 # The workbench as a web page, built and opened in headless Chromium (installs what it needs).
@@ -46,5 +48,15 @@ cargo run --locked --quiet -- record --scene "$scene" --perturb flatten --gravit
   --constraints edges,plane,volume --frames 60 --quiet --out "$recording"
 "$venv/bin/rerun" rrd verify "$recording"
 
+if [ -d ../shared/meshes ]; then
+  echo "== ../shared/meshes is here: the tests that read the reference meshes run"
+else
+  echo "== ../shared/meshes is absent: the tests that read the reference meshes skip (under CI=true they fail)"
+fi
 echo "== cargo test --workspace"
 cargo test --workspace --locked
+
+# Every fuzz target for a few seconds, so that they keep building and the easy breaks are found
+# (scripts/fuzz.sh runs them for longer; docs/reliability.md).
+echo "== fuzz targets (scripts/fuzz.sh --seconds 8)"
+scripts/fuzz.sh --seconds 8

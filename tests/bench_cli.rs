@@ -112,6 +112,46 @@ fn the_heights_are_counted_and_timed_on_their_own() {
     }
 }
 
+/// A mesh wider than the f32 engine can hold (its volumes overflowed, and the report showed
+/// inf, NaN and null) is refused when it loads, with its file and line; and nothing the bench
+/// prints is ever anything but a number.
+#[test]
+fn a_mesh_beyond_f32_is_refused_and_every_figure_is_a_number() {
+    let dir = std::env::temp_dir().join(format!("tetlab-bench-wide-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("wide.node"),
+        "4 3 0 0\n0 0 0 0\n1 2e12 0 0\n2 0 2e12 0\n3 0 0 2e12\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("wide.ele"), "1 4 0\n0 0 1 2 3\n").unwrap();
+    let scene = dir.join("wide.node");
+    assert_usage_error(
+        &tetlab(&["bench", "--scene", scene.to_str().unwrap()]),
+        "wide.node:3: x: 2e12 is beyond ±1e6",
+    );
+    std::fs::write(
+        dir.join("wide.node"),
+        "4 3 0 0\n0 0 0 0\n1 1e6 0 0\n2 0 1e6 0\n3 0 0 1e6\n",
+    )
+    .unwrap();
+    let output = tetlab(&[
+        "bench",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--constraints",
+        "edges,plane,volume",
+        "--frames",
+        "20",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stdout(&output);
+    for word in ["NaN", "inf", "null"] {
+        assert!(!text.contains(word), "{word} in {text}");
+    }
+}
+
 #[test]
 fn bad_options_are_usage_errors() {
     assert_usage_error(&tetlab(&["bench", "--frames", "0"]), "--frames");

@@ -5,7 +5,6 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3A};
 use std::hint::black_box;
-use std::path::Path;
 use tetlab_core::constraints::{distance, plane, volume};
 use tetlab_core::fast::{FastSimulation, Order};
 use tetlab_core::lanes::{F32x8, LANES, Vec3x8};
@@ -91,7 +90,7 @@ fn kernels(c: &mut Criterion) {
 /// Jacobi. The same work as `tetlab bench`, here so that builds for other CPUs are quick to
 /// compare (`RUSTFLAGS="-C target-cpu=x86-64" cargo bench -p tetlab-core -- frame`).
 fn frame(c: &mut Criterion) {
-    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes/bunny.node");
+    let bunny = tetlab_core::shared_meshes::folder().join("bunny.node");
     let (name, scene) = match Scene::load(&bunny) {
         Ok(scene) => ("bunny", scene),
         Err(_) => (

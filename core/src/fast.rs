@@ -21,6 +21,7 @@
 //! - optionally the [`Order::Jacobi`] order, for comparison.
 
 use crate::constraints::{Evaluation, Family, distance, plane, volume};
+use crate::divergence::Divergence;
 use crate::integrate;
 use crate::lanes::{F32x8, LANES, Vec3x8};
 use crate::solver::{PerFamily, Rule, Settings, Simulation, correction_lanes};
@@ -29,6 +30,11 @@ use glam::{DVec3, Vec3A};
 use particles::Particles;
 use std::ops::Range;
 use std::time::{Duration, Instant};
+
+/// The largest coordinate (m) the f32 engine holds: an edge of twice this, raised to the fourth
+/// power (the squared gradient of a volume), stays below f32's 3.4·10³⁸. Velocities are held up
+/// to [`crate::solver::SOUND_LIMIT`], as in f64 (they are only ever multiplied by a substep).
+pub const POSITION_LIMIT: f64 = 1e9;
 
 /// Colours with fewer constraints than this are projected on one thread even when several are
 /// available: below it, handing out the work costs more than it saves.
@@ -429,21 +435,39 @@ impl FastSimulation {
 
     /// Positions in the scene's particle numbering.
     pub fn positions(&self) -> Vec<DVec3> {
-        let mut out = vec![DVec3::ZERO; self.positions.len()];
-        for (p, &i) in self.positions.iter().zip(&self.original) {
-            out[i as usize] = p.as_dvec3();
+        self.in_scene_order(&self.positions)
+    }
+
+    /// Velocities in the scene's particle numbering.
+    pub fn velocities(&self) -> Vec<DVec3> {
+        self.in_scene_order(&self.velocities)
+    }
+
+    fn in_scene_order(&self, values: &[Vec3A]) -> Vec<DVec3> {
+        let mut out = vec![DVec3::ZERO; values.len()];
+        for (v, &i) in values.iter().zip(&self.original) {
+            out[i as usize] = v.as_dvec3();
         }
         out
     }
 
-    /// Whether every coordinate and velocity component is finite and below
-    /// [`crate::solver::SOUND_LIMIT`] in size.
+    /// Ok while every coordinate is finite and below [`POSITION_LIMIT`] in size and every
+    /// velocity component below [`crate::solver::SOUND_LIMIT`]; otherwise the first that is not
+    /// (particles in the scene's numbering).
+    pub fn check(&self) -> Result<(), Divergence> {
+        let f64s = |v: &Vec3A| v.as_dvec3().to_array();
+        Divergence::find(
+            self.frame,
+            (POSITION_LIMIT, crate::solver::SOUND_LIMIT),
+            self.positions.iter().map(f64s),
+            self.velocities.iter().map(f64s),
+            |i| self.original[i] as usize,
+        )
+    }
+
+    /// Whether [`FastSimulation::check`] finds nothing.
     pub fn is_sound(&self) -> bool {
-        let limit = crate::solver::SOUND_LIMIT as f32;
-        self.positions
-            .iter()
-            .chain(&self.velocities)
-            .all(|v| v.abs().max_element() < limit)
+        self.check().is_ok()
     }
 
     /// Frames stepped.

@@ -29,8 +29,10 @@
 //! `<=`, `>`, `>=`.
 
 use crate::constraints::Family;
+use crate::divergence::Divergence;
+use crate::limits::{self, Bounds};
 use crate::metrics::Metrics;
-use crate::scene::{Perturbation, Scene, reflect_through_opposite_face};
+use crate::scene::{Perturbation, Scene, SceneError, reflect_through_opposite_face};
 use crate::solver::{Method, PerFamily, Settings, Simulation};
 use std::collections::BTreeMap;
 use std::fmt;
@@ -161,8 +163,8 @@ impl Op {
 }
 
 impl Expectation {
-    /// The metric's current value, and whether the expectation holds for it; `None` when it is
-    /// about the comparison and there is none.
+    /// The metric's current value, and whether the expectation holds for it (never for a value
+    /// that is not finite); `None` when it is about the comparison and there is none.
     pub fn check(&self, metrics: &Metrics, comparison: Option<&Metrics>) -> Option<(f64, bool)> {
         let metrics = if self.of_comparison {
             comparison?
@@ -175,7 +177,7 @@ impl Expectation {
             .find(|(name, _)| *name == self.metric)
             .map(|(_, v)| v)
             .expect("the metric name was checked when the lesson was read");
-        Some((value, self.op.holds(value, self.value)))
+        Some((value, value.is_finite() && self.op.holds(value, self.value)))
     }
 
     fn parse(text: &str) -> Result<Expectation, String> {
@@ -233,15 +235,20 @@ impl Action {
                 .parse()
                 .map_err(|_| format!("'{argument}' is not a whole number in '{text}'"))
         };
-        let family_value = |what: &str| -> Result<(Family, f64), String> {
+        let family_value = |what: &str, bounds: &Bounds<f64>| -> Result<(Family, f64), String> {
             let argument = need(what)?;
-            let (family, value) = argument
-                .split_once('=')
-                .ok_or_else(|| format!("'{text}' is not {name}:FAMILY=VALUE"))?;
-            Ok((Family::parse(family)?, finite(value)?))
+            limits::family_value(argument, bounds).map_err(|e| format!("{e} in '{text}'"))
+        };
+        let setting = |what: &str, bounds: &Bounds<u32>| -> Result<u32, String> {
+            bounds
+                .parse(need(what)?)
+                .map_err(|e| format!("{e} in '{text}'"))
         };
         let action = match name {
-            "reset" => Action::Reset,
+            "reset" => match argument {
+                None => Action::Reset,
+                Some(_) => return Err(format!("'{text}': reset takes no value")),
+            },
             "invert" => match argument {
                 None => Action::Perturb(Perturbation::Invert),
                 Some(_) => Action::InvertTet(whole("K")? as usize),
@@ -251,31 +258,20 @@ impl Action {
             "constraints" => Action::Constraints(PerFamily::parse_list(need("LIST")?)?),
             "solver" => Action::Solver(Method::parse(need("xpbd|pbd")?)?),
             "compliance" => {
-                let (family, alpha) = family_value("FAMILY=α")?;
-                if alpha < 0.0 {
-                    return Err(format!("compliance {alpha} is negative in '{text}'"));
-                }
+                let (family, alpha) = family_value("FAMILY=α", &limits::COMPLIANCE)?;
                 Action::Compliance(family, alpha)
             }
             "stiffness" => {
-                let (family, k) = family_value("FAMILY=k")?;
-                if !(0.0..=1.0).contains(&k) {
-                    return Err(format!("stiffness {k} is outside 0..=1 in '{text}'"));
-                }
+                let (family, k) = family_value("FAMILY=k", &limits::STIFFNESS)?;
                 Action::Stiffness(family, k)
             }
-            "substeps" | "iterations" => {
-                let n = whole("N")?;
-                if !(1..=1000).contains(&n) {
-                    return Err(format!("{n} is outside 1..=1000 in '{text}'"));
-                }
-                if name == "substeps" {
-                    Action::Substeps(n as u32)
-                } else {
-                    Action::Iterations(n as u32)
-                }
-            }
-            "gravity" => Action::Gravity(finite(need("G")?)?),
+            "substeps" => Action::Substeps(setting("N", &limits::SUBSTEPS)?),
+            "iterations" => Action::Iterations(setting("N", &limits::ITERATIONS)?),
+            "gravity" => Action::Gravity(
+                limits::GRAVITY
+                    .parse(need("G")?)
+                    .map_err(|e| format!("{e} in '{text}'"))?,
+            ),
             "compare" => match need("LIST|off")? {
                 "off" => Action::Compare(None),
                 list => Action::Compare(Some(PerFamily::parse_list(list)?)),
@@ -312,10 +308,7 @@ impl Action {
             Action::Stiffness(family, k) => settings.stiffness.set(family, k),
             Action::Substeps(n) => settings.substeps = n,
             Action::Iterations(n) => settings.iterations = n,
-            Action::Gravity(g) => {
-                settings.gravity = g;
-                settings.ground = g != 0.0;
-            }
+            Action::Gravity(g) => settings.set_gravity(g),
             Action::Compare(_) => {}
         }
         simulation.set_settings(settings);
@@ -365,17 +358,12 @@ impl std::error::Error for LessonError {}
 struct RawLesson {
     title: String,
     scene: Spanned<String>,
-    #[serde(default = "one")]
-    resolution: u32,
+    resolution: Option<Spanned<u32>>,
     tet: Option<Spanned<usize>>,
     #[serde(default)]
     settings: RawSettings,
     #[serde(default)]
     step: Vec<RawStep>,
-}
-
-fn one() -> u32 {
-    1
 }
 
 #[derive(serde::Deserialize, Default)]
@@ -419,6 +407,52 @@ pub struct BuiltinLesson {
 
 include!(concat!(env!("OUT_DIR"), "/lessons.rs"));
 
+/// What a lesson file says about itself before its scene is built: its title and its scene, so
+/// that a lesson can be listed (and its missing mesh named) even when it cannot be opened.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LessonHeader {
+    /// Its title.
+    pub title: String,
+    /// Its scene: a built-in name, or a mesh path resolved against the lesson's folder.
+    pub scene: String,
+}
+
+/// The two fields [`LessonHeader`] reads; the rest of the file is left to [`Lesson::parse`].
+#[derive(serde::Deserialize)]
+struct RawHeader {
+    title: String,
+    scene: String,
+}
+
+impl LessonHeader {
+    /// The title and scene of lesson `text` from `path`.
+    pub fn parse(path: &Path, text: &str) -> Result<LessonHeader, LessonError> {
+        let text = crate::text_file::without_byte_order_mark(text);
+        let raw: RawHeader = toml::from_str(text).map_err(|e| LessonError {
+            path: path.to_owned(),
+            line: e.span().map(|s| line_of(text, s.start)),
+            message: e.message().trim().to_owned(),
+        })?;
+        Ok(LessonHeader {
+            title: raw.title,
+            scene: resolve_scene(path, &raw.scene),
+        })
+    }
+
+    /// The mesh file the lesson needs, when it needs one that is not there.
+    pub fn missing_mesh(&self) -> Option<&str> {
+        let builtin = crate::scene::Builtin::from_name(&self.scene).is_some();
+        (!builtin && !Path::new(&self.scene).exists()).then_some(self.scene.as_str())
+    }
+}
+
+impl BuiltinLesson {
+    /// Its title and scene ([`LessonHeader::parse`]).
+    pub fn header(&self) -> Result<LessonHeader, LessonError> {
+        LessonHeader::parse(Path::new(self.path), self.text)
+    }
+}
+
 /// The most frames one step may run.
 pub const MAX_STEP_FRAMES: u64 = 100_000;
 
@@ -449,16 +483,28 @@ impl Lesson {
 
     /// Reads a lesson file; a mesh scene path is taken relative to the file's folder.
     pub fn load(path: &Path) -> Result<Lesson, LessonError> {
-        let text = std::fs::read_to_string(path).map_err(|e| LessonError {
+        let text = crate::text_file::read(path).map_err(|e| LessonError {
             path: path.to_owned(),
-            line: None,
-            message: format!("cannot read: {e}"),
+            line: e.line,
+            message: e.message,
         })?;
         Lesson::parse(path, &text)
     }
 
     /// Parses lesson `text` that came from `path` (used for messages and relative scene paths).
     pub fn parse(path: &Path, text: &str) -> Result<Lesson, LessonError> {
+        Lesson::parse_with(path, text, &Scene::from_spec)
+    }
+
+    /// [`Lesson::parse`], with the lesson's scene made by `make_scene` from its name (resolved
+    /// against the lesson's folder) and resolution instead of [`Scene::from_spec`]: a fuzzer
+    /// gives one that builds only small scenes.
+    pub fn parse_with(
+        path: &Path,
+        text: &str,
+        make_scene: &dyn Fn(&str, u32) -> Result<Scene, SceneError>,
+    ) -> Result<Lesson, LessonError> {
+        let text = crate::text_file::without_byte_order_mark(text);
         let error = |span: Option<std::ops::Range<usize>>, message: String| LessonError {
             path: path.to_owned(),
             line: span.map(|s| line_of(text, s.start)),
@@ -476,83 +522,72 @@ impl Lesson {
         if let Some(solver) = &s.solver {
             settings.method = Method::parse(solver.get_ref()).map_err(at(solver.span()))?;
         }
-        // Each setting checked by `ok`; a failure names the file and line of the value.
-        let check = |name: &str,
-                     value: &Option<Spanned<f64>>,
-                     ok: fn(f64) -> bool,
-                     expected: &str|
-         -> Result<Option<f64>, LessonError> {
-            match value {
-                Some(v) if !ok(*v.get_ref()) => Err(error(
-                    Some(v.span()),
-                    format!("settings.{name} = {} is {expected}", v.get_ref()),
-                )),
-                other => Ok(other.as_ref().map(|v| *v.get_ref())),
-            }
-        };
-        let whole = |v: &Option<Spanned<u32>>| {
-            v.as_ref()
-                .map(|v| Spanned::new(v.span(), *v.get_ref() as f64))
-        };
-        let in_range = |n: f64| (1.0..=1000.0).contains(&n);
-        if let Some(n) = check(
-            "substeps",
-            &whole(&s.substeps),
-            in_range,
-            "outside 1..=1000",
-        )? {
-            settings.substeps = n as u32;
+        // Each setting checked against its range; a failure names the file and line of the value.
+        fn checked<T: limits::Number>(
+            bounds: &Bounds<T>,
+            value: &Option<Spanned<T>>,
+            error: impl Fn(Option<std::ops::Range<usize>>, String) -> LessonError,
+        ) -> Result<Option<T>, LessonError> {
+            value
+                .as_ref()
+                .map(|v| {
+                    bounds
+                        .check(*v.get_ref())
+                        .map_err(|e| error(Some(v.span()), format!("in [settings]: {e}")))
+                })
+                .transpose()
         }
-        if let Some(n) = check(
-            "iterations",
-            &whole(&s.iterations),
-            in_range,
-            "outside 1..=1000",
-        )? {
-            settings.iterations = n as u32;
+        if let Some(n) = checked(&limits::SUBSTEPS, &s.substeps, error)? {
+            settings.substeps = n;
         }
-        let dt_ok = |dt: f64| dt > 0.0 && dt <= 1.0;
-        if let Some(dt) = check("dt", &s.dt, dt_ok, "outside 0 < dt <= 1")? {
+        if let Some(n) = checked(&limits::ITERATIONS, &s.iterations, error)? {
+            settings.iterations = n;
+        }
+        if let Some(dt) = checked(&limits::DT, &s.dt, error)? {
             settings.dt = dt;
         }
-        if let Some(g) = check("gravity", &s.gravity, f64::is_finite, "not finite")? {
-            settings.gravity = g;
-            settings.ground = g != 0.0;
+        if let Some(g) = checked(&limits::GRAVITY, &s.gravity, error)? {
+            settings.set_gravity(g);
         }
-        let damping_ok = |d: f64| d >= 0.0 && d.is_finite();
-        if let Some(d) = check("damping", &s.damping, damping_ok, "negative or not finite")? {
+        if let Some(d) = checked(&limits::DAMPING, &s.damping, error)? {
             settings.damping = d;
         }
         settings.settle_edits = s.settle_edits.unwrap_or(settings.settle_edits);
-        for (name, value) in &s.compliance {
-            let family = Family::parse(name).map_err(at(value.span()))?;
-            let alpha = *value.get_ref();
-            if !(alpha >= 0.0 && alpha.is_finite()) {
-                return Err(error(
-                    Some(value.span()),
-                    format!("compliance {alpha} is negative"),
-                ));
+        for (table, bounds, values, per_family) in [
+            (
+                "compliance",
+                &limits::COMPLIANCE,
+                &s.compliance,
+                &mut settings.compliance,
+            ),
+            (
+                "stiffness",
+                &limits::STIFFNESS,
+                &s.stiffness,
+                &mut settings.stiffness,
+            ),
+        ] {
+            for (name, value) in values {
+                let family = Family::parse(name).map_err(at(value.span()))?;
+                let v = bounds.check(*value.get_ref()).map_err(|e| {
+                    error(
+                        Some(value.span()),
+                        format!("in [settings] {table}.{name}: {e}"),
+                    )
+                })?;
+                per_family.set(family, v);
             }
-            settings.compliance.set(family, alpha);
-        }
-        for (name, value) in &s.stiffness {
-            let family = Family::parse(name).map_err(at(value.span()))?;
-            let k = *value.get_ref();
-            if !(0.0..=1.0).contains(&k) {
-                return Err(error(
-                    Some(value.span()),
-                    format!("stiffness {k} is outside 0..=1"),
-                ));
-            }
-            settings.stiffness.set(family, k);
         }
 
+        let resolution = raw.resolution.as_ref().map_or(1, |r| *r.get_ref());
         let scene = resolve_scene(path, raw.scene.get_ref());
-        let mesh = Scene::from_spec(&scene, raw.resolution).map_err(|e| {
-            error(
-                Some(raw.scene.span()),
-                format!("scene '{}': {e}", raw.scene.get_ref()),
-            )
+        let mesh = make_scene(&scene, resolution).map_err(|e| {
+            // A resolution out of range is the resolution's mistake, anything else the scene's.
+            let span = match (&e, &raw.resolution) {
+                (SceneError::Resolution(_) | SceneError::TooLarge { .. }, Some(r)) => r.span(),
+                _ => raw.scene.span(),
+            };
+            error(Some(span), format!("scene '{}': {e}", raw.scene.get_ref()))
         })?;
         let tets = mesh.mesh.tets.len();
         let check_tet = |tet: usize, span| {
@@ -612,7 +647,7 @@ impl Lesson {
             title: raw.title,
             source: path.to_owned(),
             scene,
-            resolution: raw.resolution,
+            resolution,
             tet,
             settings,
             steps,
@@ -684,14 +719,18 @@ pub struct LessonRun {
     /// The selected tet.
     pub tet: usize,
     scene: Scene,
+    /// The metrics of both simulations, as last measured by [`LessonRun::measure`].
+    metrics: (Metrics, Option<Metrics>),
 }
 
 impl LessonRun {
     /// The lesson's scene at rest with its settings.
     pub fn new(lesson: &Lesson) -> LessonRun {
         let scene = lesson.scene();
+        let simulation = Simulation::new(&scene, lesson.settings);
         LessonRun {
-            simulation: Simulation::new(&scene, lesson.settings),
+            metrics: (Metrics::measure(&simulation), None),
+            simulation,
             comparison: None,
             tet: lesson.tet,
             scene,
@@ -729,39 +768,60 @@ impl LessonRun {
         }
     }
 
+    /// Measures both simulations ([`Metrics::measure_sound`]): an error naming the one that
+    /// diverged, if one did.
+    pub fn measure(&mut self) -> Result<(), Divergence> {
+        let main = Metrics::measure_sound(&self.simulation)?;
+        let comparison = match &self.comparison {
+            Some(c) => Some(Metrics::measure_sound(c).map_err(|d| d.of("the comparison"))?),
+            None => None,
+        };
+        self.metrics = (main, comparison);
+        Ok(())
+    }
+
+    /// The metrics of the simulation and of the comparison (if one is shown) at the last
+    /// [`LessonRun::measure`]: finite, since it checked them.
+    pub fn metrics(&self) -> (&Metrics, Option<&Metrics>) {
+        (&self.metrics.0, self.metrics.1.as_ref())
+    }
+
     /// The scene.
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
 
-    /// Runs a whole step: actions, frames (calling `on_frame` after each; it may stop the step
-    /// early by returning [`ControlFlow::Break`]), then the checks. `None` when stopped early.
+    /// Runs a whole step: actions, frames (measuring both simulations after each, then calling
+    /// `on_frame`, which may stop the step early by returning [`ControlFlow::Break`]), then the
+    /// checks. `Ok(None)` when stopped early; an error when a simulation diverged, so that
+    /// nothing after it is shown or checked.
     pub fn run_step(
         &mut self,
         step: &Step,
         mut on_frame: impl FnMut(&LessonRun) -> ControlFlow<()>,
-    ) -> Option<StepOutcome> {
+    ) -> Result<Option<StepOutcome>, Divergence> {
         for &action in &step.actions {
             self.apply(action);
         }
+        self.measure()?;
         for _ in 0..step.frames {
             self.step();
+            self.measure()?;
             if on_frame(self).is_break() {
-                return None;
+                return Ok(None);
             }
         }
-        Some(self.check(step))
+        Ok(Some(self.check(step)))
     }
 
-    /// The step's expectations against the current state.
+    /// The step's expectations against the metrics of the last [`LessonRun::measure`].
     pub fn check(&self, step: &Step) -> StepOutcome {
-        let metrics = Metrics::measure(&self.simulation);
-        let comparison = self.comparison.as_ref().map(Metrics::measure);
+        let (metrics, comparison) = self.metrics();
         StepOutcome {
             checks: step
                 .expect
                 .iter()
-                .map(|e| match e.check(&metrics, comparison.as_ref()) {
+                .map(|e| match e.check(metrics, comparison) {
                     Some((value, holds)) => (e.clone(), Some(value), holds),
                     None => (e.clone(), None, false),
                 })
@@ -803,6 +863,7 @@ expect = ["inverted_tets == 1", "max_edge_strain < 1e-9"]
         let mut run = LessonRun::new(&lesson);
         let outcome = run
             .run_step(&lesson.steps[0], |_| ControlFlow::Continue(()))
+            .unwrap()
             .unwrap();
         assert!(
             outcome.checks.iter().all(|(_, _, holds)| *holds),
@@ -853,12 +914,42 @@ expect = ["inverted_tets == 1", "max_edge_strain < 1e-9"]
             (
                 "title = \"t\"\nscene = \"tet\"\n[settings]\ndt = nan\n[[step]]\ntext = \"x\"\n",
                 4,
-                "settings.dt = NaN is outside",
+                "in [settings]: dt NaN is not a number",
             ),
             (
                 "title = \"t\"\nscene = \"tet\"\n[settings]\n\nsubsteps = 0\n[[step]]\ntext = \"x\"\n",
                 5,
-                "settings.substeps = 0 is outside 1..=1000",
+                "in [settings]: substeps 0 is out of range: expected 1 <= substeps <= 1000",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[settings]\ncompliance = { volume = inf }\n[[step]]\ntext = \"x\"\n",
+                4,
+                "compliance.volume: compliance inf is out of range",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[settings]\ncompliance = { edges = nan }\n[[step]]\ntext = \"x\"\n",
+                4,
+                "compliance.edges: compliance NaN is not a number",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[[step]]\ntext = \"x\"\nactions = [\"reset:whatever\"]\n",
+                5,
+                "'reset:whatever': reset takes no value",
+            ),
+            (
+                "title = \"t\"\nscene = \"tet\"\n[[step]]\ntext = \"x\"\nactions = [\"compliance:edges=1e303\"]\n",
+                5,
+                "compliance 1e303 is out of range",
+            ),
+            (
+                "title = \"t\"\nscene = \"ball\"\nresolution = 128\n[[step]]\ntext = \"x\"\n",
+                3,
+                "ball at resolution 128 would have 100663296 tets",
+            ),
+            (
+                "\u{feff}title = \"t\"\nscene = \"tet\"\ncolour = 1\n",
+                3,
+                "unknown field `colour`",
             ),
         ];
         for (text, line, message) in cases {
@@ -867,6 +958,71 @@ expect = ["inverted_tets == 1", "max_edge_strain < 1e-9"]
             assert!(error.to_string().contains(message), "{error}");
             assert!(error.to_string().starts_with("lessons/x.toml:"), "{error}");
         }
+    }
+
+    #[test]
+    fn a_lesson_file_that_is_not_text_names_the_line() {
+        let path = std::env::temp_dir().join(format!("tetlab-lesson-{}.toml", std::process::id()));
+        std::fs::write(&path, b"title = \"t\"\nscene = \"tet\xff\"\n").unwrap();
+        let error = Lesson::load(&path).unwrap_err();
+        std::fs::remove_file(&path).ok();
+        assert_eq!(error.line, Some(2), "{error}");
+        assert!(error.message.contains("not text"), "{error}");
+    }
+
+    /// The comparison is checked like the main simulation: when it diverges the step is an
+    /// error, never "observed" (a NaN metric holds no expectation either).
+    #[test]
+    fn a_comparison_that_diverges_stops_the_step() {
+        let lesson = parse(
+            r#"
+title = "t"
+scene = "tet"
+[settings]
+constraints = "edges"
+[[step]]
+text = "x"
+actions = ["compare:edges,volume", "invert"]
+frames = 30
+expect = ["compare.volume_error < 0.001"]
+"#,
+        )
+        .unwrap();
+        let mut run = LessonRun::new(&lesson);
+        // What no accepted setting can do: a compliance past the limits, so α / h² is infinite.
+        run.apply(Action::Compare(Some(
+            PerFamily::parse_list("edges,volume").unwrap(),
+        )));
+        let comparison = run.comparison.as_mut().unwrap();
+        let mut settings = *comparison.settings();
+        settings.compliance.volume = 1e305;
+        comparison.set_settings(settings);
+        let step = Step {
+            actions: vec![Action::Perturb(Perturbation::Invert)],
+            ..lesson.steps[0].clone()
+        };
+        let divergence = run
+            .run_step(&step, |_| ControlFlow::Continue(()))
+            .unwrap_err();
+        assert_eq!(divergence.subject, "the comparison", "{divergence}");
+        let nan = Metrics {
+            volume_error: f64::NAN,
+            ..Metrics::default()
+        };
+        let expectation = Expectation::parse("volume_error != 0").unwrap();
+        assert!(!expectation.check(&nan, None).unwrap().1);
+    }
+
+    /// A lesson can be listed, and its missing mesh named, even when it cannot be opened.
+    #[test]
+    fn a_lesson_whose_mesh_is_missing_still_has_a_title() {
+        let text = "title = \"t\"\nscene = \"../nowhere/bunny.node\"\n[[step]]\ntext = \"x\"\n";
+        let header = LessonHeader::parse(Path::new("lessons/x.toml"), text).unwrap();
+        assert_eq!(header.title, "t");
+        assert_eq!(header.missing_mesh(), Some("lessons/../nowhere/bunny.node"));
+        assert!(parse(text).unwrap_err().message.contains("bunny.node"));
+        let cube = LessonHeader::parse(Path::new("x.toml"), "title = \"c\"\nscene = \"cube\"\n");
+        assert_eq!(cube.unwrap().missing_mesh(), None);
     }
 
     #[test]

@@ -11,21 +11,29 @@
 //! - [`solver`]: the XPBD/PBD simulation; [`stepper`]: the same, one projection at a time;
 //!   [`fast`]: the same in f32, coloured, in SIMD lanes and on threads, for big meshes.
 //! - [`mesh`], [`scene`]: tet meshes (TetGen, Gmsh) and the scenes built from them; [`metrics`]:
-//!   what a state is worth; [`visual`]: what front ends draw; [`lesson`]: lessons as TOML files.
+//!   what a state is worth; [`visual`]: what front ends draw; [`lesson`]: lessons as TOML files;
+//!   [`text_file`]: reading a user's text file; [`shared_meshes`]: where the reference meshes
+//!   beside a clone are.
+//! - [`limits`]: the range of every setting and the size of every scene tetlab accepts;
+//!   [`divergence`]: when a simulation's numbers stop meaning anything, and why.
 
 pub mod constraints;
+pub mod divergence;
 pub mod fast;
 pub mod finite_difference;
 pub mod inspector;
 mod integrate;
 pub mod lanes;
 pub mod lesson;
+pub mod limits;
 pub mod mesh;
 pub mod metrics;
 pub mod random;
 pub mod scene;
+pub mod shared_meshes;
 pub mod solver;
 pub mod stepper;
+pub mod text_file;
 pub mod vector;
 pub mod verify;
 pub mod visual;

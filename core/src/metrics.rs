@@ -1,7 +1,10 @@
 //! What a frame is measured by. The CLI prints these, the recorder logs them and the GUI plots
-//! them: all from [`Metrics::measure`].
+//! them: all from [`Metrics::measure`]. No value is replaced by a fallback: a metric that
+//! overflows is reported as it is, and [`Metrics::check`] turns it into a [`Divergence`], so that
+//! nothing that is not a number is ever printed, plotted or recorded.
 
 use crate::constraints::{Evaluation, distance, plane, volume};
+use crate::divergence::{Cause, Divergence};
 use crate::solver::{ConstraintSet, PerFamily, Simulation};
 use glam::DVec3;
 
@@ -9,14 +12,16 @@ use glam::DVec3;
 /// [`Metrics::min_volume_ratio`]: V/V₀ of a tet that had no volume means nothing.
 pub const SLIVER: f64 = 1e-9;
 
-/// Measurements of one state of a simulation. All values are finite.
+/// Measurements of one state of a simulation. Finite for a sound state, except where
+/// [`Metrics::check`] says otherwise.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Metrics {
     /// Tets whose signed volume is negative.
     pub inverted_tets: usize,
-    /// min over tets of V / V₀ (tets with V₀ above [`SLIVER`] of the mean); 1 at rest.
+    /// min over tets of V / V₀ (tets with a positive V₀ above [`SLIVER`] of the mean |V₀|); 1 at
+    /// rest, and 1 when no tet has a rest volume.
     pub min_volume_ratio: f64,
-    /// |ΣV − ΣV₀| / ΣV₀, the relative change of the total volume.
+    /// |ΣV − ΣV₀| / ΣV₀, the relative change of the total volume (0 when ΣV₀ is 0).
     pub volume_error: f64,
     /// max over edges of |l − l₀| / l₀.
     pub max_edge_strain: f64,
@@ -36,14 +41,50 @@ impl Metrics {
         ]
     }
 
+    /// Every measurement by the name used in `tetlab run --json`: the headline ones, then the
+    /// residual of each family.
+    pub fn all(&self) -> [(&'static str, f64); 7] {
+        let [a, b, c, d] = self.headline();
+        [
+            a,
+            b,
+            c,
+            d,
+            ("residual_edges", self.residual.edges),
+            ("residual_plane", self.residual.plane),
+            ("residual_volume", self.residual.volume),
+        ]
+    }
+
+    /// Ok when every measurement is finite; otherwise the first that is not, as the divergence
+    /// of a state at `frame`.
+    pub fn check(&self, frame: u64) -> Result<(), Divergence> {
+        match self.all().into_iter().find(|(_, value)| !value.is_finite()) {
+            Some((name, value)) => Err(Divergence::new(frame, Cause::Metric { name, value })),
+            None => Ok(()),
+        }
+    }
+
+    /// The metrics of a sound state: [`Simulation::check`], then [`Metrics::measure`], then
+    /// [`Metrics::check`]. What every front end calls after a frame.
+    pub fn measure_sound(simulation: &Simulation) -> Result<Metrics, Divergence> {
+        simulation.check()?;
+        let metrics = Metrics::measure(simulation);
+        metrics.check(simulation.frame())?;
+        Ok(metrics)
+    }
+
     /// Measures the current state of `simulation`.
     pub fn measure(simulation: &Simulation) -> Metrics {
         let positions = simulation.positions();
         let rest_volumes = &simulation.volumes.rest;
         let total_rest: f64 = rest_volumes.iter().sum();
-        let mean_rest = total_rest / rest_volumes.len().max(1) as f64;
+        // The scale of "a sliver": the mean size of a rest volume (a degenerate tet may be a hair
+        // negative, and a mesh of them could make a signed mean negative or zero).
+        let mean_rest =
+            rest_volumes.iter().map(|v| v.abs()).sum::<f64>() / rest_volumes.len().max(1) as f64;
         let mut inverted_tets = 0;
-        let mut min_volume_ratio = f64::INFINITY;
+        let mut min_volume_ratio: Option<f64> = None;
         let mut total = 0.0;
         for (tet, &rest) in simulation.tets().iter().zip(rest_volumes) {
             let v = volume::signed_volume(&tet.map(|i| positions[i as usize]));
@@ -51,8 +92,9 @@ impl Metrics {
             if v < 0.0 {
                 inverted_tets += 1;
             }
-            if rest > SLIVER * mean_rest {
-                min_volume_ratio = min_volume_ratio.min(v / rest);
+            if rest > 0.0 && rest > SLIVER * mean_rest {
+                let ratio = v / rest;
+                min_volume_ratio = Some(min_volume_ratio.map_or(ratio, |m| smaller(m, ratio)));
             }
         }
         let mut max_edge_strain: f64 = 0.0;
@@ -64,18 +106,18 @@ impl Metrics {
         {
             if rest > 0.0 {
                 let length = positions[edge[0] as usize].distance(positions[edge[1] as usize]);
-                max_edge_strain = max_edge_strain.max((length - rest).abs() / rest);
+                max_edge_strain = larger(max_edge_strain, (length - rest).abs() / rest);
             }
         }
         Metrics {
             inverted_tets,
-            min_volume_ratio: finite_or(min_volume_ratio, 1.0),
+            min_volume_ratio: min_volume_ratio.unwrap_or(1.0),
             volume_error: if total_rest > 0.0 {
-                finite_or((total - total_rest).abs() / total_rest, 0.0)
+                (total - total_rest).abs() / total_rest
             } else {
                 0.0
             },
-            max_edge_strain: finite_or(max_edge_strain, 0.0),
+            max_edge_strain,
             residual: PerFamily {
                 edges: rms(&simulation.edges, positions, distance::evaluate),
                 plane: rms(&simulation.planes, positions, plane::evaluate),
@@ -85,6 +127,25 @@ impl Metrics {
     }
 }
 
+/// The smaller of two numbers, NaN if either is (f64::min would drop a NaN).
+fn smaller(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+/// The larger of two numbers, NaN if either is.
+fn larger(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// √(mean C²) over the constraints of `set`; 0 when there are none.
 fn rms<const N: usize>(
     set: &ConstraintSet<N>,
     positions: &[DVec3],
@@ -103,9 +164,68 @@ fn rms<const N: usize>(
                 .powi(2)
         })
         .sum();
-    finite_or((sum / set.len() as f64).sqrt(), f64::MAX)
+    (sum / set.len() as f64).sqrt()
 }
 
-fn finite_or(x: f64, fallback: f64) -> f64 {
-    if x.is_finite() { x } else { fallback }
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::divergence::Cause;
+    use crate::scene::{Builtin, Scene};
+    use crate::solver::Settings;
+
+    /// Found by the fuzzer: a mesh whose tets all have (nearly) zero rest volume, two of its
+    /// points coinciding, gave V / V₀ = 0 / 0 at rest.
+    #[test]
+    fn a_mesh_of_degenerate_tets_measures_finitely_at_rest() {
+        let p = |x, y, z| DVec3::new(x, y, z);
+        let positions = vec![
+            p(0.0, 0.8, 0.0),
+            p(0.0, 0.8, 0.0),
+            p(0.5, 0.8, 0.866),
+            p(0.5, 1.6, 0.289),
+            p(0.5, 0.0, 0.289),
+        ];
+        let (mesh, report) = crate::mesh::TetMesh::new(positions, vec![[3, 0, 1, 2], [0, 1, 2, 4]]);
+        assert_eq!(report.degenerate_tets, 2);
+        let scene = Scene::from_mesh("coincident".into(), mesh, report);
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        let metrics = Metrics::measure_sound(&simulation).expect("finite at rest");
+        assert_eq!(
+            metrics.min_volume_ratio, 1.0,
+            "no tet has a rest volume to compare"
+        );
+        simulation.step();
+        assert!(Metrics::measure_sound(&simulation).is_ok());
+    }
+
+    #[test]
+    fn a_metric_that_overflows_is_reported_not_replaced() {
+        let tet = Scene::builtin(Builtin::Tet, 1).unwrap().mesh;
+        let tiny: Vec<DVec3> = tet.positions.iter().map(|p| *p * 1e-100).collect();
+        let (mesh, report) = crate::mesh::TetMesh::new(tiny, tet.tets);
+        let scene = Scene::from_mesh("tiny".into(), mesh, report);
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        assert_eq!(Metrics::measure_sound(&simulation).map(|_| ()), Ok(()));
+        // Positions still below the sound limit of 1e30, but the tet is (1e129)³ times its rest
+        // volume: V / V₀ and the relative volume error overflow.
+        let grown: Vec<DVec3> = simulation.positions().iter().map(|p| *p * 1e129).collect();
+        simulation.set_positions(&grown);
+        assert!(simulation.is_sound());
+        let metrics = Metrics::measure(&simulation);
+        assert_eq!(metrics.min_volume_ratio, f64::INFINITY, "{metrics:?}");
+        assert_eq!(metrics.volume_error, f64::INFINITY, "{metrics:?}");
+        let divergence = Metrics::measure_sound(&simulation).unwrap_err();
+        assert!(
+            matches!(
+                divergence.cause,
+                Cause::Metric {
+                    name: "volume_error",
+                    ..
+                }
+            ),
+            "{divergence}"
+        );
+        assert!(smaller(1.0, f64::NAN).is_nan() && larger(f64::NAN, 1.0).is_nan());
+    }
 }

@@ -3,6 +3,7 @@
 //! positions to set up an experiment (invert one tet, mirror the body, flatten it, scramble it).
 
 use crate::constraints::volume::signed_volume;
+use crate::limits;
 use crate::mesh::{LoadReport, MeshError, TetMesh};
 use crate::random::SplitMix64;
 use glam::DVec3;
@@ -40,6 +41,32 @@ impl Builtin {
     pub fn from_name(name: &str) -> Option<Builtin> {
         Builtin::ALL.into_iter().find(|b| b.name() == name)
     }
+
+    /// How many tets the scene has at `resolution`: 1 for the tet, six per lattice cell for the
+    /// others (N³ cells for the cube, 4N·N·N for the beam, (2N)³ for the ball).
+    ///
+    /// ```
+    /// use tetlab_core::scene::{Builtin, Scene};
+    /// let cube = Scene::builtin(Builtin::Cube, 3).unwrap();
+    /// assert_eq!(Builtin::Cube.tets(3), cube.mesh.tets.len() as u64);
+    /// ```
+    pub fn tets(self, resolution: u32) -> u64 {
+        let n = resolution as u64;
+        match self {
+            Builtin::Tet => 1,
+            Builtin::Cube => 6 * n * n * n,
+            Builtin::Beam => 6 * 4 * n * n * n,
+            Builtin::Ball => 6 * 8 * n * n * n,
+        }
+    }
+
+    /// The largest resolution at which the scene has at most [`limits::MAX_TETS`] tets.
+    pub fn largest_resolution(self) -> u32 {
+        (limits::RESOLUTION.min..=limits::RESOLUTION.max)
+            .rev()
+            .find(|&n| self.tets(n) <= limits::MAX_TETS as u64)
+            .unwrap_or(limits::RESOLUTION.min)
+    }
 }
 
 /// A rest mesh, the particles held in place, and notes on how it was made.
@@ -60,8 +87,15 @@ pub struct Scene {
 pub enum SceneError {
     /// Not a built-in name, and no file of that name.
     Unknown(String),
-    /// The resolution is out of range.
-    Resolution(u32),
+    /// The resolution is out of range: why.
+    Resolution(String),
+    /// The built-in scene would have more tets than tetlab simulates at this resolution.
+    TooLarge {
+        /// The scene.
+        builtin: Builtin,
+        /// The resolution asked for.
+        resolution: u32,
+    },
     /// The file could not be loaded.
     Mesh(MeshError),
 }
@@ -73,21 +107,26 @@ impl fmt::Display for SceneError {
                 f,
                 "'{spec}' is neither a built-in scene (tet, cube, beam, ball) nor an existing file"
             ),
-            SceneError::Resolution(n) => {
-                write!(
-                    f,
-                    "resolution {n} is out of range: expected 1..={MAX_RESOLUTION}"
-                )
-            }
+            SceneError::Resolution(why) => f.write_str(why),
+            SceneError::TooLarge {
+                builtin,
+                resolution,
+            } => write!(
+                f,
+                "{} at resolution {resolution} would have {} tets, more than the {} tetlab \
+                 simulates; {} goes up to resolution {}",
+                builtin.name(),
+                builtin.tets(*resolution),
+                limits::MAX_TETS,
+                builtin.name(),
+                builtin.largest_resolution()
+            ),
             SceneError::Mesh(e) => e.fmt(f),
         }
     }
 }
 
 impl std::error::Error for SceneError {}
-
-/// The largest `resolution` accepted: a 128³-cell cube is 12.6 M tets.
-pub const MAX_RESOLUTION: u32 = 128;
 
 impl Scene {
     /// A built-in scene by name, or a mesh file (`.node`, `.ele`, `.msh`) by path.
@@ -102,11 +141,18 @@ impl Scene {
         Scene::load(path).map_err(SceneError::Mesh)
     }
 
-    /// A built-in scene; `resolution` (1..=128) is the number of cells along a side (cube,
-    /// beam cross-section) or half the cells across (ball), ignored by `tet`.
+    /// A built-in scene; `resolution` ([`limits::RESOLUTION`]) is the number of cells along a
+    /// side (cube, beam cross-section) or half the cells across (ball), ignored by `tet`. The
+    /// size is checked before anything is allocated: at most [`limits::MAX_TETS`] tets.
     pub fn builtin(builtin: Builtin, resolution: u32) -> Result<Scene, SceneError> {
-        if !(1..=MAX_RESOLUTION).contains(&resolution) {
-            return Err(SceneError::Resolution(resolution));
+        limits::RESOLUTION
+            .check(resolution)
+            .map_err(SceneError::Resolution)?;
+        if builtin.tets(resolution) > limits::MAX_TETS as u64 {
+            return Err(SceneError::TooLarge {
+                builtin,
+                resolution,
+            });
         }
         let n = resolution as usize;
         let (mesh, pinned) = match builtin {

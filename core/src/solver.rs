@@ -21,12 +21,14 @@
 //! - PBD: s = −C / Σ wᵢ|∇ᵢC|², Δxᵢ = k′ s wᵢ ∇ᵢC with k′ = 1 − (1 − k)^(1/iterations), so that
 //!   `iterations` sweeps of stiffness k′ compound to k.
 //!
-//! Degenerate evaluations (undefined ∇C) and constraints whose particles are all pinned are
-//! skipped. All state lives in flat arrays, one set per family, allocated once: a step allocates
+//! Degenerate evaluations (undefined ∇C), constraints whose particles are all pinned, and
+//! constraints whose free particles can barely change them ([`LOCKED`]) are skipped. All state lives in flat arrays, one set per family, allocated once: a step allocates
 //! nothing, and the same inputs give the same bits.
 
 use crate::constraints::{Evaluation, Family, distance, plane, volume};
+use crate::divergence::Divergence;
 use crate::integrate;
+use crate::limits;
 use crate::mesh::{TET_EDGES, TetMesh};
 use crate::scene::Scene;
 use crate::vector::{Real, Vector3};
@@ -158,6 +160,36 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// Sets gravity, and the ground with it: on when g ≠ 0, off in weightlessness (the rule of
+    /// the command line and of lessons; the workbench also lets the user set the ground apart).
+    pub fn set_gravity(&mut self, gravity: f64) {
+        self.gravity = gravity;
+        self.ground = gravity != 0.0;
+    }
+
+    /// Ok when every number is within its range of [`crate::limits`]; otherwise the first that
+    /// is not, named (e.g. settings remembered by an older workbench, or edited by hand).
+    pub fn check(&self) -> Result<(), String> {
+        limits::SUBSTEPS.check(self.substeps)?;
+        limits::ITERATIONS.check(self.iterations)?;
+        limits::DT.check(self.dt)?;
+        limits::GRAVITY.check(self.gravity)?;
+        limits::DAMPING.check(self.damping)?;
+        limits::COMPLIANCE
+            .check(self.grab_compliance)
+            .map_err(|e| format!("grab {e}"))?;
+        for family in Family::ALL {
+            let name = family.short_name();
+            limits::COMPLIANCE
+                .check(self.compliance.get(family))
+                .map_err(|e| format!("{e} ({name})"))?;
+            limits::STIFFNESS
+                .check(self.stiffness.get(family))
+                .map_err(|e| format!("{e} ({name})"))?;
+        }
+        Ok(())
+    }
+
     /// Constraint projections in one frame, given how many constraints each family has: the
     /// active families' counts × substeps × iterations.
     pub fn projections_per_frame(&self, counts: PerFamily<usize>) -> u64 {
@@ -195,8 +227,8 @@ impl Default for Settings {
     }
 }
 
-/// The largest coordinate or velocity component (in m or m/s) a sound simulation has: below it,
-/// volumes (cubes), squared residuals and their sums over any mesh stay finite in f64.
+/// The largest coordinate or velocity component (in m or m/s) a sound simulation in f64 has:
+/// below it, volumes (cubes), squared residuals and their sums over any mesh stay finite.
 pub const SOUND_LIMIT: f64 = 1e30;
 
 /// Density used to lump masses: 1000 kg/m³.
@@ -314,8 +346,9 @@ where
 
 /// The projection rule without a branch, for one constraint or several in lanes:
 /// Σ wᵢ|∇ᵢC|²; XPBD Δλ = (−C − α̃λ) / (Σ wᵢ|∇ᵢC|² + α̃), PBD Δλ = −k′C / Σ wᵢ|∇ᵢC|²; Δxᵢ = wᵢ ∇ᵢC Δλ.
-/// Where the evaluation is degenerate or Σ wᵢ|∇ᵢC|² is not positive and finite (every particle
-/// fixed), the mask is set and the correction is zero.
+/// The mask is set and the correction is zero where the evaluation is degenerate, where
+/// Σ wᵢ|∇ᵢC|² is not positive and finite (every particle fixed), and where the constraint is
+/// [`LOCKED`]: its free particles can barely change it.
 #[inline(always)]
 pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
     evaluation: Evaluation<V, N>,
@@ -323,9 +356,19 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
     lambda: V::Real,
     rule: Rule<V::Real>,
 ) -> (<V::Real as Real>::Mask, Correction<N, V>) {
-    let weighted_norm = weighted_norm(&weights, &evaluation.gradients);
+    // Σ wᵢ|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
+    let mut weighted_norm = V::Real::ZERO;
+    let mut norm = V::Real::ZERO;
+    let mut heaviest = V::Real::ZERO;
+    for (w, g) in weights.iter().zip(&evaluation.gradients) {
+        let squared = g.length_squared();
+        weighted_norm += *w * squared;
+        norm += squared;
+        heaviest = V::Real::select(w.gt(heaviest), *w, heaviest);
+    }
+    let locked = weighted_norm.le(V::Real::from_f64(LOCKED) * heaviest * norm);
     let skipped =
-        evaluation.degenerate | !weighted_norm.gt(V::Real::ZERO) | !weighted_norm.finite();
+        evaluation.degenerate | !weighted_norm.gt(V::Real::ZERO) | !weighted_norm.finite() | locked;
     let delta_lambda = match rule {
         Rule::Xpbd { alpha_tilde } => {
             (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
@@ -362,6 +405,16 @@ pub fn project_kernel<V: Vector3, const N: usize>(
         .1
         .delta_x
 }
+
+/// Below this fraction of max wᵢ · Σ|∇ᵢC|², Σ wᵢ|∇ᵢC|² says that the particles free to move
+/// (w > 0) can barely change the constraint: those that could are pinned or held, and the free
+/// ones' gradients nearly vanish. Projecting it would move a free particle by about |C| / |∇ᵢC|,
+/// unboundedly far as ∇ᵢC → 0 (a face vertex of a height constraint whose other corners are
+/// held flings out by millions of metres, and the next projections feed on it). At this
+/// threshold a projection moves no particle more than 1/√LOCKED = 100 times as far as it would
+/// with every particle free; at or below it the constraint is skipped, like a degenerate one:
+/// Σ wᵢ|∇ᵢC|² ≤ LOCKED · max wᵢ · Σ|∇ᵢC|².
+pub const LOCKED: f64 = 1e-4;
 
 /// Σ wᵢ |∇ₚᵢC|², the denominator of every projection.
 #[inline]
@@ -532,14 +585,22 @@ impl Simulation {
         self.time
     }
 
-    /// Whether every coordinate and velocity component is finite and below [`SOUND_LIMIT`] in
-    /// size. A step with extreme settings (say gravity 10³⁰⁰ and nothing to stop the fall) leaves
-    /// that range; front ends check this and stop.
+    /// Ok while every coordinate and velocity component is finite and below [`SOUND_LIMIT`] in
+    /// size; otherwise the first that is not. Within the input [`crate::limits`] only an
+    /// instability leaves that range; front ends check after every frame and stop.
+    pub fn check(&self) -> Result<(), Divergence> {
+        Divergence::find(
+            self.frame,
+            (SOUND_LIMIT, SOUND_LIMIT),
+            self.positions.iter().map(|p| p.to_array()),
+            self.velocities.iter().map(|v| v.to_array()),
+            |i| i,
+        )
+    }
+
+    /// Whether [`Simulation::check`] finds nothing.
     pub fn is_sound(&self) -> bool {
-        self.positions
-            .iter()
-            .chain(&self.velocities)
-            .all(|v| v.abs().max_element() < SOUND_LIMIT)
+        self.check().is_ok()
     }
 
     /// The bytes of memory the simulation's arrays take (their capacities).
@@ -1003,8 +1064,8 @@ pub struct Projection {
     pub weighted_norm: f64,
     /// λ accumulated so far in this substep (XPBD).
     pub lambda: f64,
-    /// XPBD: Δλ; PBD: k′ s. `None` when the projection is skipped (degenerate, or every particle
-    /// fixed).
+    /// XPBD: Δλ; PBD: k′ s. `None` when the projection is skipped (degenerate, every particle
+    /// fixed, or [`LOCKED`]).
     pub delta_lambda: Option<f64>,
     /// Δx the projection would give each particle (zero when skipped).
     pub delta_x: [DVec3; 4],

@@ -4,15 +4,13 @@
 use std::path::{Path, PathBuf};
 use tetlab_core::constraints::volume::signed_volume;
 use tetlab_core::mesh::{MeshError, TetMesh};
+use tetlab_core::shared_meshes;
 
-fn shared(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/meshes")
-        .join(name)
-}
-
-fn load(name: &str) -> TetMesh {
-    let (mesh, report) = TetMesh::load(&shared(name)).unwrap_or_else(|e| panic!("{e}"));
+/// A reference mesh of `../shared/meshes`, loaded and checked; `None` when the folder is absent
+/// (the test then skips, see [`shared_meshes::for_test`]).
+fn load(name: &str) -> Option<TetMesh> {
+    let path = shared_meshes::for_test(name)?;
+    let (mesh, report) = TetMesh::load(&path).unwrap_or_else(|e| panic!("{e}"));
     println!(
         "{name}: {} nodes, {} tets, {:?}",
         mesh.positions.len(),
@@ -23,12 +21,14 @@ fn load(name: &str) -> TetMesh {
         (0..mesh.tets.len()).all(|t| signed_volume(&mesh.corners(t)) >= 0.0),
         "{name}: every tet positively oriented after loading"
     );
-    mesh
+    Some(mesh)
 }
 
 #[test]
 fn shared_meshes_have_the_counts_their_readme_states() {
-    let bunny = load("bunny.node");
+    let Some(bunny) = load("bunny.node") else {
+        return;
+    };
     assert_eq!(
         (bunny.positions.len(), bunny.tets.len(), bunny.edges().len()),
         (333, 1351, 1907)
@@ -38,21 +38,21 @@ fn shared_meshes_have_the_counts_their_readme_states() {
         456,
         "bunny.face lists 456 surface triangles"
     );
-    let bunny_from_ele = load("bunny.ele");
+    let bunny_from_ele = load("bunny.ele").expect("the folder is there");
     assert_eq!(bunny_from_ele, bunny);
 
-    let armadillo = load("armadillo_4k.ele");
+    let armadillo = load("armadillo_4k.ele").expect("the folder is there");
     assert_eq!(
         (armadillo.positions.len(), armadillo.tets.len()),
         (1180, 3717)
     );
 
-    let ball41 = load("ball_v41.msh");
-    let ball22 = load("ball_v22.msh");
+    let ball41 = load("ball_v41.msh").expect("the folder is there");
+    let ball22 = load("ball_v22.msh").expect("the folder is there");
     assert_eq!((ball41.positions.len(), ball41.tets.len()), (470, 1812));
     assert_eq!(ball41, ball22, "the same mesh in Gmsh 4.1 and 2.2");
 
-    let beam = load("beam_v41.msh");
+    let beam = load("beam_v41.msh").expect("the folder is there");
     assert_eq!((beam.positions.len(), beam.tets.len()), (423, 1208));
 }
 
@@ -177,6 +177,86 @@ fn broken_tetgen_files_name_the_file_and_line() {
     let path = write(&dir, "m.node", NODE);
     let e = TetMesh::load(&path).unwrap_err();
     assert_error(&e, "m.ele", None, "cannot read");
+}
+
+/// The defects a fuzzing pass found in the loaders (issue 13), each refused where it is written.
+#[test]
+fn headers_coordinates_and_sections_out_of_bounds_are_refused_at_their_line() {
+    // A count of attributes that wraps `4 + attributes` in release (and panicked in debug).
+    let huge = "18446744073709551615";
+    let e = tetgen_error("attributes", &format!("5 3 {huge} 0\n"), ELE);
+    assert_error(
+        &e,
+        "m.node",
+        Some(1),
+        "more than the 65536 values a line may hold",
+    );
+    let e = tetgen_error("ele-attributes", NODE, &format!("2 4 {huge}\n"));
+    assert_error(
+        &e,
+        "m.ele",
+        Some(1),
+        "more than the 65536 values a line may hold",
+    );
+    let e = tetgen_error("markers", "4 3 0 99999999999\n", ELE);
+    assert_error(&e, "m.node", Some(1), "boundary markers");
+    let e = tetgen_error("tets", NODE, "99999999999 4 0\n");
+    assert_error(
+        &e,
+        "m.ele",
+        Some(1),
+        "more than the 16777216 tetlab simulates",
+    );
+    // Coordinates whose fourth power overflows f32.
+    let e = tetgen_error("far", &NODE.replace("3 0 0 1", "3 0 0 1e31"), ELE);
+    assert_error(&e, "m.node", Some(6), "z: 1e31 is beyond ±1e6");
+    let e = gmsh_error("far", &MSH22.replace("3 0 1 0", "3 0 -2e6 0"));
+    assert_error(&e, "m.msh", Some(8), "y: -2e6 is beyond ±1e6");
+    // A second $Elements section no longer replaces the first.
+    let twice = MSH22.replace(
+        "$EndElements\n",
+        "$EndElements\n$Elements\n1\n1 4 2 0 1 1 2 3 4\n$EndElements\n",
+    );
+    let e = gmsh_error("elements-twice", &twice);
+    assert_error(&e, "m.msh", Some(16), "a second $Elements section");
+    // A misspelt section is reported where it is, not at the end of the file.
+    let e = gmsh_error("nodez", &MSH22.replace("$Nodes\n", "$Nodez\n"));
+    assert_error(
+        &e,
+        "m.msh",
+        Some(4),
+        "'$Nodez' is not a section: did you mean $Nodes?",
+    );
+    let e = gmsh_error(
+        "unclosed",
+        &MSH22.replace("$Nodes\n", "$Comments\nhello\n$Nodes\n"),
+    );
+    assert_error(
+        &e,
+        "m.msh",
+        Some(4),
+        "section $Comments is never closed by $EndComments",
+    );
+    let e = gmsh_error(
+        "v2-tags",
+        &MSH22.replace("2 4 2 0 1", &format!("2 4 {huge} 0 1")),
+    );
+    assert_error(&e, "m.msh", Some(14), "number of tags");
+}
+
+/// A byte-order mark some editors write first is skipped, never quoted in an error.
+#[test]
+fn a_byte_order_mark_is_skipped() {
+    let dir = scratch("bom");
+    write(&dir, "m.node", &format!("\u{feff}{NODE}"));
+    write(&dir, "m.ele", &format!("\u{feff}{ELE}"));
+    let (mesh, _) = TetMesh::load(&dir.join("m.node")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(mesh.tets.len(), 1);
+    let e = gmsh_error("bom", "\u{feff}$MeshFormat\n9.9 0 8\n");
+    assert_error(&e, "m.msh", Some(2), "MSH version 9.9");
+    let e = gmsh_error("bom-word", "\u{feff}solid\n");
+    assert!(!e.to_string().contains('\u{feff}'), "{e}");
+    assert_error(&e, "m.msh", Some(1), "found 'solid'");
 }
 
 const MSH22: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n$Elements\n2\n1 2 2 0 1 1 2 3\n2 4 2 0 1 1 2 3 4\n$EndElements\n";

@@ -6,8 +6,11 @@ use super::UsageError;
 use serde::Serialize;
 use std::io::Write;
 use std::time::{Duration, Instant};
+use tetlab_core::constraints::Family;
 use tetlab_core::fast::{FastSimulation, Order};
 use tetlab_core::lanes::{LANES, REGISTERS};
+use tetlab_core::limits;
+use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::Scene;
 use tetlab_core::solver::{Method, PerFamily, Settings, Simulation};
 
@@ -17,8 +20,9 @@ pub struct Args {
     /// A built-in scene (tet, cube, beam, ball) or a mesh file (.node, .ele, .msh).
     #[arg(long, default_value = "cube", value_name = "NAME|PATH")]
     scene: String,
-    /// Cells along a side of cube and beam, half the cells across ball (1..=128).
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=128))]
+    /// Cells along a side of cube and beam, half the cells across ball (1..=128, and at most
+    /// 16777216 tets).
+    #[arg(long, default_value_t = 10, value_parser = |s: &str| limits::RESOLUTION.parse(s))]
     resolution: u32,
     /// Active constraint families, comma-separated: edges, plane, volume.
     #[arg(long, default_value = "edges,volume", value_parser = PerFamily::parse_list)]
@@ -27,10 +31,10 @@ pub struct Args {
     #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
     solver: Method,
     /// Substeps per frame (1..=1000).
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 10, value_parser = |s: &str| limits::SUBSTEPS.parse(s))]
     substeps: u32,
     /// Gauss–Seidel iterations per substep (1..=1000).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 1, value_parser = |s: &str| limits::ITERATIONS.parse(s))]
     iterations: u32,
     /// Frames timed (1..=100000).
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..=100_000))]
@@ -124,7 +128,7 @@ fn time_reference(
     simulation: &mut Simulation,
 ) -> Result<Report, UsageError> {
     let elapsed = time(args, simulation, Simulation::step, |_| {});
-    sound(simulation.is_sound())?;
+    Metrics::measure_sound(simulation).map_err(|d| UsageError(d.to_string()))?;
     let projections = simulation.projections_per_frame();
     Ok(report(
         args,
@@ -152,7 +156,7 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
         FastSimulation::step,
         FastSimulation::reset_timings,
     );
-    sound(fast.is_sound())?;
+    fast.check().map_err(|d| UsageError(d.to_string()))?;
     let timings = fast.timings();
     let per = |k: usize| {
         let n = timings.projections[k];
@@ -189,7 +193,19 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
         Some(colours),
     );
     report.lanes = Some(format!("{LANES} f32 per batch, in {REGISTERS}"));
-    report.relative_error = Some(fast.relative_error());
+    let relative_error = fast.relative_error();
+    for family in Family::ALL {
+        if let Some(error) = relative_error.get(family)
+            && !error.is_finite()
+        {
+            return Err(UsageError(format!(
+                "the f32 engine could not measure how well the {} constraints hold (their \
+                 relative error is {error}); the scene is beyond what f32 resolves",
+                family.short_name()
+            )));
+        }
+    }
+    report.relative_error = Some(relative_error);
     Ok(report)
 }
 
@@ -205,16 +221,6 @@ fn time<S>(args: &Args, solver: &mut S, step: fn(&mut S), warmed: fn(&mut S)) ->
         step(solver);
     }
     started.elapsed()
-}
-
-fn sound(sound: bool) -> Result<(), UsageError> {
-    if sound {
-        Ok(())
-    } else {
-        Err(UsageError(
-            "the simulation diverged: a coordinate or velocity passed 1e30".into(),
-        ))
-    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -247,7 +253,8 @@ fn report(
         ns_per_projection: seconds * 1e9 / (frames * projections_per_frame.max(1) as f64),
         ns_per_projection_by_family: by_family,
         ms_per_frame: seconds * 1e3 / frames,
-        frames_per_second: frames / seconds.max(f64::MIN_POSITIVE),
+        // A clock reads at least a nanosecond, which keeps the rate finite.
+        frames_per_second: frames / seconds.max(1e-9),
         bytes_per_tet: heap_bytes as f64 / tets.max(1) as f64,
         peak_rss_bytes: peak_rss(),
         colours,

@@ -4,7 +4,7 @@
 //! (under `compare/`), and the text of each step (`lesson`).
 
 use super::UsageError;
-use super::record::{ArrowsMode, Destination, Ending, Recorder, Session, send_layout};
+use crate::record::{ArrowsMode, Destination, Ending, Recorder, Session, send_layout};
 use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
@@ -55,9 +55,19 @@ impl Clock {
 pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     if args.list {
         for (k, builtin) in BUILTIN.iter().enumerate() {
-            let lesson = Lesson::builtin(k + 1).map_err(|e| UsageError(e.to_string()))?;
-            writeln!(out, "{:>2}  {}  ({})", k + 1, lesson.title, builtin.file)
-                .map_err(UsageError::stdout)?;
+            let header = builtin.header().map_err(|e| UsageError(e.to_string()))?;
+            let missing = header
+                .missing_mesh()
+                .map(|mesh| format!("; needs {mesh}, which is not there"))
+                .unwrap_or_default();
+            writeln!(
+                out,
+                "{:>2}  {}  ({}{missing})",
+                k + 1,
+                header.title,
+                builtin.file
+            )
+            .map_err(UsageError::stdout)?;
         }
         return Ok(Outcome::Observed);
     }
@@ -98,8 +108,9 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
         )
     });
     let mut comparison_recorder: Option<Recorder> = None;
+    run.measure().map_err(|d| UsageError(d.to_string()))?;
     if let Some(recorder) = &mut recorder {
-        recorder.log_frame_at(0, 0.0, &run.simulation);
+        recorder.log_frame_at(0, 0.0, &run.simulation, run.metrics().0);
     }
 
     writeln!(out, "# {}", lesson.title).map_err(UsageError::stdout)?;
@@ -130,11 +141,14 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
             clock.tick(run.simulation.settings().dt);
             if let (Some(rec), Some(recorder)) = (rec, &mut recorder) {
                 recorder.set_tet(run.tet);
-                recorder.log_frame_at(clock.frame, clock.time, &run.simulation);
+                let (metrics, comparison_metrics) = run.metrics();
+                recorder.log_frame_at(clock.frame, clock.time, &run.simulation, metrics);
                 if run.comparison.is_none() && comparison_recorder.take().is_some() {
                     rec.log("compare", &rerun::Clear::recursive()).ok();
                 }
-                if let Some(comparison) = &run.comparison {
+                if let (Some(comparison), Some(comparison_metrics)) =
+                    (&run.comparison, comparison_metrics)
+                {
                     let second = comparison_recorder.get_or_insert_with(|| {
                         Recorder::new(
                             rec,
@@ -146,7 +160,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
                         )
                     });
                     second.set_tet(run.tet);
-                    second.log_frame_at(clock.frame, clock.time, comparison);
+                    second.log_frame_at(clock.frame, clock.time, comparison, comparison_metrics);
                 }
             }
             match &session {
@@ -158,15 +172,20 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
                 None => ControlFlow::Continue(()),
             }
         });
-        if !run.simulation.is_sound() {
-            return Err(UsageError(format!(
-                "lesson {}: the simulation diverged in step {}",
-                lesson.source.display(),
-                k + 1
-            )));
-        }
-        let Some(outcome) = outcome else {
-            break;
+        let outcome = match outcome {
+            Ok(Some(outcome)) => outcome,
+            Ok(None) => break,
+            Err(divergence) => {
+                let failure = UsageError(format!(
+                    "lesson {}, step {}: {divergence}",
+                    lesson.source.display(),
+                    k + 1
+                ));
+                return Err(match session {
+                    Some(session) => session.close_after(clock.frame, failure),
+                    None => failure,
+                });
+            }
         };
         if step.frames > 0 {
             writeln!(out, "(ran {} frames)", step.frames).map_err(UsageError::stdout)?;

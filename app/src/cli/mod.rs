@@ -91,8 +91,8 @@ pub fn main() -> ExitCode {
         Command::Bench(args) => bench::run(&args, &mut stdout),
         #[cfg(not(target_arch = "wasm32"))]
         Command::Record(args) => record::run(&args, &mut stdout).map(|ending| {
-            if let record::Ending::Interrupted = ending {
-                success = ExitCode::from(record::INTERRUPTED);
+            if let crate::record::Ending::Interrupted = ending {
+                success = ExitCode::from(crate::record::INTERRUPTED);
             }
         }),
         #[cfg(not(target_arch = "wasm32"))]
@@ -101,7 +101,7 @@ pub fn main() -> ExitCode {
         Command::Lesson(args) => lesson::run(&args, &mut stdout).map(|outcome| match outcome {
             lesson::Outcome::Observed => {}
             lesson::Outcome::NotObserved => success = ExitCode::FAILURE,
-            lesson::Outcome::Interrupted => success = ExitCode::from(record::INTERRUPTED),
+            lesson::Outcome::Interrupted => success = ExitCode::from(crate::record::INTERRUPTED),
         }),
     };
     let flushed = outcome.and_then(|()| stdout.flush().map_err(UsageError::stdout));

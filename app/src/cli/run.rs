@@ -62,7 +62,7 @@ impl FrameRecord {
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let (scene, mut simulation) = args.simulation.build()?;
     let io = UsageError::stdout;
-    let initial = Metrics::measure(&simulation);
+    let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
     if args.json {
         write_json(out, &FrameRecord::new(&simulation, &initial)).map_err(io)?;
     } else {
@@ -91,8 +91,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let mut last_inverted_frame = (initial.inverted_tets > 0).then_some(0);
     let mut last = initial;
     for _ in 0..args.simulation.frames {
-        SimulationArgs::step(&mut simulation)?;
-        last = Metrics::measure(&simulation);
+        last = SimulationArgs::step(&mut simulation)?;
         if last.inverted_tets > 0 {
             last_inverted_frame = Some(simulation.frame());
         }

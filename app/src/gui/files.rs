@@ -69,8 +69,10 @@ impl Inbox {
 /// Opens a file given by name and contents: a lesson (.toml) or a Gmsh mesh (.msh). A TetGen mesh
 /// is two files, which a browser hands over one by one.
 fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
-    let text =
-        std::str::from_utf8(bytes).map_err(|_| format!("{}: not a text file", name.display()))?;
+    let text = tetlab_core::text_file::decode(bytes).map_err(|e| {
+        let line = e.line.map(|l| format!(":{l}")).unwrap_or_default();
+        format!("{}{line}: {}", name.display(), e.message)
+    })?;
     let extension = name.extension().and_then(|e| e.to_str()).unwrap_or("");
     match extension {
         "toml" => Lesson::parse(name, text)
@@ -112,12 +114,13 @@ mod tests {
     /// What a browser hands over (a name and the bytes) opens as on the desktop.
     #[test]
     fn dropped_bytes_open_meshes_and_lessons_and_explain_what_they_cannot() {
-        let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
-        let ball = std::fs::read(shared.join("ball_v41.msh")).unwrap();
-        assert_eq!(
-            opened_name(open_bytes(Path::new("ball_v41.msh"), &ball)),
-            "scene ball_v41"
-        );
+        if let Some(path) = tetlab_core::shared_meshes::for_test("ball_v41.msh") {
+            let ball = std::fs::read(path).unwrap();
+            assert_eq!(
+                opened_name(open_bytes(Path::new("ball_v41.msh"), &ball)),
+                "scene ball_v41"
+            );
+        }
         let lesson = tetlab_core::lesson::BUILTIN[0];
         assert!(
             opened_name(open_bytes(Path::new(lesson.file), lesson.text.as_bytes()))
@@ -127,7 +130,10 @@ mod tests {
         assert!(node.contains("two files"), "{node}");
         let bad = opened_name(open_bytes(Path::new("bad.msh"), b"$MeshFormat\n9.9 0 8\n"));
         assert!(bad.starts_with("bad.msh:2:"), "{bad}");
-        assert!(opened_name(open_bytes(Path::new("x.msh"), &[0xff, 0xfe])).contains("not a text"));
+        assert!(
+            opened_name(open_bytes(Path::new("x.msh"), &[0xff, 0xfe]))
+                .contains("x.msh:1: not text")
+        );
         assert!(opened_name(open_bytes(Path::new("notes.txt"), b"hi")).contains("not a mesh"));
     }
 }

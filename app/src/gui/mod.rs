@@ -144,7 +144,13 @@ impl TetlabApp {
     }
 
     /// The workbench on the scene and settings of `preferences` (the renderer must be installed).
-    pub fn with_preferences(preferences: Preferences) -> Self {
+    /// Settings that are out of range (remembered settings come from a file on disk, which may
+    /// be old or edited by hand) are replaced by the defaults, and the error says so.
+    pub fn with_preferences(mut preferences: Preferences) -> Self {
+        let refused = preferences.settings.check().err();
+        if refused.is_some() {
+            preferences.settings = Preferences::default().settings;
+        }
         let builtin = Builtin::from_name(&preferences.scene.builtin).unwrap_or(Builtin::Cube);
         let bench = Workbench::builtin(builtin, preferences.scene.resolution, preferences.settings);
         let cache = SceneCache::new(&bench.scene.mesh);
@@ -154,7 +160,9 @@ impl TetlabApp {
             cache,
             viewport,
             preferences,
-            error: None,
+            error: refused.map(|why| {
+                format!("the remembered solver settings were refused ({why}); using the defaults")
+            }),
             step_time: Duration::ZERO,
             show_help: false,
             show_inspector: false,
@@ -400,6 +408,16 @@ impl TetlabApp {
         ctx.request_repaint();
     }
 
+    /// A simulation that diverged (and went back to rest) is reported where errors are.
+    fn show_divergence(&mut self) {
+        let twin = self.comparison.as_mut().map(|c| &mut c.bench);
+        for (bench, which) in [(Some(&mut self.bench), ""), (twin, "right: ")] {
+            if let Some(divergence) = bench.and_then(|b| b.diverged.take()) {
+                self.error = Some(format!("{which}{divergence}; back to the rest shape"));
+            }
+        }
+    }
+
     /// The 3D view, or two side by side when comparing, each titled with its families.
     fn views(&mut self, ui: &mut egui::Ui) {
         let view = self.preferences.view;
@@ -453,6 +471,7 @@ impl eframe::App for TetlabApp {
             ctx.set_zoom_factor(zoom);
         }
         self.advance(&ctx);
+        self.show_divergence();
         let mut actions = Vec::new();
         let mut request = None;
         let mut lesson_request = None;
@@ -645,5 +664,19 @@ mod tests {
         assert_eq!(restored.scene.builtin, "tet");
         assert_eq!(restored.settings, Preferences::default().settings);
         assert!(restored.settings.settle_edits);
+    }
+
+    #[test]
+    fn remembered_settings_out_of_range_are_refused_with_a_message() {
+        let mut preferences = Preferences::default();
+        preferences.settings.dt = 0.0;
+        preferences.settings.compliance.volume = f64::INFINITY;
+        let app = TetlabApp::with_preferences(preferences);
+        assert_eq!(
+            *app.bench.simulation.settings(),
+            Preferences::default().settings
+        );
+        let error = app.error.expect("the refusal is shown");
+        assert!(error.contains("dt 0 is out of range"), "{error}");
     }
 }

@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 use std::collections::VecDeque;
+use tetlab_core::divergence::Divergence;
 use tetlab_core::lesson::Action as LessonAction;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
@@ -45,6 +46,8 @@ pub struct Workbench {
     pub stepping: Option<StepByStep>,
     /// What the last step-by-step press did.
     pub last_advance: Option<Advanced>,
+    /// The simulation diverged (and was put back at rest): why, until the app shows it.
+    pub diverged: Option<Divergence>,
 }
 
 impl Workbench {
@@ -63,6 +66,7 @@ impl Workbench {
             scramble_seed: 1,
             stepping: None,
             last_advance: None,
+            diverged: None,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -304,8 +308,23 @@ impl Workbench {
         self.after_change();
     }
 
+    /// Measures the new state. A state that diverged is never drawn or plotted: the body goes
+    /// back to rest, paused, and [`Workbench::diverged`] says why.
     fn after_change(&mut self) {
-        self.metrics = Metrics::measure(&self.simulation);
+        match Metrics::measure_sound(&self.simulation) {
+            Ok(metrics) => self.metrics = metrics,
+            Err(divergence) => {
+                self.diverged = Some(divergence);
+                self.stepping = None;
+                self.last_advance = None;
+                self.dragging = None;
+                self.playing = false;
+                self.simulation.release();
+                self.simulation.reset();
+                self.history.clear();
+                self.metrics = Metrics::measure(&self.simulation);
+            }
+        }
         self.record();
     }
 
@@ -378,6 +397,34 @@ mod tests {
         bench.next_tet_of_selected();
         assert_ne!(bench.selected_tet, Some(first));
         assert!(bench.simulation.tets()[bench.selected_tet.unwrap()].contains(&13));
+    }
+
+    #[test]
+    fn a_simulation_that_diverges_goes_back_to_rest_and_says_why() {
+        let mut bench = Workbench::builtin(Builtin::Cube, 2, Settings::default());
+        // What no setting of the controls allows: a compliance whose α / h² is infinite.
+        let mut settings = *bench.simulation.settings();
+        settings.compliance.volume = 1e305;
+        bench.set_settings(settings);
+        bench.select_tet(0);
+        bench.invert_selected();
+        bench.set_playing(true);
+        bench.step_frame();
+        let divergence = bench
+            .diverged
+            .take()
+            .expect("the volume projections gave NaN");
+        assert!(
+            divergence.to_string().contains("diverged at frame"),
+            "{divergence}"
+        );
+        assert!(!bench.playing);
+        assert!(bench.simulation.is_sound());
+        assert_eq!(
+            bench.simulation.positions(),
+            bench.simulation.rest_positions()
+        );
+        assert!(bench.metrics.volume_error.is_finite());
     }
 
     #[test]

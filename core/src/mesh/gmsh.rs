@@ -1,6 +1,7 @@
 //! Gmsh's `.msh` ASCII format, versions 2.2 and 4.1.
 //!
-//! Only the `$MeshFormat`, `$Nodes` and `$Elements` sections are read; other sections are skipped.
+//! Only the `$MeshFormat`, `$Nodes` and `$Elements` sections are read, one of each (a second is
+//! refused); other sections are skipped.
 //! Of the elements, 4-node tets (type 4) and 10-node tets (type 11, corners only) are kept; points,
 //! lines, triangles and the rest are counted and ignored. Node tags may be any positive numbers;
 //! elements refer to them by tag.
@@ -44,7 +45,9 @@ pub fn parse(path: &Path, text: &str) -> Result<(TetMesh, LoadReport), MeshError
         match name {
             "$Nodes" => {
                 if nodes.is_some() {
-                    return Err(line.error("a second $Nodes section"));
+                    return Err(line.error(
+                        "a second $Nodes section: tetlab reads one (merge the sections in Gmsh)",
+                    ));
                 }
                 nodes = Some(match version {
                     Version::V2 => nodes_v2(&mut lines)?,
@@ -53,6 +56,11 @@ pub fn parse(path: &Path, text: &str) -> Result<(TetMesh, LoadReport), MeshError
                 end_section(&mut lines, "$EndNodes")?;
             }
             "$Elements" => {
+                if tets.is_some() {
+                    return Err(line.error(
+                        "a second $Elements section: tetlab reads one (merge the sections in Gmsh)",
+                    ));
+                }
                 let Some(nodes) = &nodes else {
                     return Err(line.error("$Elements before $Nodes"));
                 };
@@ -63,7 +71,7 @@ pub fn parse(path: &Path, text: &str) -> Result<(TetMesh, LoadReport), MeshError
                 end_section(&mut lines, "$EndElements")?;
             }
             _ if name.starts_with('$') && !name.starts_with("$End") => {
-                skip_section(&mut lines, &name[1..])?;
+                skip_section(&mut lines, &line)?;
             }
             _ => {
                 return Err(
@@ -125,13 +133,43 @@ fn end_section(lines: &mut Lines<'_>, end: &str) -> Result<(), MeshError> {
     }
 }
 
-fn skip_section(lines: &mut Lines<'_>, name: &str) -> Result<(), MeshError> {
-    let end = format!("$End{name}");
-    loop {
-        let line = lines.next_line(&end)?;
+/// The sections tetlab reads.
+const KNOWN: [&str; 3] = ["$MeshFormat", "$Nodes", "$Elements"];
+
+/// Skips a section tetlab does not read, from its opening line `start` to its `$End…` line. A
+/// name one letter away from a section tetlab reads is taken for a typing mistake, and a section
+/// that is never closed is reported at its opening line.
+fn skip_section(lines: &mut Lines<'_>, start: &Line<'_>) -> Result<(), MeshError> {
+    let opening = start.words[0];
+    if let Some(known) = KNOWN
+        .into_iter()
+        .find(|known| one_letter_apart(known, opening))
+    {
+        return Err(start.error(format!(
+            "'{opening}' is not a section: did you mean {known}?"
+        )));
+    }
+    let end = format!("$End{}", &opening[1..]);
+    while let Some(line) = lines.next_or_end() {
         if line.words[0] == end {
             return Ok(());
         }
+    }
+    Err(start.error(format!("section {opening} is never closed by {end}")))
+}
+
+/// Whether `a` and `b` differ by exactly one letter changed, added or left out.
+fn one_letter_apart(a: &str, b: &str) -> bool {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let (short, long) = if a.len() <= b.len() { (a, b) } else { (b, a) };
+    match long.len() - short.len() {
+        0 => short.iter().zip(&long).filter(|(x, y)| x != y).count() == 1,
+        1 => (0..long.len()).any(|i| {
+            let mut without = long.clone();
+            without.remove(i);
+            without == short
+        }),
+        _ => false,
     }
 }
 
@@ -142,9 +180,9 @@ fn add_node(
     coordinates_at: usize,
 ) -> Result<(), MeshError> {
     let p = DVec3::new(
-        line.number(coordinates_at, "x")?,
-        line.number(coordinates_at + 1, "y")?,
-        line.number(coordinates_at + 2, "z")?,
+        line.coordinate(coordinates_at, "x")?,
+        line.coordinate(coordinates_at + 1, "y")?,
+        line.coordinate(coordinates_at + 2, "z")?,
     );
     let index = nodes.positions.len() as u32;
     if nodes.index_of_tag.insert(tag, index).is_some() {
@@ -218,6 +256,14 @@ fn tet_from(line: &Line<'_>, first: usize, nodes: &Nodes) -> Result<[u32; 4], Me
     Ok(tet)
 }
 
+/// Adds the tet read on `line`, unless the mesh would then have more than
+/// [`crate::limits::MAX_TETS`].
+fn push_tet(tets: &mut Vec<[u32; 4]>, line: &Line<'_>, tet: [u32; 4]) -> Result<(), MeshError> {
+    crate::limits::tet_count(tets.len() + 1).map_err(|e| line.error(e))?;
+    tets.push(tet);
+    Ok(())
+}
+
 fn elements_v2(lines: &mut Lines<'_>, nodes: &Nodes) -> Result<(Vec<[u32; 4]>, usize), MeshError> {
     let header = lines.next_line("the number of elements")?;
     let n = count(&header, 0, "number of elements")?;
@@ -226,11 +272,11 @@ fn elements_v2(lines: &mut Lines<'_>, nodes: &Nodes) -> Result<(Vec<[u32; 4]>, u
         let line = lines.next_line(&format!("element {} of {n}", i + 1))?;
         line.expect_at_least(3, "<tag> <type> <number of tags> …")?;
         let kind: u32 = line.integer(1, "element type")?;
-        let tags: usize = line.integer(2, "number of tags")?;
+        let tags = line.per_line(2, "number of tags")?;
         if kind == TET4 || kind == TET10 {
             let per = if kind == TET4 { 4 } else { 10 };
             line.expect_at_least(3 + tags + per, "a tet element's tags and nodes")?;
-            tets.push(tet_from(&line, 3 + tags, nodes)?);
+            push_tet(&mut tets, &line, tet_from(&line, 3 + tags, nodes)?)?;
         } else {
             ignored += 1;
         }
@@ -257,7 +303,7 @@ fn elements_v4(lines: &mut Lines<'_>, nodes: &Nodes) -> Result<(Vec<[u32; 4]>, u
             if kind == TET4 || kind == TET10 {
                 let per = if kind == TET4 { 4 } else { 10 };
                 line.expect_at_least(1 + per, "<tag> <nodes…>")?;
-                tets.push(tet_from(&line, 1, nodes)?);
+                push_tet(&mut tets, &line, tet_from(&line, 1, nodes)?)?;
             } else {
                 ignored += 1;
             }

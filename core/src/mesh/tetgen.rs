@@ -32,8 +32,8 @@ pub fn parse_nodes(path: &Path, text: &str) -> Result<(Vec<DVec3>, u64), MeshErr
     if dimension != 3 {
         return Err(header.error(format!("dimension is {dimension}; tet meshes need 3")));
     }
-    let attributes: usize = optional(&header, 2, "number of attributes")?;
-    let markers: usize = optional(&header, 3, "number of boundary markers")?;
+    let attributes = optional(&header, 2, "number of attributes")?;
+    let markers = optional(&header, 3, "number of boundary markers")?;
     if markers > 1 {
         return Err(header.error(format!("boundary markers must be 0 or 1, found {markers}")));
     }
@@ -63,9 +63,9 @@ pub fn parse_nodes(path: &Path, text: &str) -> Result<(Vec<DVec3>, u64), MeshErr
             )));
         }
         positions.push(DVec3::new(
-            line.number(1, "x")?,
-            line.number(2, "y")?,
-            line.number(3, "z")?,
+            line.coordinate(1, "x")?,
+            line.coordinate(2, "y")?,
+            line.coordinate(3, "z")?,
         ));
     }
     reject_extra(&mut lines, count, "points")?;
@@ -82,12 +82,12 @@ pub fn parse_elements(
     let mut lines = Lines::new(path, text, true);
     let header = lines.next_line("the header: <tets> <nodes per tet> <attributes>")?;
     header.expect_at_least(2, "<tets> <nodes per tet>")?;
-    let count: usize = header.integer(0, "number of tets")?;
+    let count = header.tet_count(0, "number of tets")?;
     let per_tet: usize = header.integer(1, "nodes per tet")?;
     if per_tet != 4 && per_tet != 10 {
         return Err(header.error(format!("nodes per tet is {per_tet}; expected 4 or 10")));
     }
-    let attributes: usize = optional(&header, 2, "number of attributes")?;
+    let attributes = optional(&header, 2, "number of attributes")?;
     if count == 0 {
         return Err(header.error("the file declares 0 tets"));
     }
@@ -120,9 +120,10 @@ pub fn parse_elements(
     Ok(tets)
 }
 
+/// Header word `i`, a count of values per line, or 0 when the header ends before it.
 fn optional(header: &Line<'_>, i: usize, what: &str) -> Result<usize, MeshError> {
     if header.words.len() > i {
-        header.integer(i, what)
+        header.per_line(i, what)
     } else {
         Ok(0)
     }

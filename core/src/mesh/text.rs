@@ -46,6 +46,9 @@ impl fmt::Display for MeshError {
 
 impl std::error::Error for MeshError {}
 
+/// The most values (attributes, markers) a header may declare for each line that follows.
+pub const MAX_VALUES_PER_LINE: usize = 1 << 16;
+
 /// The non-blank lines of a text file, split into words, with `#` comments removed when asked.
 pub(crate) struct Lines<'a> {
     path: &'a Path,
@@ -63,30 +66,22 @@ pub(crate) struct Line<'a> {
 }
 
 impl<'a> Lines<'a> {
-    /// Reads `path` whole (as UTF-8) and returns the text for [`Lines::new`].
+    /// Reads `path` whole as text ([`crate::text_file::read`]) for [`Lines::new`].
     pub fn read(path: &Path) -> Result<String, MeshError> {
-        std::fs::read(path)
-            .map_err(|e| MeshError::whole_file(path, format!("cannot read: {e}")))
-            .and_then(|bytes| {
-                String::from_utf8(bytes).map_err(|e| {
-                    let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
-                        .iter()
-                        .filter(|&&b| b == b'\n')
-                        .count();
-                    MeshError::at(
-                        path,
-                        line,
-                        "not text: invalid UTF-8 (binary files are not supported)",
-                    )
-                })
-            })
+        crate::text_file::read(path).map_err(|e| MeshError {
+            path: path.to_owned(),
+            line: e.line,
+            message: e.message,
+        })
     }
 
     /// Lines of `text` read from `path`; `comments` removes everything from a `#` on.
     pub fn new(path: &'a Path, text: &'a str, comments: bool) -> Self {
         Self {
             path,
-            lines: text.lines().enumerate(),
+            lines: crate::text_file::without_byte_order_mark(text)
+                .lines()
+                .enumerate(),
             comments,
             last_line: 0,
         }
@@ -160,6 +155,32 @@ impl Line<'_> {
             Ok(x) if x.is_finite() => Ok(x),
             Ok(_) => Err(self.error(format!("{what}: '{word}' is not a finite number"))),
             Err(_) => Err(self.error(format!("{what}: '{word}' is not a number"))),
+        }
+    }
+
+    /// Word `i` as a coordinate within [`crate::limits::MAX_COORDINATE`].
+    pub fn coordinate(&self, i: usize, what: &str) -> Result<f64, MeshError> {
+        let x = self.number(i, what)?;
+        crate::limits::coordinate(x).map_err(|e| self.error(format!("{what}: {e}")))
+    }
+
+    /// Word `i` as a count of tets (or of elements that may be tets), at most
+    /// [`crate::limits::MAX_TETS`].
+    pub fn tet_count(&self, i: usize, what: &str) -> Result<usize, MeshError> {
+        let count: usize = self.integer(i, what)?;
+        crate::limits::tet_count(count).map_err(|e| self.error(format!("{what}: {e}")))
+    }
+
+    /// Word `i` as a count of values per line (attributes, markers), at most
+    /// [`MAX_VALUES_PER_LINE`]: more than any line of a mesh holds.
+    pub fn per_line(&self, i: usize, what: &str) -> Result<usize, MeshError> {
+        let count: usize = self.integer(i, what)?;
+        if count <= MAX_VALUES_PER_LINE {
+            Ok(count)
+        } else {
+            Err(self.error(format!(
+                "{what}: {count} is more than the {MAX_VALUES_PER_LINE} values a line may hold"
+            )))
         }
     }
 

@@ -1,0 +1,36 @@
+//! The viewer's layout for a recording: the blueprint sent at the start.
+
+use rerun::RecordingStream;
+use tetlab_core::metrics::Metrics;
+
+/// The default layout: a 3D view per root (side by side) on the left, the four metrics stacked on
+/// the right (each plot shows the metric of every root).
+pub fn send_layout(rec: &RecordingStream, roots: &[&str]) {
+    use rerun::blueprint::{
+        Blueprint, BlueprintActivation, Horizontal, Spatial3DView, TimeSeriesView, Vertical,
+    };
+    let plots = Metrics::default().headline().map(|(name, _)| {
+        let contents: Vec<String> = roots
+            .iter()
+            .map(|root| format!("+ {root}metrics/{name}"))
+            .collect();
+        TimeSeriesView::new(name.replace('_', " "))
+            .with_contents(contents)
+            .into()
+    });
+    let views = roots.iter().map(|root| {
+        let title = if root.is_empty() {
+            "soft body"
+        } else {
+            root.trim_end_matches('/')
+        };
+        Spatial3DView::new(title)
+            .with_origin(format!("{root}world"))
+            .into()
+    });
+    let layout = Horizontal::new([Horizontal::new(views).into(), Vertical::new(plots).into()])
+        .with_column_shares([3.0, 2.0]);
+    Blueprint::new(layout)
+        .send(rec, BlueprintActivation::default())
+        .ok();
+}

@@ -1,0 +1,13 @@
+//! Rerun recordings: what a simulation looks like in one ([`recorder`]), writing one safely
+//! ([`session`]), the viewer's layout ([`layout`]), and reading one back with Rerun's own decoder
+//! ([`summary`], which `tetlab inspect` prints and `record` uses to check its own file). The
+//! subcommands `record` and `lesson --record` are set-up around these.
+
+pub mod layout;
+pub mod recorder;
+pub mod session;
+pub mod summary;
+
+pub use layout::send_layout;
+pub use recorder::{ArrowsMode, Recorder};
+pub use session::{Destination, Ending, INTERRUPTED, Session};

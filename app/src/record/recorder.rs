@@ -1,0 +1,226 @@
+//! What a simulation looks like in a recording: the entities [`Recorder`] logs, static data once
+//! and what changes every frame, all derived from [`tetlab_core::visual`] like the workbench's
+//! view.
+
+use glam::Vec3;
+use rerun::RecordingStream;
+use tetlab_core::constraints::Family;
+use tetlab_core::metrics::Metrics;
+use tetlab_core::scene::Scene;
+use tetlab_core::solver::Simulation;
+use tetlab_core::visual::{self, Arrow, Quantity, Rgba};
+
+/// Which gradient arrows to log.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ArrowsMode {
+    /// None.
+    None,
+    /// Those of the tet given by --tet.
+    Selected,
+    /// Those of every tet.
+    All,
+}
+
+/// Logs a simulation to a recording: static data once, what changes every frame.
+///
+/// Entities, under a root (empty, or e.g. `compare/` for a second simulation): `world` (view
+/// coordinates, y up; the viewer draws its grid on y = 0, the ground), `world/particles`,
+/// `world/mesh` and `world/edges` (all faces and edges of a small mesh, the surface of a large
+/// one, as [`visual::display_faces`] and [`visual::display_edges`] choose),
+/// `world/gradients/<family>`, `world/corrections` (Δp of the last substep, at its true length),
+/// `metrics/<name>`.
+pub struct Recorder<'a> {
+    rec: &'a RecordingStream,
+    root: String,
+    arrows: ArrowsMode,
+    tet: usize,
+    edge_strips: Vec<Vec<u32>>,
+    inverted: Vec<bool>,
+    colours: Vec<Rgba>,
+    logged_colours: Option<Vec<Rgba>>,
+    points: Vec<Vec3>,
+    arrow_scratch: Vec<Arrow>,
+}
+
+impl<'a> Recorder<'a> {
+    /// Logs the static parts under `root`: coordinates, mesh topology, styles.
+    pub fn new(
+        rec: &'a RecordingStream,
+        root: &str,
+        scene: &Scene,
+        simulation: &Simulation,
+        arrows: ArrowsMode,
+        tet: usize,
+    ) -> Self {
+        let log = |path: &str, what: &dyn rerun::AsComponents| {
+            rec.log_static(format!("{root}{path}"), what).ok();
+        };
+        log("world", &rerun::ViewCoordinates::RIGHT_HAND_Y_UP());
+        let size = visual::body_size(simulation.rest_positions());
+        log(
+            "world/particles",
+            &rerun::Points3D::update_fields()
+                .with_radii([rerun::Radius::new_scene_units((0.004 * size) as f32)]),
+        );
+        let faces = visual::display_faces(&scene.mesh);
+        log(
+            "world/mesh",
+            &rerun::Mesh3D::update_fields()
+                .with_triangle_indices(faces.iter().map(|f| rerun::TriangleIndices::from(*f))),
+        );
+        log(
+            "world/edges",
+            &rerun::LineStrips3D::update_fields()
+                .with_colors([rgba(visual::EDGE)])
+                .with_radii([rerun::Radius::new_ui_points(0.75)]),
+        );
+        let quantities = Family::ALL.map(Quantity::Gradient);
+        for quantity in quantities.into_iter().chain([Quantity::Correction]) {
+            log(
+                &arrow_path(quantity),
+                &rerun::Arrows3D::update_fields().with_colors([rgba(quantity.colour())]),
+            );
+        }
+        Recorder {
+            rec,
+            root: root.to_owned(),
+            arrows,
+            tet,
+            edge_strips: visual::edge_strips(&visual::display_edges(&scene.mesh)),
+            inverted: Vec::new(),
+            colours: Vec::new(),
+            logged_colours: None,
+            points: Vec::new(),
+            arrow_scratch: Vec::new(),
+        }
+    }
+
+    /// The tet whose arrows are logged with [`ArrowsMode::Selected`].
+    pub fn set_tet(&mut self, tet: usize) {
+        self.tet = tet;
+    }
+
+    /// Logs the current state, whose `metrics` were measured and checked
+    /// ([`Metrics::measure_sound`]), at the simulation's frame and time. Colours are logged only
+    /// when they change: the viewer shows the latest value at each frame.
+    pub fn log_frame(&mut self, simulation: &Simulation, metrics: &Metrics) {
+        self.log_frame_at(simulation.frame(), simulation.time(), simulation, metrics);
+    }
+
+    /// Logs the current state at a given frame and time (for runs whose simulation is reset
+    /// along the way, like lessons, but whose recording goes on).
+    pub fn log_frame_at(
+        &mut self,
+        frame: u64,
+        time: f64,
+        simulation: &Simulation,
+        metrics: &Metrics,
+    ) {
+        let rec = self.rec;
+        rec.set_time_sequence("frame", frame as i64);
+        rec.set_duration_secs("sim_time", time);
+        let root = self.root.clone();
+        let log = |path: &str, what: &dyn rerun::AsComponents| {
+            rec.log(format!("{root}{path}"), what).ok();
+        };
+
+        self.points.clear();
+        self.points
+            .extend(simulation.positions().iter().map(|p| p.as_vec3()));
+        visual::inverted_tets(
+            simulation.positions(),
+            simulation.tets(),
+            &mut self.inverted,
+        );
+        visual::particle_colours(
+            self.points.len(),
+            simulation.tets(),
+            &self.inverted,
+            &mut self.colours,
+        );
+        let colours_changed = self.logged_colours.as_ref() != Some(&self.colours);
+
+        let mut particles =
+            rerun::Points3D::update_fields().with_positions(self.points.iter().copied());
+        let mut mesh =
+            rerun::Mesh3D::update_fields().with_vertex_positions(self.points.iter().copied());
+        if colours_changed {
+            particles = particles.with_colors(self.colours.iter().map(|&c| rgba(c)));
+            mesh = mesh.with_vertex_colors(self.colours.iter().map(|&c| rgba(c)));
+            self.logged_colours = Some(self.colours.clone());
+        }
+        log("world/particles", &particles);
+        log("world/mesh", &mesh);
+        log(
+            "world/edges",
+            &rerun::LineStrips3D::update_fields().with_strips(self.edge_strips.iter().map(
+                |strip| {
+                    strip
+                        .iter()
+                        .map(|&i| self.points[i as usize])
+                        .collect::<Vec<_>>()
+                },
+            )),
+        );
+        self.log_arrows(simulation);
+
+        for (name, value) in metrics.headline() {
+            log(&format!("metrics/{name}"), &rerun::Scalars::single(value));
+        }
+    }
+
+    /// Logs the gradient arrows of the chosen tets, one entity per active family, and Δp of the
+    /// last substep at their particles, at its true length.
+    fn log_arrows(&mut self, simulation: &Simulation) {
+        let tets = match self.arrows {
+            ArrowsMode::None => return,
+            ArrowsMode::Selected => self.tet..self.tet + 1,
+            ArrowsMode::All => 0..simulation.tets().len(),
+        };
+        let active = simulation.settings().active;
+        self.arrow_scratch.clear();
+        for family in Family::ALL.into_iter().filter(|&f| active.get(f)) {
+            for tet in tets.clone() {
+                visual::tet_gradient_arrows(simulation, tet, family, 1.0, &mut self.arrow_scratch);
+            }
+        }
+        match self.arrows {
+            ArrowsMode::All => {
+                let particles = 0..simulation.positions().len() as u32;
+                visual::correction_arrows(simulation, particles, 1.0, &mut self.arrow_scratch);
+            }
+            _ => {
+                let corners = simulation.tets()[self.tet];
+                visual::correction_arrows(simulation, corners, 1.0, &mut self.arrow_scratch);
+            }
+        }
+        let quantities = Family::ALL
+            .into_iter()
+            .filter(|&f| active.get(f))
+            .map(Quantity::Gradient)
+            .chain([Quantity::Correction]);
+        for quantity in quantities {
+            let arrows = self.arrow_scratch.iter().filter(|a| a.quantity == quantity);
+            self.rec
+                .log(
+                    format!("{}{}", self.root, arrow_path(quantity)),
+                    &rerun::Arrows3D::update_fields()
+                        .with_origins(arrows.clone().map(|a| a.origin.as_vec3()))
+                        .with_vectors(arrows.map(|a| a.vector.as_vec3())),
+                )
+                .ok();
+        }
+    }
+}
+
+/// Where arrows of `quantity` are logged.
+fn arrow_path(quantity: Quantity) -> String {
+    match quantity {
+        Quantity::Gradient(family) => format!("world/gradients/{}", family.short_name()),
+        Quantity::Correction => "world/corrections".to_owned(),
+    }
+}
+
+fn rgba(c: Rgba) -> rerun::Color {
+    rerun::Color::from_unmultiplied_rgba(c[0], c[1], c[2], c[3])
+}

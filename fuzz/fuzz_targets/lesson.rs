@@ -1,0 +1,51 @@
+//! A lesson file. Whatever the bytes, reading gives a lesson or an error naming the file and a
+//! line that exists; never a panic. Scenes are built only when small (built-ins up to resolution
+//! 2), so that the fuzzer's time goes to parsing; the first step's actions are applied and one
+//! frame run, since a parsed lesson must run.
+
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+use tetlab_core::lesson::{Lesson, LessonRun};
+use tetlab_core::limits::{MAX_TETS, RESOLUTION};
+use tetlab_core::scene::{Builtin, Scene, SceneError};
+use tetlab_core::text_file::decode;
+
+/// Built-in scenes of up to 500 tets are built; larger ones that are valid are refused here (not
+/// built, to keep each run fast); out-of-range ones go to `Scene::builtin`, which refuses them
+/// before allocating anything.
+fn small(name: &str, resolution: u32) -> Result<Scene, SceneError> {
+    let Some(builtin) = Builtin::from_name(name) else {
+        return Err(SceneError::Unknown(name.to_owned()));
+    };
+    let valid = RESOLUTION.contains(resolution) && builtin.tets(resolution) <= MAX_TETS as u64;
+    if valid && builtin.tets(resolution) > 500 {
+        return Err(SceneError::Resolution("not built while fuzzing".into()));
+    }
+    Scene::builtin(builtin, resolution)
+}
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(text) = decode(data) else {
+        return;
+    };
+    match Lesson::parse_with(Path::new("fuzz.toml"), text, &small) {
+        Ok(lesson) => {
+            assert!(!lesson.steps.is_empty());
+            let mut run = LessonRun::new(&lesson);
+            for &action in &lesson.steps[0].actions {
+                run.apply(action);
+            }
+            let settings = run.simulation.settings();
+            if settings.substeps * settings.iterations <= 1000 {
+                run.step();
+            }
+        }
+        Err(e) => {
+            if let Some(line) = e.line {
+                assert!(line >= 1 && line <= text.lines().count() + 1, "{e}");
+            }
+        }
+    }
+});
