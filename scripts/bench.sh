@@ -9,7 +9,7 @@ cargo build --release --quiet
 tetlab=target/release/tetlab
 bunny=../shared/meshes/bunny.node
 
-echo "| scene | tets | constraints | solver, threads | projections per frame | ms per frame | frames per second | ns per projection (edges / plane / volume) | bytes per tet | error at the end (edges / plane / volume) | command |"
+echo "| scene | tets | constraints | solver, threads | projections per frame | ms per frame | frames per second | ns per projection (edges / height / volume) | bytes per tet | error at the end (edges / height / volume) | command |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 
 row() {
@@ -21,10 +21,10 @@ runs = [json.loads(line) for line in sys.stdin]
 r = min(runs, key=lambda r: r["ms_per_frame"])
 f = r["ns_per_projection_by_family"]
 families = "—" if f is None else " / ".join(
-    "—" if f[k] == 0 else "%.1f" % f[k] for k in ("edges", "plane", "volume"))
+    "—" if f[k] == 0 else "%.1f" % f[k] for k in ("edges", "height", "volume"))
 e = r.get("relative_error")
 errors = "—" if e is None else " / ".join(
-    "—" if e[k] is None else "%.1e" % e[k] for k in ("edges", "plane", "volume"))
+    "—" if e[k] is None else "%.1e" % e[k] for k in ("edges", "height", "volume"))
 print("| %s | %d | %s | %s, %d | %d | %.3f | %.1f | %.1f (%s) | %.0f | %s | `tetlab bench %s` |" % (
     r["scene"], r["tets"], r["constraints"], r["solver"], r["threads"],
     r["projections_per_frame"], r["ms_per_frame"], r["frames_per_second"],
@@ -34,13 +34,13 @@ print("| %s | %d | %s | %s, %d | %d | %.3f | %.1f | %.1f (%s) | %.0f | %s | `tet
 
 row --scene $bunny --frames 1000
 row --scene $bunny --frames 300 --reference
-row --scene $bunny --frames 300 --constraints edges,plane,volume
+row --scene $bunny --frames 300 --constraints edges,height,volume
 row --scene $bunny --frames 1000 --jacobi
 row --scene cube --resolution 6 --frames 500
 row --scene cube --resolution 13 --frames 100
 row --scene cube --resolution 26 --frames 40
 row --scene cube --resolution 26 --frames 40 --threads 2
-row --scene cube --resolution 26 --frames 10 --constraints edges,plane,volume
+row --scene cube --resolution 26 --frames 10 --constraints edges,height,volume
 row --scene cube --resolution 26 --frames 40 --jacobi
 row --scene cube --resolution 55 --frames 5 --warmup 1
 row --scene cube --resolution 55 --frames 5 --warmup 1 --threads 2

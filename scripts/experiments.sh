@@ -37,7 +37,7 @@ print("| {} | {} | {} of {} | {} | {:.3g} | {:.2e} | {:.2e} | `tetlab run {}` |"
 ' "$args"
 }
 
-families="edges plane volume edges,volume edges,plane plane,volume edges,plane,volume"
+families="edges height volume edges,volume edges,height height,volume edges,height,volume"
 
 header "1. One tet, vertex 0 reflected through its opposite face (\`--perturb invert\`), 300 frames"
 for c in $families; do row --scene tet --perturb invert --constraints $c; done
@@ -52,7 +52,7 @@ header "4. Cube 4×4×4 flattened onto the ground: every tet flat"
 for c in $families; do row --scene cube --perturb flatten --constraints $c; done
 
 header "5. Cube 4×4×4 at rest under gravity: does a family alone hold the shape?"
-for c in edges plane volume; do row --scene cube --constraints $c; done
+for c in edges height volume; do row --scene cube --constraints $c; done
 
 header "6. Bunny flattened, rigid edges (compliance 0), gravity 10"
 for s in 1 10; do for c in $families; do row --scene $bunny --perturb flatten --gravity 10 --constraints $c --substeps $s; done; done
@@ -61,14 +61,14 @@ header "7. Bunny mirrored, rigid edges, gravity 10"
 for c in $families; do row --scene $bunny --perturb mirror --gravity 10 --constraints $c; done
 
 header "8. The headline: bunny flattened with the teaching demo's soft edges (compliance 0.1 at density 1000, its 100 at density 1), gravity 10"
-for s in 1 2 5 10; do for c in edges,volume edges,plane,volume; do
+for s in 1 2 5 10; do for c in edges,volume edges,height,volume; do
   row --scene $bunny --perturb flatten --gravity 10 --compliance edges=0.1 --constraints $c --substeps $s
 done; done
 
 header "9. Bunny resting on the ground, soft edges as in the demo"
-for c in edges,volume edges,plane,volume; do row --scene $bunny --gravity 10 --compliance edges=0.1 --constraints $c; done
+for c in edges,volume edges,height,volume; do row --scene $bunny --gravity 10 --compliance edges=0.1 --constraints $c; done
 
 header "10. One substep: more iterations instead of substeps (bunny flattened, gravity 10)"
 for ec in 0 0.1; do for i in 1 2 5 20; do
-  row --scene $bunny --perturb flatten --gravity 10 --compliance edges=$ec --constraints edges,plane,volume --substeps 1 --iterations $i
+  row --scene $bunny --perturb flatten --gravity 10 --compliance edges=$ec --constraints edges,height,volume --substeps 1 --iterations $i
 done; done

@@ -62,7 +62,7 @@ fn the_report_counts_the_work_of_a_frame() {
     );
     let error = &report["relative_error"];
     assert!(error["edges"].as_f64().unwrap().is_finite());
-    assert!(error["plane"].is_null(), "heights not active");
+    assert!(error["height"].is_null(), "heights not active");
 }
 
 #[test]
@@ -96,7 +96,7 @@ fn the_heights_are_counted_and_timed_on_their_own() {
         "--resolution",
         "2",
         "--constraints",
-        "edges,plane,volume",
+        "edges,height,volume",
         "--frames",
         "3",
     ]);
@@ -107,7 +107,7 @@ fn the_heights_are_counted_and_timed_on_their_own() {
         (edges + 4 * tets + tets) * 10
     );
     let by_family = &report["ns_per_projection_by_family"];
-    for family in ["edges", "plane", "volume"] {
+    for family in ["edges", "height", "volume"] {
         assert!(by_family[family].as_f64().unwrap() > 0.0, "{family}");
     }
 }
@@ -140,7 +140,7 @@ fn a_mesh_beyond_f32_is_refused_and_every_figure_is_a_number() {
         "--scene",
         scene.to_str().unwrap(),
         "--constraints",
-        "edges,plane,volume",
+        "edges,height,volume",
         "--frames",
         "20",
         "--json",

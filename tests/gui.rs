@@ -115,7 +115,7 @@ fn a_tet_inverted_through_the_ui_turns_red_with_arrows_and_recovers_when_played(
     assert!(
         pixels_like(
             &mut harness,
-            visual::family_colour(tetlab_core::constraints::Family::Volume)
+            visual::family_colour(tetlab_core::constraints::Family::VOLUME)
         ) > 50,
         "volume arrows"
     );
@@ -265,11 +265,12 @@ fn dragging_a_particle_while_paused_moves_it() {
 fn the_controls_switch_solver_and_families() {
     let mut harness = workbench("cube", 2);
     harness.get_by_label("PBD").click();
-    harness.get_by_label("heights (plane)").click();
+    // The solver panel's checkbox; the compare panel below has one of the same name.
+    harness.get_all_by_label("heights").next().unwrap().click();
     harness.run_steps(2);
     let settings = *harness.state().bench.simulation.settings();
     assert_eq!(settings.method, tetlab_core::solver::Method::Pbd);
-    assert!(settings.active.plane);
+    assert!(settings.active[tetlab_core::constraints::Family::HEIGHT]);
     harness.snapshot("controls_pbd_heights");
 }
 
@@ -303,7 +304,8 @@ fn a_bad_mesh_file_shows_an_error_and_keeps_the_scene() {
 #[test]
 fn readme_screenshot() {
     let mut harness = workbench("cube", 3);
-    harness.get_by_label("heights (plane)").click();
+    // The solver panel's checkbox; the compare panel below has one of the same name.
+    harness.get_all_by_label("heights").next().unwrap().click();
     harness.run_steps(1);
     let corner = 63;
     let (rect, camera) = (
@@ -359,9 +361,9 @@ fn step_by_step_projects_one_constraint_per_key_press() {
         .unwrap()
         .pending(&harness.state().bench.simulation)
         .expect("the volume is next");
-    assert_eq!(pending.family, tetlab_core::constraints::Family::Volume);
+    assert_eq!(pending.family, tetlab_core::constraints::Family::VOLUME);
     harness.get_by_label_contains("next projects volume #0");
-    harness.get_by_label_contains("last: projected distance #5");
+    harness.get_by_label_contains("last: projected edges #5");
     assert!(
         pixels_like(&mut harness, tetlab::gui::geometry::PENDING) > 50,
         "the pending constraint is highlighted"
@@ -393,7 +395,8 @@ fn step_by_step_projects_one_constraint_per_key_press() {
 #[test]
 fn the_inspector_shows_the_numbers_of_the_selected_tet() {
     let mut harness = workbench("cube", 2);
-    harness.get_by_label("heights (plane)").click();
+    // The solver panel's checkbox; the compare panel below has one of the same name.
+    harness.get_all_by_label("heights").next().unwrap().click();
     harness.key_press(egui::Key::I);
     harness.key_press(egui::Key::E);
     harness.run_steps(2);
@@ -506,9 +509,25 @@ fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
         let comparison = harness.state().comparison.as_ref().expect("comparing");
         comparison.bench.simulation.settings().active.describe()
     };
-    assert_eq!(families(&harness), "plane+volume");
-    harness.get_by_label("plane+volume");
+    assert_eq!(families(&harness), "height+volume");
+    harness.get_by_label("height+volume");
     harness.get_by_label("edges+volume");
+    // A solver setting reaches both sides; the families are each side's own.
+    harness.get_by_label("PBD").click();
+    harness.get_all_by_label("heights").next().unwrap().click();
+    harness.run_steps(1);
+    let app = harness.state();
+    let (left, right) = (
+        app.bench.simulation.settings(),
+        app.comparison.as_ref().unwrap().bench.simulation.settings(),
+    );
+    assert_eq!(left.method, tetlab_core::solver::Method::Pbd);
+    assert_eq!(right.method, tetlab_core::solver::Method::Pbd, "both sides");
+    assert_eq!(left.active.describe(), "edges+height+volume");
+    assert_eq!(families(&harness), "height+volume", "its own families");
+    harness.get_by_label("XPBD").click();
+    harness.get_all_by_label("heights").next().unwrap().click();
+    harness.run_steps(1);
     harness.key_press(egui::Key::M);
     harness.run_steps(1);
     let comparison = harness.state().comparison.as_ref().unwrap();

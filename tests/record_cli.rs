@@ -38,7 +38,7 @@ const RUN: [&str; 10] = [
     "--perturb",
     "mirror",
     "--constraints",
-    "edges,plane,volume",
+    "edges,height,volume",
     "--frames",
     "20",
 ];
@@ -69,7 +69,7 @@ fn a_recording_holds_every_entity_frame_particle_and_metric_of_the_run() {
         "world/mesh",
         "world/edges",
         "world/gradients/edges",
-        "world/gradients/plane",
+        "world/gradients/height",
         "world/gradients/volume",
         "world/corrections",
         "metrics/inverted_tets",

@@ -5,12 +5,13 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3A};
 use std::hint::black_box;
-use tetlab_core::constraints::{distance, plane, volume};
+use tetlab_core::constraints::PerFamily;
+use tetlab_core::constraints::{distance, height, volume};
 use tetlab_core::fast::{FastSimulation, Order};
 use tetlab_core::lanes::{F32x8, LANES, Vec3x8};
+use tetlab_core::projection::project_kernel;
 use tetlab_core::scene::{Builtin, Scene};
-use tetlab_core::solver::project_kernel;
-use tetlab_core::solver::{PerFamily, Settings, Simulation};
+use tetlab_core::solver::{Settings, Simulation};
 
 fn kernels(c: &mut Criterion) {
     let tet = [
@@ -43,11 +44,11 @@ fn kernels(c: &mut Criterion) {
             )
         })
     });
-    group.bench_function("plane f32", |b| {
-        b.iter(|| project_kernel(plane::evaluate::<Vec3A>, black_box(&tet32), 0.7, w32))
+    group.bench_function("height f32", |b| {
+        b.iter(|| project_kernel(height::evaluate::<Vec3A>, black_box(&tet32), 0.7, w32))
     });
-    group.bench_function("plane f64", |b| {
-        b.iter(|| project_kernel(plane::evaluate::<DVec3>, black_box(&tet), 0.7, w))
+    group.bench_function("height f64", |b| {
+        b.iter(|| project_kernel(height::evaluate::<DVec3>, black_box(&tet), 0.7, w))
     });
     group.bench_function("volume f32", |b| {
         b.iter(|| project_kernel(volume::evaluate::<Vec3A>, black_box(&tet32), 0.2, w32))
@@ -69,8 +70,15 @@ fn kernels(c: &mut Criterion) {
             )
         })
     });
-    group.bench_function("plane f32 x8 lanes", |b| {
-        b.iter(|| project_kernel(plane::evaluate::<Vec3x8>, black_box(&lanes), rest4(0.7), w4))
+    group.bench_function("height f32 x8 lanes", |b| {
+        b.iter(|| {
+            project_kernel(
+                height::evaluate::<Vec3x8>,
+                black_box(&lanes),
+                rest4(0.7),
+                w4,
+            )
+        })
     });
     group.bench_function("volume f32 x8 lanes", |b| {
         b.iter(|| {

@@ -34,8 +34,15 @@ pub enum Cause {
     },
     /// A metric of the state is not finite.
     Metric {
-        /// Its name, as in [`crate::metrics::Metrics::all`].
+        /// Its name, as in [`crate::metrics::Metrics::headline`].
         name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// The RMS residual of a family is not finite.
+    Residual {
+        /// The family.
+        family: crate::constraints::Family,
         /// Its value.
         value: f64,
     },
@@ -140,6 +147,11 @@ impl fmt::Display for Divergence {
                 number(value)
             )?,
             Cause::Metric { name, value } => write!(f, "{name} became {}", number(value))?,
+            Cause::Residual { family, value } => write!(
+                f,
+                "the RMS residual of the {family} constraints became {}",
+                number(value)
+            )?,
         }
         f.write_str("; more substeps or a shorter frame (dt) may keep it stable")
     }

@@ -38,20 +38,22 @@ impl Inspection {
 /// let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
 /// let mut simulation = Simulation::new(&scene, Settings::default());
 /// simulation.perturb(Perturbation::Invert);
-/// let volume = inspect(&simulation, Family::Volume, 0);
+/// let volume = inspect(&simulation, Family::VOLUME, 0);
 /// // Inverted: C = −2V, and the analytic gradient agrees with central differences.
 /// assert!((volume.projection.value + 2.0 * volume.projection.rest).abs() < 1e-12);
 /// assert!(volume.relative_error < 1e-6);
 /// ```
 pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection {
     let projection = simulation.projection(family, c);
-    let positions = simulation.positions();
-    let points: Vec<DVec3> = projection
-        .particles()
-        .iter()
-        .map(|&i| positions[i as usize])
-        .collect();
-    let (analytic, numeric) = analytic_and_numeric(family, &points, projection.rest);
+    let at = |positions: &[DVec3]| -> Vec<DVec3> {
+        projection
+            .particles()
+            .iter()
+            .map(|&i| positions[i as usize])
+            .collect()
+    };
+    let (points, rest_shape) = (at(simulation.positions()), at(simulation.rest_positions()));
+    let (analytic, numeric) = analytic_and_numeric(family, &points, projection.rest, &rest_shape);
     let mut numeric_gradients = [DVec3::ZERO; 4];
     numeric_gradients[..numeric.len()].copy_from_slice(&numeric);
     Inspection {
@@ -65,7 +67,7 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
 /// `out`.
 pub fn inspect_tet(simulation: &Simulation, tet: usize, out: &mut Vec<Inspection>) {
     let active = simulation.settings().active;
-    for family in Family::ALL.into_iter().filter(|&f| active.get(f)) {
+    for family in active.families() {
         for c in simulation.tet_constraints(tet, family) {
             out.push(inspect(simulation, family, c));
         }
@@ -75,8 +77,9 @@ pub fn inspect_tet(simulation: &Simulation, tet: usize, out: &mut Vec<Inspection
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::constraints::PerFamily;
     use crate::scene::{Builtin, Perturbation, Scene};
-    use crate::solver::{PerFamily, Settings};
+    use crate::solver::Settings;
 
     #[test]
     fn a_tet_shows_six_edges_four_heights_and_one_volume_all_checked() {
@@ -91,7 +94,7 @@ mod tests {
         inspect_tet(&simulation, 3, &mut out);
         let count = |f: Family| out.iter().filter(|i| i.projection.family == f).count();
         assert_eq!(
-            [Family::Distance, Family::Plane, Family::Volume].map(count),
+            [Family::EDGES, Family::HEIGHT, Family::VOLUME].map(count),
             [6, 4, 1]
         );
         for inspection in &out {

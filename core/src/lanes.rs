@@ -356,7 +356,7 @@ impl Vector3 for Vec3x8 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constraints::{distance, plane, volume};
+    use crate::constraints::{distance, height, volume};
     use crate::random::SplitMix64;
 
     /// Each lane of a formula on lanes is that formula on one f32 (up to the last bits of the
@@ -378,13 +378,13 @@ mod tests {
             let rest = [0.1, -0.2, 0.3, 0.05, 0.2, -0.1, 0.0, 0.4];
             let r = F32x8::new(rest);
             let v = volume::evaluate(&lanes, r);
-            let h = plane::evaluate(&lanes, r);
+            let h = height::evaluate(&lanes, r);
             let d = distance::evaluate(&[lanes[0], lanes[1]], r);
             let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * (1.0 + a.abs().max(b.abs()));
             for k in 0..LANES {
                 let one = points[k];
                 let one_v = volume::evaluate(&one, rest[k]);
-                let one_h = plane::evaluate(&one, rest[k]);
+                let one_h = height::evaluate(&one, rest[k]);
                 let one_d = distance::evaluate(&[one[0], one[1]], rest[k]);
                 for (lanes, one) in [(&v, &one_v), (&h, &one_h)] {
                     assert!(close(lanes.value.to_array()[k], one.value));

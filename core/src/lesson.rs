@@ -28,12 +28,12 @@
 //! [`Metrics::headline`] (`compare.METRIC` for the comparison's) and OP one of `==`, `!=`, `<`,
 //! `<=`, `>`, `>=`.
 
-use crate::constraints::Family;
+use crate::constraints::{Family, PerFamily};
 use crate::divergence::Divergence;
 use crate::limits::{self, Bounds};
 use crate::metrics::Metrics;
 use crate::scene::{Perturbation, Scene, SceneError, reflect_through_opposite_face};
-use crate::solver::{Method, PerFamily, Settings, Simulation};
+use crate::solver::{Method, Settings, Simulation};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::ops::ControlFlow;
@@ -995,7 +995,7 @@ expect = ["compare.volume_error < 0.001"]
         )));
         let comparison = run.comparison.as_mut().unwrap();
         let mut settings = *comparison.settings();
-        settings.compliance.volume = 1e305;
+        settings.compliance[Family::VOLUME] = 1e305;
         comparison.set_settings(settings);
         let step = Step {
             actions: vec![Action::Perturb(Perturbation::Invert)],

@@ -197,7 +197,7 @@ pub const MAX_TETS: usize = 1 << 24;
 /// ```
 /// use tetlab_core::constraints::Family;
 /// use tetlab_core::limits::{COMPLIANCE, family_value};
-/// assert_eq!(family_value("volume=0.5", &COMPLIANCE), Ok((Family::Volume, 0.5)));
+/// assert_eq!(family_value("volume=0.5", &COMPLIANCE), Ok((Family::VOLUME, 0.5)));
 /// assert!(family_value("edges=inf", &COMPLIANCE).unwrap_err().contains("out of range"));
 /// ```
 pub fn family_value(text: &str, bounds: &Bounds<f64>) -> Result<(Family, f64), String> {

@@ -3,9 +3,10 @@
 //! overflows is reported as it is, and [`Metrics::check`] turns it into a [`Divergence`], so that
 //! nothing that is not a number is ever printed, plotted or recorded.
 
-use crate::constraints::{Evaluation, distance, plane, volume};
+use crate::constraints::volume::signed_volume;
+use crate::constraints::{Constraint, Family, PerFamily, Visit};
 use crate::divergence::{Cause, Divergence};
-use crate::solver::{ConstraintSet, PerFamily, Simulation};
+use crate::solver::{ConstraintSet, Simulation};
 use glam::DVec3;
 
 /// Rest volumes at or below this fraction of the mean rest volume are left out of
@@ -41,26 +42,14 @@ impl Metrics {
         ]
     }
 
-    /// Every measurement by the name used in `tetlab run --json`: the headline ones, then the
-    /// residual of each family.
-    pub fn all(&self) -> [(&'static str, f64); 7] {
-        let [a, b, c, d] = self.headline();
-        [
-            a,
-            b,
-            c,
-            d,
-            ("residual_edges", self.residual.edges),
-            ("residual_plane", self.residual.plane),
-            ("residual_volume", self.residual.volume),
-        ]
-    }
-
     /// Ok when every measurement is finite; otherwise the first that is not, as the divergence
     /// of a state at `frame`.
     pub fn check(&self, frame: u64) -> Result<(), Divergence> {
-        match self.all().into_iter().find(|(_, value)| !value.is_finite()) {
-            Some((name, value)) => Err(Divergence::new(frame, Cause::Metric { name, value })),
+        if let Some((name, value)) = self.headline().into_iter().find(|(_, v)| !v.is_finite()) {
+            return Err(Divergence::new(frame, Cause::Metric { name, value }));
+        }
+        match self.residual.iter().find(|(_, v)| !v.is_finite()) {
+            Some((family, value)) => Err(Divergence::new(frame, Cause::Residual { family, value })),
             None => Ok(()),
         }
     }
@@ -77,7 +66,7 @@ impl Metrics {
     /// Measures the current state of `simulation`.
     pub fn measure(simulation: &Simulation) -> Metrics {
         let positions = simulation.positions();
-        let rest_volumes = &simulation.volumes.rest;
+        let rest_volumes = simulation.constraints(Family::VOLUME).rest();
         let total_rest: f64 = rest_volumes.iter().sum();
         // The scale of "a sliver": the mean size of a rest volume (a degenerate tet may be a hair
         // negative, and a mesh of them could make a signed mean negative or zero).
@@ -87,7 +76,7 @@ impl Metrics {
         let mut min_volume_ratio: Option<f64> = None;
         let mut total = 0.0;
         for (tet, &rest) in simulation.tets().iter().zip(rest_volumes) {
-            let v = volume::signed_volume(&tet.map(|i| positions[i as usize]));
+            let v = signed_volume(&tet.map(|i| positions[i as usize]));
             total += v;
             if v < 0.0 {
                 inverted_tets += 1;
@@ -98,14 +87,11 @@ impl Metrics {
             }
         }
         let mut max_edge_strain: f64 = 0.0;
-        for (edge, &rest) in simulation
-            .edges
-            .particles
-            .iter()
-            .zip(&simulation.edges.rest)
-        {
+        let edges = simulation.constraints(Family::EDGES);
+        for (c, &rest) in edges.rest().iter().enumerate() {
             if rest > 0.0 {
-                let length = positions[edge[0] as usize].distance(positions[edge[1] as usize]);
+                let [a, b] = [edges.particles(c)[0], edges.particles(c)[1]];
+                let length = positions[a as usize].distance(positions[b as usize]);
                 max_edge_strain = larger(max_edge_strain, (length - rest).abs() / rest);
             }
         }
@@ -118,11 +104,13 @@ impl Metrics {
                 0.0
             },
             max_edge_strain,
-            residual: PerFamily {
-                edges: rms(&simulation.edges, positions, distance::evaluate),
-                plane: rms(&simulation.planes, positions, plane::evaluate),
-                volume: rms(&simulation.volumes, positions, volume::evaluate),
-            },
+            residual: PerFamily::from_fn(|family| {
+                family.visit(Rms {
+                    set: simulation.constraints(family),
+                    positions,
+                    rest_positions: simulation.rest_positions(),
+                })
+            }),
         }
     }
 }
@@ -146,25 +134,30 @@ fn larger(a: f64, b: f64) -> f64 {
 }
 
 /// √(mean C²) over the constraints of `set`; 0 when there are none.
-fn rms<const N: usize>(
-    set: &ConstraintSet<N>,
-    positions: &[DVec3],
-    evaluate: fn(&[DVec3; N], f64) -> Evaluation<DVec3, N>,
-) -> f64 {
-    if set.is_empty() {
-        return 0.0;
+struct Rms<'a> {
+    set: &'a ConstraintSet,
+    positions: &'a [DVec3],
+    rest_positions: &'a [DVec3],
+}
+
+impl Visit for Rms<'_> {
+    type Output = f64;
+
+    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, constraint: &C) -> f64 {
+        let set = self.set;
+        if set.is_empty() {
+            return 0.0;
+        }
+        let sum: f64 = (0..set.len())
+            .map(|c| {
+                let idx: [u32; N] = std::array::from_fn(|k| set.particles(c)[k]);
+                let p = idx.map(|i| self.positions[i as usize]);
+                let shape = idx.map(|i| self.rest_positions[i as usize]);
+                constraint.evaluate(&p, set.rest()[c], &shape).value.powi(2)
+            })
+            .sum();
+        (sum / set.len() as f64).sqrt()
     }
-    let sum: f64 = set
-        .particles
-        .iter()
-        .zip(&set.rest)
-        .map(|(idx, &rest)| {
-            evaluate(&idx.map(|i| positions[i as usize]), rest)
-                .value
-                .powi(2)
-        })
-        .sum();
-    (sum / set.len() as f64).sqrt()
 }
 
 #[cfg(test)]

@@ -149,9 +149,10 @@ impl StepByStep {
 
 /// How many constraints one sweep projects.
 fn sweep_length(simulation: &Simulation) -> usize {
-    Family::ALL
-        .into_iter()
-        .filter(|&f| simulation.settings().active.get(f))
+    simulation
+        .settings()
+        .active
+        .families()
         .map(|f| simulation.constraint_count(f))
         .sum()
 }
@@ -159,8 +160,9 @@ fn sweep_length(simulation: &Simulation) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::constraints::PerFamily;
     use crate::scene::{Builtin, Perturbation, Scene};
-    use crate::solver::{Method, PerFamily, Settings};
+    use crate::solver::{Method, Settings};
 
     fn scrambled(method: Method) -> Simulation {
         let scene = Scene::builtin(Builtin::Cube, 1).unwrap();
@@ -200,7 +202,7 @@ mod tests {
                     Advanced::BeganSubstep => panic!("one substep only"),
                 }
             }
-            let per_sweep = whole.edges.len() + whole.planes.len() + whole.volumes.len();
+            let per_sweep: usize = Family::all().map(|f| whole.constraint_count(f)).sum();
             assert_eq!((sweeps, projections), (2, 2 * per_sweep), "{method:?}");
             assert_eq!(stepper, StepByStep::BetweenSubsteps);
             assert_eq!(whole.positions(), stepped.positions(), "{method:?}");

@@ -29,14 +29,16 @@ pub fn max_abs_error(analytic: &[DVec3], numeric: &[DVec3]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The analytic gradient of `family` at `points` and the central-difference one, in f64.
+/// The analytic gradient of `family` at `points` (with rest value `rest` and rest shape
+/// `rest_shape`) and the central-difference one, in f64.
 pub fn analytic_and_numeric(
     family: Family,
     points: &[DVec3],
     rest: f64,
+    rest_shape: &[DVec3],
 ) -> (Vec<DVec3>, Vec<DVec3>) {
-    let analytic = family.evaluate(points, rest).gradients[..points.len()].to_vec();
-    let numeric = central_difference(points, |p| family.evaluate(p, rest).value);
+    let analytic = family.evaluate(points, rest, rest_shape).gradients[..points.len()].to_vec();
+    let numeric = central_difference(points, |p| family.evaluate(p, rest, rest_shape).value);
     (analytic, numeric)
 }
 
@@ -54,12 +56,11 @@ pub fn well_conditioned(family: Family, points: &[DVec3]) -> bool {
     if lengths.iter().any(|&l| l < CONDITIONING * longest) || longest == 0.0 {
         return false;
     }
-    match family {
-        Family::Plane => {
-            let (e2, e3) = (points[2] - points[0], points[3] - points[0]);
-            e2.cross(e3).length() >= CONDITIONING * e2.length() * e3.length()
-        }
-        Family::Distance | Family::Volume => true,
+    if family.row().needs_face_p0_p2_p3 {
+        let (e2, e3) = (points[2] - points[0], points[3] - points[0]);
+        e2.cross(e3).length() >= CONDITIONING * e2.length() * e3.length()
+    } else {
+        true
     }
 }
 
@@ -80,7 +81,8 @@ pub struct Report {
 
 /// Draws configurations until `samples` well-conditioned ones have been compared: points uniform
 /// in a cube of random size 10^U(−2, 2) around a random centre, rest value random in the range of
-/// the constraint's own values. Returns the error statistics.
+/// the constraint's own values, and (for a family that reads one) a rest shape drawn the same
+/// way. Returns the error statistics.
 pub fn random_check(family: Family, samples: usize, seed: u64) -> Report {
     let mut rng = SplitMix64::new(seed);
     let (mut compared, mut skipped) = (0, 0);
@@ -88,15 +90,23 @@ pub fn random_check(family: Family, samples: usize, seed: u64) -> Report {
     while compared < samples {
         let size = 10f64.powf(rng.range(-2.0, 2.0));
         let centre = rng.in_cube(size);
-        let points: Vec<DVec3> = (0..family.arity())
-            .map(|_| centre + rng.in_cube(size))
-            .collect();
-        if !well_conditioned(family, &points) {
+        let mut draw = || -> Vec<DVec3> {
+            (0..family.arity())
+                .map(|_| centre + rng.in_cube(size))
+                .collect()
+        };
+        let points = draw();
+        let rest_shape = if family.uses_rest_shape() {
+            draw()
+        } else {
+            points.clone()
+        };
+        if !well_conditioned(family, &points) || !well_conditioned(family, &rest_shape) {
             skipped += 1;
             continue;
         }
         let rest = family.rest_value(&points) * rng.range(-1.5, 1.5);
-        let (analytic, numeric) = analytic_and_numeric(family, &points, rest);
+        let (analytic, numeric) = analytic_and_numeric(family, &points, rest, &rest_shape);
         let error = relative_error(&analytic, &numeric);
         max_error = max_error.max(error);
         sum_error += error;

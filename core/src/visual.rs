@@ -17,13 +17,10 @@ pub const INVERTED: Rgba = [220, 40, 40, 255];
 /// Edges.
 pub const EDGE: Rgba = [60, 60, 70, 255];
 
-/// The colour of a constraint family's arrows: edges orange, heights green, volume blue.
+/// The colour of a constraint family's arrows ([`crate::constraints::Row::colour`]): edges
+/// orange, heights green, volume blue.
 pub fn family_colour(family: Family) -> Rgba {
-    match family {
-        Family::Distance => [240, 150, 20, 255],
-        Family::Plane => [40, 170, 60, 255],
-        Family::Volume => [50, 100, 230, 255],
-    }
+    family.row().colour
 }
 
 /// The colour map of V/V₀: red at ≤ 0 (flat or inverted), through yellow at ½, to white at ≥ 1.
@@ -356,7 +353,7 @@ mod tests {
         assert!(colours.iter().all(|&c| c == INVERTED));
 
         let mut arrows = Vec::new();
-        tet_gradient_arrows(&simulation, 0, Family::Volume, 1.0, &mut arrows);
+        tet_gradient_arrows(&simulation, 0, Family::VOLUME, 1.0, &mut arrows);
         assert_eq!(arrows.len(), 4);
         // Vertex 0 was reflected through the face (1, 2, 3): its arrow points back across it.
         let p = simulation.positions();
@@ -368,7 +365,7 @@ mod tests {
         );
 
         let size = tet_size(p, &simulation.tets()[0]);
-        for (family, count) in [(Family::Distance, 12), (Family::Plane, 16)] {
+        for (family, count) in [(Family::EDGES, 12), (Family::HEIGHT, 16)] {
             let mut arrows = Vec::new();
             tet_gradient_arrows(&simulation, 0, family, 2.0, &mut arrows);
             assert_eq!(arrows.len(), count, "{family:?}");

@@ -91,7 +91,7 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
     };
     settings.set_gravity(gravity);
     settings.ground = settings.ground && !rng.next_u64().is_multiple_of(4);
-    for family in Family::ALL {
+    for family in Family::all() {
         settings
             .active
             .set(family, !rng.next_u64().is_multiple_of(3));
@@ -439,7 +439,7 @@ fn the_fast_engine_survives_random_edits_and_settings() {
         }
         let relative = fast.relative_error();
         assert!(
-            Family::ALL
+            Family::all()
                 .into_iter()
                 .all(|f| relative.get(f).is_none_or(f64::is_finite)),
             "{relative:?}"

@@ -1,7 +1,7 @@
 //! Geometric invariants of the three constraints, on seeded random configurations.
 
 use glam::{DVec3, Vec3, Vec3A};
-use tetlab_core::constraints::{Family, distance, plane, volume};
+use tetlab_core::constraints::{Family, distance, height, volume};
 use tetlab_core::random::SplitMix64;
 use tetlab_core::verify::well_conditioned;
 
@@ -27,10 +27,10 @@ fn max_gradient(g: &[DVec3]) -> f64 {
 #[test]
 fn gradients_sum_to_zero() {
     let mut rng = SplitMix64::new(10);
-    for family in Family::ALL {
+    for family in Family::all() {
         for _ in 0..TRIALS {
             let p = well_conditioned_points(&mut rng, family);
-            let e = family.evaluate(&p, 0.3);
+            let e = family.evaluate(&p, 0.3, &p);
             let sum: DVec3 = e.gradients.iter().sum();
             assert!(
                 sum.length() <= 1e-12 * max_gradient(&e.gradients),
@@ -43,14 +43,14 @@ fn gradients_sum_to_zero() {
 #[test]
 fn value_is_invariant_under_rigid_motion_and_gradients_rotate_with_the_body() {
     let mut rng = SplitMix64::new(11);
-    for family in Family::ALL {
+    for family in Family::all() {
         for _ in 0..TRIALS {
             let p = well_conditioned_points(&mut rng, family);
             let rotation = rng.rotation();
             let shift = rng.in_cube(5.0);
             let moved: Vec<DVec3> = p.iter().map(|&x| rotation * x + shift).collect();
-            let before = family.evaluate(&p, 0.2);
-            let after = family.evaluate(&moved, 0.2);
+            let before = family.evaluate(&p, 0.2, &p);
+            let after = family.evaluate(&moved, 0.2, &moved);
             assert!(
                 (before.value - after.value).abs() <= 1e-11,
                 "{family:?}: C changed from {} to {}",
@@ -85,7 +85,7 @@ fn swapping_two_vertices_flips_volume_and_height() {
         }
         let mut q = p;
         q.swap(2, 3);
-        let (h, h_swapped) = (plane::rest_value(&p), plane::rest_value(&q));
+        let (h, h_swapped) = (height::rest_value(&p), height::rest_value(&q));
         assert!((h + h_swapped).abs() <= 1e-12 * h.abs().max(1.0));
     }
 }
@@ -94,11 +94,11 @@ fn swapping_two_vertices_flips_volume_and_height() {
 fn height_equals_three_volumes_over_the_opposite_face_area() {
     let mut rng = SplitMix64::new(13);
     for _ in 0..TRIALS {
-        let p: [DVec3; 4] = well_conditioned_points(&mut rng, Family::Plane)
+        let p: [DVec3; 4] = well_conditioned_points(&mut rng, Family::HEIGHT)
             .try_into()
             .unwrap();
         let area = 0.5 * (p[2] - p[0]).cross(p[3] - p[0]).length();
-        let height = plane::rest_value(&p);
+        let height = height::rest_value(&p);
         let expected = 3.0 * volume::signed_volume(&p) / area;
         assert!((height - expected).abs() <= 1e-10 * expected.abs().max(1.0));
     }
@@ -112,11 +112,11 @@ fn the_four_heights_of_a_positive_tet_are_positive_and_match_each_vertex() {
         if volume::signed_volume(&t) < 0.0 {
             t.swap(0, 1);
         }
-        for (vertex, order) in plane::tet_vertex_order().into_iter().enumerate() {
+        for (vertex, order) in height::tet_vertex_order().into_iter().enumerate() {
             assert_eq!(order[1], vertex, "entry k keeps vertex k off its face");
             let p = order.map(|i| t[i]);
             assert!(
-                plane::rest_value(&p) > 0.0,
+                height::rest_value(&p) > 0.0,
                 "vertex {vertex}: height not positive"
             );
         }
@@ -136,8 +136,8 @@ fn mirrored_tet_keeps_its_edges_but_not_its_volume_or_heights() {
     }
     let v = volume::rest_value(&t);
     assert_eq!(volume::evaluate(&mirrored, v).value, -2.0 * v);
-    let h = plane::rest_value(&t);
-    assert!(plane::evaluate(&mirrored, h).value < -h * 1.99);
+    let h = height::rest_value(&t);
+    assert!(height::evaluate(&mirrored, h).value < -h * 1.99);
 }
 
 #[test]
@@ -148,7 +148,7 @@ fn coincident_points_and_zero_area_faces_are_flagged_with_finite_values() {
 
     // Zero-area face (p0, p2, p3): p3 on the line through p0 and p2.
     let flat = [DVec3::ZERO, DVec3::Y, DVec3::X, 2.0 * DVec3::X];
-    let h = plane::evaluate(&flat, 0.5);
+    let h = height::evaluate(&flat, 0.5);
     assert!(h.degenerate && h.value == -0.5 && h.gradients == [DVec3::ZERO; 4]);
 
     // All four points on one line: no volume gradient.
@@ -157,8 +157,8 @@ fn coincident_points_and_zero_area_faces_are_flagged_with_finite_values() {
     assert!(v.degenerate && v.value == -0.25 && v.gradients == [DVec3::ZERO; 4]);
 
     // All four coincident.
-    for family in Family::ALL {
-        let e = family.evaluate(&vec![p; family.arity()], 0.1);
+    for family in Family::all() {
+        let e = family.evaluate(&vec![p; family.arity()], 0.1, &vec![p; family.arity()]);
         assert!(e.degenerate && e.value.is_finite(), "{family:?}");
     }
 
@@ -180,15 +180,16 @@ fn near_degenerate_configurations_stay_finite() {
             let along = q[a].lerp(q[b], rng.range(-1.0, 2.0));
             let offset = (q[b] - q[a]).normalize().any_orthonormal_vector() * 1e-6;
             q[v] = along + offset;
-            for family in [Family::Plane, Family::Volume] {
-                let e = family.evaluate(&q, 0.1);
+            for family in [Family::HEIGHT, Family::VOLUME] {
+                let e = family.evaluate(&q, 0.1, &q);
                 assert!(e.value.is_finite(), "{family:?} value at {q:?}");
                 assert!(
                     e.gradients.iter().all(|g| g.is_finite()),
                     "{family:?} ∇C at {q:?}"
                 );
             }
-            let d = Family::Distance.evaluate(&[q[v], q[v] + offset], 0.1);
+            let pair = [q[v], q[v] + offset];
+            let d = Family::EDGES.evaluate(&pair, 0.1, &pair);
             assert!(d.value.is_finite() && d.gradients.iter().all(|g| g.is_finite()));
         }
     }
@@ -198,15 +199,15 @@ fn near_degenerate_configurations_stay_finite() {
 fn f32_and_f64_share_one_implementation_and_agree() {
     let mut rng = SplitMix64::new(16);
     for _ in 0..TRIALS {
-        let p: [DVec3; 4] = well_conditioned_points(&mut rng, Family::Plane)
+        let p: [DVec3; 4] = well_conditioned_points(&mut rng, Family::HEIGHT)
             .try_into()
             .unwrap();
         let p32 = p.map(|x| x.as_vec3());
         let p32a = p.map(|x| Vec3A::from(x.as_vec3()));
         let rest = 0.1;
-        let e64 = plane::evaluate(&p, rest);
-        let e32 = plane::evaluate::<Vec3>(&p32, rest as f32);
-        let e32a = plane::evaluate::<Vec3A>(&p32a, rest as f32);
+        let e64 = height::evaluate(&p, rest);
+        let e32 = height::evaluate::<Vec3>(&p32, rest as f32);
+        let e32a = height::evaluate::<Vec3A>(&p32a, rest as f32);
         assert!((e64.value - e32.value as f64).abs() < 1e-4);
         assert_eq!(e32.value, e32a.value);
         let scale = max_gradient(&e64.gradients);
@@ -226,10 +227,10 @@ fn f32_and_f64_share_one_implementation_and_agree() {
 fn height_gradients_are_minus_barycentric_weights_of_the_foot_times_n() {
     let mut rng = SplitMix64::new(17);
     for _ in 0..TRIALS {
-        let p: [DVec3; 4] = well_conditioned_points(&mut rng, Family::Plane)
+        let p: [DVec3; 4] = well_conditioned_points(&mut rng, Family::HEIGHT)
             .try_into()
             .unwrap();
-        let e = plane::evaluate(&p, 0.0);
+        let e = height::evaluate(&p, 0.0);
         let n = e.gradients[1];
         let foot = p[1] - n * e.value;
         // Barycentric weights of the foot in the face (p0, p2, p3) from sub-triangle areas.

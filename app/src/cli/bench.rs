@@ -3,16 +3,17 @@
 //! took, per projection, per family and per frame, and the memory the solver's arrays take.
 
 use super::UsageError;
+use super::simulation_args::SolverArgs;
 use serde::Serialize;
 use std::io::Write;
 use std::time::{Duration, Instant};
-use tetlab_core::constraints::Family;
+use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::fast::{FastSimulation, Order};
 use tetlab_core::lanes::{LANES, REGISTERS};
 use tetlab_core::limits;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::{Method, PerFamily, Settings, Simulation};
+use tetlab_core::solver::Simulation;
 
 /// Options of `tetlab bench`.
 #[derive(Debug, clap::Args)]
@@ -24,18 +25,9 @@ pub struct Args {
     /// 16777216 tets).
     #[arg(long, default_value_t = 10, value_parser = |s: &str| limits::RESOLUTION.parse(s))]
     resolution: u32,
-    /// Active constraint families, comma-separated: edges, plane, volume.
-    #[arg(long, default_value = "edges,volume", value_parser = PerFamily::parse_list)]
-    constraints: PerFamily<bool>,
-    /// xpbd or pbd.
-    #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
-    solver: Method,
-    /// Substeps per frame (1..=1000).
-    #[arg(long, default_value_t = 10, value_parser = |s: &str| limits::SUBSTEPS.parse(s))]
-    substeps: u32,
-    /// Gauss–Seidel iterations per substep (1..=1000).
-    #[arg(long, default_value_t = 1, value_parser = |s: &str| limits::ITERATIONS.parse(s))]
-    iterations: u32,
+    /// The solver's options, as for `tetlab run`.
+    #[command(flatten)]
+    solver: SolverArgs,
     /// Frames timed (1..=100000).
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     frames: u64,
@@ -78,41 +70,30 @@ struct Report {
     tets: usize,
     edges: usize,
     constraints: String,
+    #[serde(skip)]
+    active: PerFamily<bool>,
     substeps: u32,
     iterations: u32,
     frames: u64,
     projections_per_frame: u64,
     ns_per_projection: f64,
-    ns_per_projection_by_family: Option<ByFamily>,
+    ns_per_projection_by_family: Option<PerFamily<f64>>,
     ms_per_frame: f64,
     frames_per_second: f64,
     bytes_per_tet: f64,
     peak_rss_bytes: Option<u64>,
-    colours: Option<ByFamily>,
+    colours: Option<PerFamily<usize>>,
     /// How the fast solver's SIMD lanes are held on this build.
     lanes: Option<String>,
     /// After the run, per active family: √(mean (C / rest value)²).
     relative_error: Option<PerFamily<Option<f64>>>,
 }
 
-#[derive(Debug, Serialize)]
-struct ByFamily {
-    edges: f64,
-    plane: f64,
-    volume: f64,
-}
-
 /// Runs the benchmark and prints the report.
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let scene = Scene::from_spec(&args.scene, args.resolution)
         .map_err(|e| UsageError(format!("--scene: {e}")))?;
-    let settings = Settings {
-        method: args.solver,
-        active: args.constraints,
-        substeps: args.substeps,
-        iterations: args.iterations,
-        ..Settings::default()
-    };
+    let settings = args.solver.settings();
     let mut simulation = Simulation::new(&scene, settings);
     let report = if args.reference {
         time_reference(args, &scene, &mut simulation)?
@@ -158,24 +139,17 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
     );
     fast.check().map_err(|d| UsageError(d.to_string()))?;
     let timings = fast.timings();
-    let per = |k: usize| {
-        let n = timings.projections[k];
+    let active = fast.settings().active;
+    let per = |f: Family| {
+        let n = timings.projections[f];
         if n == 0 {
             0.0
         } else {
-            timings.time[k].as_nanos() as f64 / n as f64
+            timings.time[f].as_nanos() as f64 / n as f64
         }
     };
-    let by_family = ByFamily {
-        edges: per(0),
-        plane: per(1),
-        volume: per(2),
-    };
-    let colours = ByFamily {
-        edges: fast.edges.colours.len() as f64,
-        plane: fast.planes.colours.len() as f64,
-        volume: fast.volumes.colours.len() as f64,
-    };
+    let by_family = PerFamily::from_fn(|f| if active[f] { per(f) } else { 0.0 });
+    let colours = PerFamily::from_fn(|f| fast.batches(f).colours.len());
     let solver = if args.jacobi {
         "fast (f32), Jacobi"
     } else {
@@ -194,14 +168,14 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
     );
     report.lanes = Some(format!("{LANES} f32 per batch, in {REGISTERS}"));
     let relative_error = fast.relative_error();
-    for family in Family::ALL {
+    for family in Family::all() {
         if let Some(error) = relative_error.get(family)
             && !error.is_finite()
         {
             return Err(UsageError(format!(
                 "the f32 engine could not measure how well the {} constraints hold (their \
                  relative error is {error}); the scene is beyond what f32 resolves",
-                family.short_name()
+                family.name()
             )));
         }
     }
@@ -231,9 +205,9 @@ fn report(
     threads: usize,
     projections_per_frame: u64,
     elapsed: Duration,
-    by_family: Option<ByFamily>,
+    by_family: Option<PerFamily<f64>>,
     heap_bytes: usize,
-    colours: Option<ByFamily>,
+    colours: Option<PerFamily<usize>>,
 ) -> Report {
     let seconds = elapsed.as_secs_f64();
     let frames = args.frames as f64;
@@ -245,9 +219,10 @@ fn report(
         particles: scene.mesh.positions.len(),
         tets,
         edges: scene.mesh.edges().len(),
-        constraints: args.constraints.describe(),
-        substeps: args.substeps,
-        iterations: args.iterations,
+        constraints: args.solver.constraints.describe(),
+        active: args.solver.constraints,
+        substeps: args.solver.substeps,
+        iterations: args.solver.iterations,
         frames: args.frames,
         projections_per_frame,
         ns_per_projection: seconds * 1e9 / (frames * projections_per_frame.max(1) as f64),
@@ -288,12 +263,18 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
         r.ms_per_frame, r.frames_per_second
     )?;
     write!(out, "ns per projection      {:.2}", r.ns_per_projection)?;
+    let active = r.active;
+    let of_active = |values: PerFamily<String>| -> String {
+        values
+            .iter_ref()
+            .filter(|(f, _)| active[*f])
+            .map(|(f, v)| format!("{} {v}", f.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     if let Some(f) = &r.ns_per_projection_by_family {
-        write!(
-            out,
-            " (edges {:.2}, plane {:.2}, volume {:.2}; inside the sweeps)",
-            f.edges, f.plane, f.volume
-        )?;
+        let each = of_active(PerFamily::build(|family| format!("{:.2}", f[family])));
+        write!(out, " ({each}; inside the sweeps)")?;
     }
     writeln!(out)?;
     write!(
@@ -306,24 +287,16 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
     }
     writeln!(out)?;
     if let Some(c) = &r.colours {
-        writeln!(
-            out,
-            "colours                edges {}, plane {}, volume {}",
-            c.edges, c.plane, c.volume
-        )?;
+        let each = of_active(PerFamily::build(|family| c[family].to_string()));
+        writeln!(out, "colours                {each}")?;
     }
     if let Some(lanes) = &r.lanes {
         writeln!(out, "SIMD lanes             {lanes}")?;
     }
     if let Some(error) = &r.relative_error {
-        let families = [
-            ("edges", error.edges),
-            ("plane", error.plane),
-            ("volume", error.volume),
-        ];
-        let shown: Vec<String> = families
+        let shown: Vec<String> = error
             .iter()
-            .filter_map(|(name, e)| e.map(|e| format!("{name} {e:.2e}")))
+            .filter_map(|(family, e)| e.map(|e| format!("{} {e:.2e}", family.name())))
             .collect();
         writeln!(
             out,

@@ -32,8 +32,7 @@ struct Row {
 
 /// Runs the check for every family and writes one row each.
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
-    let rows: Vec<Row> = Family::ALL
-        .into_iter()
+    let rows: Vec<Row> = Family::all()
         .map(|family| {
             let r = random_check(family, args.samples as usize, args.seed);
             Row {
@@ -59,7 +58,7 @@ fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()>
     writeln!(
         out,
         "seed {}; a configuration is skipped when an edge is shorter than {CONDITIONING} of the \
-         longest or (plane) the face's edges meet at a sine below {CONDITIONING}",
+         longest or (height) the face's edges meet at a sine below {CONDITIONING}",
         args.seed
     )?;
     writeln!(

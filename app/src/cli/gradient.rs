@@ -10,8 +10,8 @@ use tetlab_core::verify::{analytic_and_numeric, max_abs_error};
 /// Options of `tetlab gradient`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The constraint: distance (2 points), plane (4: height of p1 above the plane of p0, p2, p3)
-    /// or volume (4: signed volume).
+    /// The constraint family: edges (2 points: distance), height (4: height of p1 above the
+    /// plane of p0, p2, p3) or volume (4: signed volume). `distance` and `plane` are aliases.
     #[arg(long, value_parser = Family::parse)]
     constraint: Family,
     /// The particles in the constraint's order, each X,Y,Z; negative numbers are fine.
@@ -48,8 +48,8 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             args.points.len()
         )));
     }
-    let evaluation = family.evaluate(&args.points, args.rest);
-    let (analytic, numeric) = analytic_and_numeric(family, &args.points, args.rest);
+    let evaluation = family.evaluate(&args.points, args.rest, &args.points);
+    let (analytic, numeric) = analytic_and_numeric(family, &args.points, args.rest, &args.points);
     let output = Output {
         constraint: family.name(),
         value: evaluation.value,
@@ -77,7 +77,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             .map_err(std::io::Error::from)
             .and_then(|()| writeln!(out))
     } else {
-        write_table(&output, out)
+        write_table(family, &output, out)
     };
     written.map_err(UsageError::stdout)
 }
@@ -87,13 +87,16 @@ fn without_negative_zero(v: DVec3) -> [f64; 3] {
     (v + DVec3::ZERO).to_array()
 }
 
-fn write_table(o: &Output, out: &mut impl Write) -> std::io::Result<()> {
-    let description = match o.constraint {
-        "distance" => "C = |p0 - p1| - d",
-        "plane" => "C = (p1 - p0)·n - d, n the unit normal of (p0, p2, p3)",
-        _ => "C = (1/6) (p1 - p0)·((p2 - p0)×(p3 - p0)) - V",
-    };
-    writeln!(out, "constraint  {}   {description}", o.constraint)?;
+fn write_table(family: Family, o: &Output, out: &mut impl Write) -> std::io::Result<()> {
+    // The formula's lines up to C itself; its gradient lines are what the table below shows.
+    let definition = family
+        .formula()
+        .iter()
+        .take_while(|line| !line.starts_with('∇'));
+    writeln!(out, "constraint  {}", o.constraint)?;
+    for line in definition {
+        writeln!(out, "            {line}")?;
+    }
     writeln!(out, "C           {}", o.value)?;
     writeln!(out, "rest        {}", o.rest)?;
     writeln!(

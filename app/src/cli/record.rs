@@ -7,6 +7,7 @@ use crate::record::{ArrowsMode, Destination, Ending, Recorder, Session, send_lay
 use rerun::RecordingStream;
 use std::io::Write;
 use std::path::PathBuf;
+use tetlab_core::constraints::Family;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::Scene;
 use tetlab_core::solver::Simulation;
@@ -98,7 +99,7 @@ fn describe(rec: &RecordingStream, scene: &Scene, simulation: &Simulation, args:
         scene.name,
         simulation.positions().len(),
         simulation.tets().len(),
-        simulation.edges.len(),
+        simulation.constraint_count(Family::EDGES),
         args.simulation.describe(),
         args.arrows,
         args.tet

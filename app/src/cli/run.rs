@@ -3,7 +3,9 @@
 use super::UsageError;
 use super::simulation_args::SimulationArgs;
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::io::Write;
+use tetlab_core::constraints::Family;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::solver::Simulation;
 
@@ -26,9 +28,9 @@ pub struct FrameRecord {
     min_volume_ratio: f64,
     volume_error: f64,
     max_edge_strain: f64,
-    residual_edges: f64,
-    residual_plane: f64,
-    residual_volume: f64,
+    /// `residual_<family>` for each family of the table, in its order.
+    #[serde(flatten)]
+    residuals: BTreeMap<String, f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     particles: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -48,12 +50,14 @@ impl FrameRecord {
             min_volume_ratio: metrics.min_volume_ratio,
             volume_error: metrics.volume_error,
             max_edge_strain: metrics.max_edge_strain,
-            residual_edges: metrics.residual.edges,
-            residual_plane: metrics.residual.plane,
-            residual_volume: metrics.residual.volume,
+            residuals: metrics
+                .residual
+                .iter()
+                .map(|(family, value)| (format!("residual_{}", family.name()), value))
+                .collect(),
             particles: first.then(|| simulation.positions().len()),
             tets: first.then(|| simulation.tets().len()),
-            edges: first.then(|| simulation.edges.len()),
+            edges: first.then(|| simulation.constraint_count(Family::EDGES)),
         }
     }
 }
@@ -72,7 +76,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             scene.name,
             simulation.positions().len(),
             simulation.tets().len(),
-            simulation.edges.len()
+            simulation.constraint_count(Family::EDGES)
         )
         .map_err(io)?;
         for note in &scene.notes {

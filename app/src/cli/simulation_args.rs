@@ -3,10 +3,11 @@
 
 use super::UsageError;
 use tetlab_core::constraints::Family;
+use tetlab_core::constraints::PerFamily;
 use tetlab_core::limits::{self, Number};
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
-use tetlab_core::solver::{Method, PerFamily, Settings, Simulation};
+use tetlab_core::solver::{Method, Settings, Simulation};
 
 /// Scene and solver options.
 #[derive(Debug, Clone, clap::Args)]
@@ -21,7 +22,24 @@ pub struct SimulationArgs {
     /// Deform the scene before the first frame: invert, mirror, flatten or scramble:SEED.
     #[arg(long, value_parser = Perturbation::parse)]
     pub perturb: Option<Perturbation>,
-    /// Active constraint families, comma-separated: edges, plane, volume.
+    /// Frames to simulate (0..=10000000).
+    #[arg(long, default_value_t = 300, value_parser = |s: &str| limits::FRAMES.parse(s), allow_hyphen_values = true)]
+    pub frames: u64,
+    /// The solver's options.
+    #[command(flatten)]
+    pub solver: SolverArgs,
+    /// After the perturbation, let corrections move particles but not speed them up until the
+    /// violation is undone (otherwise a large violation launches the body).
+    #[arg(long)]
+    pub settle_edits: bool,
+}
+
+/// The solver's options, the same for every subcommand that simulates (`run`, `record`,
+/// `bench`); each range is [`tetlab_core::limits`]'s, and the ground follows gravity
+/// ([`Settings::set_gravity`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SolverArgs {
+    /// Active constraint families, comma-separated: edges, height, volume.
     #[arg(long, default_value = "edges,volume", value_parser = PerFamily::parse_list)]
     pub constraints: PerFamily<bool>,
     /// xpbd or pbd.
@@ -33,9 +51,6 @@ pub struct SimulationArgs {
     /// Gauss–Seidel iterations per substep (1..=1000).
     #[arg(long, default_value_t = 1, value_parser = |s: &str| limits::ITERATIONS.parse(s), allow_hyphen_values = true)]
     pub iterations: u32,
-    /// Frames to simulate (0..=10000000).
-    #[arg(long, default_value_t = 300, value_parser = |s: &str| limits::FRAMES.parse(s), allow_hyphen_values = true)]
-    pub frames: u64,
     /// Frame length in seconds (1e-6 <= dt <= 1).
     #[arg(long, default_value_t = 1.0 / 60.0, value_parser = |s: &str| limits::DT.parse(s), allow_hyphen_values = true)]
     pub dt: f64,
@@ -49,16 +64,12 @@ pub struct SimulationArgs {
     /// PBD stiffness of a family, FAMILY=k with 0 <= k <= 1 (default 1); repeatable.
     #[arg(long, value_name = "FAMILY=k", value_parser = |s: &str| limits::family_value(s, &limits::STIFFNESS))]
     pub stiffness: Vec<(Family, f64)>,
-    /// After the perturbation, let corrections move particles but not speed them up until the
-    /// violation is undone (otherwise a large violation launches the body).
-    #[arg(long)]
-    pub settle_edits: bool,
     /// Velocity damping per second (0..=1e6).
     #[arg(long, default_value_t = 0.0, value_parser = |s: &str| limits::DAMPING.parse(s), allow_hyphen_values = true)]
     pub damping: f64,
 }
 
-impl SimulationArgs {
+impl SolverArgs {
     /// The solver settings these options ask for.
     pub fn settings(&self) -> Settings {
         let mut settings = Settings {
@@ -68,7 +79,6 @@ impl SimulationArgs {
             iterations: self.iterations,
             dt: self.dt,
             damping: self.damping,
-            settle_edits: self.settle_edits,
             ..Settings::default()
         };
         settings.set_gravity(self.gravity);
@@ -79,6 +89,39 @@ impl SimulationArgs {
             settings.stiffness.set(family, k);
         }
         settings
+    }
+
+    /// "xpbd, edges+volume, 10 substeps × 1 iteration, dt 0.016667 s, gravity 9.81" and any
+    /// non-default compliance or stiffness.
+    pub fn describe(&self) -> String {
+        let s = self.settings();
+        let mut text = format!(
+            "{}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
+            s.method.name(),
+            s.active.describe(),
+            s.substeps,
+            s.iterations,
+            if s.iterations == 1 { "" } else { "s" },
+            s.dt,
+            s.gravity.show()
+        );
+        for (family, alpha) in &self.compliance {
+            text += &format!(", compliance {}={alpha}", family.name());
+        }
+        for (family, k) in &self.stiffness {
+            text += &format!(", stiffness {}={k}", family.name());
+        }
+        text
+    }
+}
+
+impl SimulationArgs {
+    /// The solver settings these options ask for.
+    pub fn settings(&self) -> Settings {
+        Settings {
+            settle_edits: self.settle_edits,
+            ..self.solver.settings()
+        }
     }
 
     /// Advances one frame and measures it; an error when the simulation diverged
@@ -99,28 +142,11 @@ impl SimulationArgs {
         Ok((scene, simulation))
     }
 
-    /// "xpbd, edges+volume, 10 substeps × 1 iteration, dt 0.016667 s, gravity 9.81" and any
-    /// non-default compliance or stiffness.
+    /// What [`SolverArgs::describe`] says, and whether edits settle.
     pub fn describe(&self) -> String {
-        let s = self.settings();
-        let mut text = format!(
-            "{}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
-            s.method.name(),
-            s.active.describe(),
-            s.substeps,
-            s.iterations,
-            if s.iterations == 1 { "" } else { "s" },
-            s.dt,
-            s.gravity.show()
-        );
+        let mut text = self.solver.describe();
         if self.settle_edits {
             text += ", settle edits";
-        }
-        for (family, alpha) in &self.compliance {
-            text += &format!(", compliance {}={alpha}", family.short_name());
-        }
-        for (family, k) in &self.stiffness {
-            text += &format!(", stiffness {}={k}", family.short_name());
         }
         text
     }

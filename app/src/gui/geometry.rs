@@ -116,7 +116,7 @@ pub fn build(
         } else if bench.selected_tet == Some(tet) {
             SELECTED
         } else if options.colour_by_volume {
-            let rest = simulation.volumes.rest[tet];
+            let rest = simulation.constraints(Family::VOLUME).rest()[tet];
             let ratio = if rest > 0.0 {
                 signed_volume(&tets[tet].map(|i| positions[i as usize])) / rest
             } else {
@@ -242,10 +242,7 @@ fn tet_arrows(bench: &Workbench, options: &ViewOptions, arrows: &mut Vec<Arrow>)
         }
     };
     if options.arrows {
-        for family in Family::ALL
-            .into_iter()
-            .filter(|&f| simulation.settings().active.get(f))
-        {
+        for family in Family::all().filter(|&f| simulation.settings().active.get(f)) {
             for tet in chosen.clone() {
                 let gain = options.arrow_scale as f64;
                 visual::tet_gradient_arrows(simulation, tet, family, gain, arrows);
@@ -356,7 +353,7 @@ mod tests {
         let geometry = build(&bench, &cache, &ViewOptions::default(), None);
         assert_eq!(geometry.triangles.len() % 3, 0);
         assert_eq!(geometry.lines.len() % 2, 0);
-        let arrow_colour = visual::family_colour(Family::Volume);
+        let arrow_colour = visual::family_colour(Family::VOLUME);
         assert!(
             geometry
                 .overlay_lines

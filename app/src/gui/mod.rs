@@ -20,9 +20,10 @@ use panels::controls::{SceneChoice, SceneRequest};
 use panels::lesson::{LessonRequest, LessonState};
 use shortcuts::{Action, SHORTCUTS};
 use std::time::Duration;
+use tetlab_core::constraints::PerFamily;
 use tetlab_core::lesson::{Action as LessonAction, Lesson};
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{PerFamily, Settings};
+use tetlab_core::solver::Settings;
 use viewport::Viewport;
 use web_time::Instant;
 use workbench::Workbench;
@@ -227,6 +228,18 @@ impl TetlabApp {
         }
         if step.frames > 0 {
             self.set_playing(true);
+        }
+    }
+
+    /// Changes the solver settings of the simulation, and of the comparison beside it (as a
+    /// lesson's actions do): everything but its own families.
+    pub fn set_settings(&mut self, settings: Settings) {
+        self.bench.set_settings(settings);
+        if let Some(comparison) = &mut self.comparison {
+            let active = comparison.bench.simulation.settings().active;
+            comparison
+                .bench
+                .set_settings(Settings { active, ..settings });
         }
     }
 
@@ -476,6 +489,7 @@ impl eframe::App for TetlabApp {
         let mut request = None;
         let mut lesson_request = None;
         let mut compare_request = None;
+        let mut settings_request = None;
         let metrics = self.bench.metrics;
         let comparison_metrics = self.comparison.as_ref().map(|c| c.bench.metrics);
         if self.classroom {
@@ -519,10 +533,13 @@ impl eframe::App for TetlabApp {
                         }
                         request = panels::controls::show(
                             ui,
-                            &mut self.bench,
+                            &self.bench,
                             &mut self.preferences.scene,
                             &mut actions,
                         );
+                        ui.separator();
+                        settings_request =
+                            panels::solver::show(ui, self.bench.simulation.settings());
                         ui.separator();
                         panels::tools::show(ui, &self.bench, &mut actions);
                         ui.separator();
@@ -591,6 +608,9 @@ impl eframe::App for TetlabApp {
         if let Some(request) = lesson_request {
             self.lesson_request(request);
         }
+        if let Some(settings) = settings_request {
+            self.set_settings(settings);
+        }
         if let Some(families) = compare_request {
             self.compare(families);
         }
@@ -638,6 +658,7 @@ pub fn run_native() -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tetlab_core::constraints::Family;
     use tetlab_core::solver::Method;
 
     /// What `save` writes, `new` reads back: eframe stores the preferences as RON text.
@@ -647,7 +668,7 @@ mod tests {
         preferences.scene.builtin = "ball".into();
         preferences.scene.resolution = 2;
         preferences.settings.method = Method::Pbd;
-        preferences.settings.active.plane = true;
+        preferences.settings.active[Family::HEIGHT] = true;
         preferences.settings.substeps = 7;
         preferences.view.see_through = true;
         let text = ron::to_string(&preferences).unwrap();
@@ -670,7 +691,7 @@ mod tests {
     fn remembered_settings_out_of_range_are_refused_with_a_message() {
         let mut preferences = Preferences::default();
         preferences.settings.dt = 0.0;
-        preferences.settings.compliance.volume = f64::INFINITY;
+        preferences.settings.compliance[Family::VOLUME] = f64::INFINITY;
         let app = TetlabApp::with_preferences(preferences);
         assert_eq!(
             *app.bench.simulation.settings(),

@@ -239,16 +239,11 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
         entry(geometry::PENDING, "next projection".to_owned());
     }
     let active = bench.simulation.settings().active;
-    for family in Family::ALL
-        .into_iter()
-        .filter(|&f| options.arrows && active.get(f))
-    {
-        let name = match family {
-            Family::Distance => "grad C: edges",
-            Family::Plane => "grad C: heights",
-            Family::Volume => "grad C: volume",
-        };
-        entry(visual::family_colour(family), name.to_owned());
+    for family in Family::all().filter(|&f| options.arrows && active.get(f)) {
+        entry(
+            visual::family_colour(family),
+            format!("grad C: {}", family.row().label),
+        );
     }
     if stepping {
         entry(

@@ -3,11 +3,12 @@
 
 use glam::DVec3;
 use std::collections::VecDeque;
+use tetlab_core::constraints::PerFamily;
 use tetlab_core::divergence::Divergence;
 use tetlab_core::lesson::Action as LessonAction;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
-use tetlab_core::solver::{PerFamily, Settings, Simulation};
+use tetlab_core::solver::{Settings, Simulation};
 use tetlab_core::stepper::{Advanced, StepByStep};
 
 /// How many frames of metrics the plots keep.
@@ -404,7 +405,7 @@ mod tests {
         let mut bench = Workbench::builtin(Builtin::Cube, 2, Settings::default());
         // What no setting of the controls allows: a compliance whose α / h² is infinite.
         let mut settings = *bench.simulation.settings();
-        settings.compliance.volume = 1e305;
+        settings.compliance[tetlab_core::constraints::Family::VOLUME] = 1e305;
         bench.set_settings(settings);
         bench.select_tet(0);
         bench.invert_selected();

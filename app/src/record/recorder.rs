@@ -74,7 +74,7 @@ impl<'a> Recorder<'a> {
                 .with_colors([rgba(visual::EDGE)])
                 .with_radii([rerun::Radius::new_ui_points(0.75)]),
         );
-        let quantities = Family::ALL.map(Quantity::Gradient);
+        let quantities = Family::all().map(Quantity::Gradient);
         for quantity in quantities.into_iter().chain([Quantity::Correction]) {
             log(
                 &arrow_path(quantity),
@@ -179,7 +179,7 @@ impl<'a> Recorder<'a> {
         };
         let active = simulation.settings().active;
         self.arrow_scratch.clear();
-        for family in Family::ALL.into_iter().filter(|&f| active.get(f)) {
+        for family in Family::all().filter(|&f| active.get(f)) {
             for tet in tets.clone() {
                 visual::tet_gradient_arrows(simulation, tet, family, 1.0, &mut self.arrow_scratch);
             }
@@ -194,8 +194,7 @@ impl<'a> Recorder<'a> {
                 visual::correction_arrows(simulation, corners, 1.0, &mut self.arrow_scratch);
             }
         }
-        let quantities = Family::ALL
-            .into_iter()
+        let quantities = Family::all()
             .filter(|&f| active.get(f))
             .map(Quantity::Gradient)
             .chain([Quantity::Correction]);
@@ -216,7 +215,7 @@ impl<'a> Recorder<'a> {
 /// Where arrows of `quantity` are logged.
 fn arrow_path(quantity: Quantity) -> String {
     match quantity {
-        Quantity::Gradient(family) => format!("world/gradients/{}", family.short_name()),
+        Quantity::Gradient(family) => format!("world/gradients/{}", family.name()),
         Quantity::Correction => "world/corrections".to_owned(),
     }
 }

@@ -9,7 +9,7 @@
 //! change under translation or rotation and the gradients rotate with the body. Coincident
 //! particles have no edge direction: the evaluation is flagged degenerate.
 
-use super::Evaluation;
+use super::{Constraint, Evaluation};
 use crate::vector::{Real, Vector3};
 
 /// The constraint and its gradients as lines of math, for display (the inspector, lessons).
@@ -43,4 +43,14 @@ pub fn evaluate<V: Vector3>(p: &[V; 2], rest: V::Real) -> Evaluation<V, 2> {
     let degenerate = !length.finite() | length.le(V::Real::MIN_POSITIVE);
     let direction = delta / length;
     Evaluation::unless_degenerate(degenerate, value, value, [direction, -direction])
+}
+
+/// The edge distance constraint, as the family table evaluates it ([`evaluate`]).
+pub struct Distance;
+
+impl Constraint<2> for Distance {
+    #[inline(always)]
+    fn evaluate<V: Vector3>(&self, p: &[V; 2], rest: V::Real, _: &[V; 2]) -> Evaluation<V, 2> {
+        evaluate(p, rest)
+    }
 }

@@ -17,7 +17,7 @@
 //! the volume. When all four particles lie on one line every gradient vanishes: the evaluation is
 //! flagged degenerate.
 
-use super::{Evaluation, first_from_rest};
+use super::{Constraint, Evaluation, first_from_rest};
 use crate::vector::{Mask, Real, Vector3, spans_no_plane};
 
 /// The constraint and its gradients as lines of math, for display (the inspector, lessons).
@@ -87,4 +87,14 @@ pub fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
 #[inline]
 fn sixth<R: Real>() -> R {
     R::ONE / R::from_f64(6.0)
+}
+
+/// The signed volume constraint, as the family table evaluates it ([`evaluate`]).
+pub struct Volume;
+
+impl Constraint<4> for Volume {
+    #[inline(always)]
+    fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, _: &[V; 4]) -> Evaluation<V, 4> {
+        evaluate(p, rest)
+    }
 }

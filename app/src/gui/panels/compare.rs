@@ -2,7 +2,7 @@
 
 use eframe::egui;
 use tetlab_core::constraints::Family;
-use tetlab_core::solver::PerFamily;
+use tetlab_core::constraints::PerFamily;
 
 /// Shows the comparison controls; returns the families to compare with when "Compare" is
 /// pressed, or `Some(None)` when "Stop comparing" is.
@@ -13,9 +13,9 @@ pub fn show(
 ) -> Option<Option<PerFamily<bool>>> {
     ui.heading("Compare");
     ui.horizontal(|ui| {
-        for family in Family::ALL {
+        for family in Family::all() {
             let mut on = families.get(family);
-            if ui.checkbox(&mut on, family.short_name()).changed() {
+            if ui.checkbox(&mut on, family.row().label).changed() {
                 families.set(family, on);
             }
         }

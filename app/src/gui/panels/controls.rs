@@ -1,11 +1,9 @@
-//! Playback, the scene, and the solver settings.
+//! Playback and the scene.
 
 use crate::gui::shortcuts::Action;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
-use tetlab_core::constraints::Family;
 use tetlab_core::scene::Builtin;
-use tetlab_core::solver::Method;
 use tetlab_core::stepper::{Advanced, Next};
 
 /// A scene the user asked for.
@@ -113,7 +111,7 @@ fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>)
 /// load, if the user asked for one.
 pub fn show(
     ui: &mut egui::Ui,
-    bench: &mut Workbench,
+    bench: &Workbench,
     choice: &mut SceneChoice,
     actions: &mut Vec<Action>,
 ) -> Option<SceneRequest> {
@@ -190,52 +188,5 @@ pub fn show(
         ui.small(note);
     }
 
-    ui.separator();
-    ui.heading("Solver");
-    let mut settings = *bench.simulation.settings();
-    ui.horizontal(|ui| {
-        ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");
-        ui.radio_value(&mut settings.method, Method::Pbd, "PBD");
-    });
-    for family in Family::ALL {
-        let name = match family {
-            Family::Distance => "edges",
-            Family::Plane => "heights (plane)",
-            Family::Volume => "volume",
-        };
-        ui.horizontal(|ui| {
-            let mut active = settings.active.get(family);
-            ui.checkbox(&mut active, name);
-            settings.active.set(family, active);
-            match settings.method {
-                Method::Xpbd => {
-                    let mut alpha = settings.compliance.get(family);
-                    ui.add(
-                        egui::DragValue::new(&mut alpha)
-                            .range(0.0..=10.0)
-                            .speed(1e-4)
-                            .prefix("alpha "),
-                    )
-                    .on_hover_text("XPBD compliance: 0 is rigid, larger is softer");
-                    settings.compliance.set(family, alpha);
-                }
-                Method::Pbd => {
-                    let mut k = settings.stiffness.get(family);
-                    ui.add(egui::Slider::new(&mut k, 0.0..=1.0).text("k"));
-                    settings.stiffness.set(family, k);
-                }
-            }
-        });
-    }
-    ui.add(egui::Slider::new(&mut settings.substeps, 1..=50).text("substeps"));
-    ui.add(egui::Slider::new(&mut settings.iterations, 1..=20).text("iterations"));
-    ui.add(egui::Slider::new(&mut settings.gravity, 0.0..=20.0).text("gravity"));
-    ui.checkbox(&mut settings.ground, "ground (y = 0)");
-    ui.add(egui::Slider::new(&mut settings.damping, 0.0..=10.0).text("damping"));
-    ui.checkbox(&mut settings.settle_edits, "settle edits")
-        .on_hover_text("After an invert, mirror, flatten or drag, corrections may move particles but not speed them up until the edit is undone");
-    if settings != *bench.simulation.settings() {
-        bench.set_settings(settings);
-    }
     request
 }

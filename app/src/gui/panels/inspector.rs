@@ -41,7 +41,7 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
     if inspections.is_empty() {
         ui.label("No constraint family is active.");
     }
-    for family in Family::ALL {
+    for family in Family::all() {
         let of_family: Vec<&Inspection> = inspections
             .iter()
             .filter(|i| i.projection.family == family)
@@ -49,9 +49,9 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
         if of_family.is_empty() {
             continue;
         }
-        egui::CollapsingHeader::new(format!("{} ({})", title(family), of_family.len()))
+        egui::CollapsingHeader::new(format!("{} ({})", family.row().title, of_family.len()))
             .id_salt(family.name())
-            .default_open(family == Family::Volume)
+            .default_open(family == Family::VOLUME)
             .show(ui, |ui| {
                 formula(ui, family);
                 for inspection in of_family {
@@ -60,14 +60,6 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
                     constraint(ui, inspection, method, (p.family.name(), p.constraint));
                 }
             });
-    }
-}
-
-fn title(family: Family) -> &'static str {
-    match family {
-        Family::Distance => "Edge distance",
-        Family::Plane => "Heights above the opposite face",
-        Family::Volume => "Signed volume",
     }
 }
 
@@ -89,7 +81,7 @@ fn constraint(
     id: impl std::hash::Hash + std::fmt::Debug,
 ) {
     let p = &inspection.projection;
-    let rest_name = if p.family == Family::Volume { "V" } else { "d" };
+    let rest_name = p.family.row().rest_symbol;
     let step = match (p.delta_lambda, method) {
         (Some(d), Method::Xpbd) => format!("next Δλ = {d:+.4e}"),
         (Some(d), Method::Pbd) => format!("next k′s = {d:+.4e}"),

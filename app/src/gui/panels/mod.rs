@@ -7,4 +7,5 @@ pub mod help;
 pub mod inspector;
 pub mod lesson;
 pub mod readouts;
+pub mod solver;
 pub mod tools;

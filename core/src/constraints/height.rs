@@ -1,4 +1,5 @@
-//! Height above the opposite face: keeps p1 at signed height d above the plane of p0, p2, p3.
+//! Height above the opposite face (the `height` family): keeps p1 at signed height d above the
+//! plane of p0, p2, p3.
 //!
 //! With e₁ = p1 − p0, e₂ = p2 − p0, e₃ = p3 − p0, c = e₂×e₃ and n = c/|c|:
 //!
@@ -18,7 +19,7 @@
 //! the height; the height equals 3V / area(p0, p2, p3). A face of zero area has no normal: the
 //! evaluation is flagged degenerate, with C = −d.
 
-use super::{Evaluation, first_from_rest};
+use super::{Constraint, Evaluation, first_from_rest};
 use crate::vector::{Vector3, spans_no_plane};
 
 /// The constraint and its gradients as lines of math, for display (the inspector, lessons).
@@ -52,13 +53,13 @@ pub fn rest_value<V: Vector3>(p: &[V; 4]) -> V::Real {
 ///
 /// ```
 /// use glam::DVec3;
-/// use tetlab_core::constraints::plane;
+/// use tetlab_core::constraints::height;
 /// let p = [DVec3::ZERO, DVec3::new(0.2, 0.3, 2.0), DVec3::X, DVec3::Y];
-/// let e = plane::evaluate(&p, 0.0);
+/// let e = height::evaluate(&p, 0.0);
 /// assert_eq!(e.value, 2.0);                      // p1 is 2 above the z = 0 face
 /// assert_eq!(e.gradients[1], DVec3::Z);          // moving p1 along n raises it fastest
 /// // Swapping p2 and p3 turns the face over: the height changes sign.
-/// let swapped = plane::evaluate(&[p[0], p[1], p[3], p[2]], 0.0);
+/// let swapped = height::evaluate(&[p[0], p[1], p[3], p[2]], 0.0);
 /// assert_eq!(swapped.value, -2.0);
 /// ```
 #[inline]
@@ -77,4 +78,14 @@ pub fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
     let gradients = first_from_rest(g1, g2, g3);
     // A face of zero area has no normal: the height counts as 0.
     Evaluation::unless_degenerate(degenerate, height - rest, -rest, gradients)
+}
+
+/// The height above the opposite face constraint, as the family table evaluates it ([`evaluate`]).
+pub struct Height;
+
+impl Constraint<4> for Height {
+    #[inline(always)]
+    fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, _: &[V; 4]) -> Evaluation<V, 4> {
+        evaluate(p, rest)
+    }
 }

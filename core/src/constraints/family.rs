@@ -1,0 +1,478 @@
+//! The constraint families, described in one place: one row of [`TABLE`] per family holds its
+//! names, how it is drawn and written, its arity and how it binds to a mesh, and which
+//! [`Constraint`] type evaluates it. Everything that handles a family (parsing, both solvers, the
+//! stepper, the inspector, what is drawn and recorded, the workbench, lessons) reads the row, and
+//! reaches the family's formula through [`Family::visit`], the one place that dispatches on the
+//! family. Adding a family is a file with its [`Constraint`] type plus a row here.
+//!
+//! Per-family data has one shape, [`PerFamily`], indexed by [`Family`].
+
+use super::{Constraint, Evaluation, distance::Distance, height::Height, volume::Volume};
+use crate::mesh::{TET_EDGES, TetMesh};
+use glam::DVec3;
+use std::fmt;
+use std::ops::{Index, IndexMut};
+
+/// How many families the table can hold.
+pub const MAX_FAMILIES: usize = 8;
+
+/// A constraint family: a row of [`TABLE`].
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Family(u8);
+
+/// How a family's constraints bind to a tet mesh, and so how many it has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Binding {
+    /// One constraint per edge of the mesh: (p0, p1), the edge's ends, smaller index first; in the
+    /// order of [`TetMesh::edges`].
+    Edges,
+    /// One per tet: (p0, p1, p2, p3), the tet's corners in its own order.
+    Tets,
+    /// Four per tet, one per corner k: (p0, p1, p2, p3) with p1 = corner k, in the orders of
+    /// [`super::height::tet_vertex_order`]; tet t's are constraints 4t..4t+4.
+    TetVertices,
+}
+
+/// A family as people see it, and as the code reaches it.
+pub struct Row {
+    /// Its name on the command line, in files, JSON keys and recordings' entity paths.
+    pub name: &'static str,
+    /// Other spellings the command line and files accept.
+    pub aliases: &'static [&'static str],
+    /// A title for headings: "Edge distance".
+    pub title: &'static str,
+    /// A short label for legends and buttons: "edges".
+    pub label: &'static str,
+    /// The colour of its gradient arrows (sRGB and alpha), the same in the workbench and in
+    /// recordings.
+    pub colour: [u8; 4],
+    /// The constraint and its gradients as lines of math (the inspector, lessons).
+    pub formula: &'static [&'static str],
+    /// What the rest value is called in the formula: d or V.
+    pub rest_symbol: &'static str,
+    /// How many particles one constraint touches.
+    pub arity: usize,
+    /// How it binds to a mesh.
+    pub binding: Binding,
+    /// Whether its gradient needs the face (p0, p2, p3) to span a plane: the gradient check then
+    /// leaves out random configurations where that face is nearly a line (the height's gradient
+    /// grows without bound there).
+    pub needs_face_p0_p2_p3: bool,
+    kind: Kind,
+}
+
+/// Which [`Constraint`] type evaluates a family: the one `match` over families.
+#[derive(Clone, Copy)]
+enum Kind {
+    Distance,
+    Height,
+    Volume,
+}
+
+/// The families, in projection order (edges, then heights, then volumes).
+pub static TABLE: [Row; 3] = [
+    Row {
+        name: "edges",
+        aliases: &["edge", "distance"],
+        title: "Edge distance",
+        label: "edges",
+        colour: [240, 150, 20, 255],
+        formula: super::distance::FORMULA,
+        rest_symbol: "d",
+        arity: 2,
+        binding: Binding::Edges,
+        needs_face_p0_p2_p3: false,
+        kind: Kind::Distance,
+    },
+    Row {
+        name: "height",
+        aliases: &["heights", "plane"],
+        title: "Heights above the opposite face",
+        label: "heights",
+        colour: [40, 170, 60, 255],
+        formula: super::height::FORMULA,
+        rest_symbol: "d",
+        arity: 4,
+        binding: Binding::TetVertices,
+        needs_face_p0_p2_p3: true,
+        kind: Kind::Height,
+    },
+    Row {
+        name: "volume",
+        aliases: &[],
+        title: "Signed volume",
+        label: "volume",
+        colour: [50, 100, 230, 255],
+        formula: super::volume::FORMULA,
+        rest_symbol: "V",
+        arity: 4,
+        binding: Binding::Tets,
+        needs_face_p0_p2_p3: false,
+        kind: Kind::Volume,
+    },
+];
+
+/// Code that works on one family's constraints with the family's [`Constraint`] type known at
+/// compile time (so that the formula is inlined into the loop, and into SIMD lanes).
+pub trait Visit {
+    /// What the visit gives.
+    type Output;
+    /// Works on `family`, whose constraints `constraint` evaluates, `N` particles each.
+    fn visit<const N: usize, C: Constraint<N>>(
+        self,
+        family: Family,
+        constraint: &C,
+    ) -> Self::Output;
+}
+
+impl Family {
+    /// Edge distance ([`super::distance`]).
+    pub const EDGES: Family = Family(0);
+    /// The four heights of each tet ([`super::height`]).
+    pub const HEIGHT: Family = Family(1);
+    /// Signed volume ([`super::volume`]).
+    pub const VOLUME: Family = Family(2);
+
+    /// Every family of the table, in projection order.
+    pub fn all() -> impl DoubleEndedIterator<Item = Family> + Clone {
+        (0..TABLE.len() as u8).map(Family)
+    }
+
+    /// The family's place in the table: what [`PerFamily`] is indexed by.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+
+    /// Its row of the table.
+    pub fn row(self) -> &'static Row {
+        &TABLE[self.index()]
+    }
+
+    /// Its name ([`Row::name`]).
+    pub fn name(self) -> &'static str {
+        self.row().name
+    }
+
+    /// How many particles one of its constraints touches.
+    pub fn arity(self) -> usize {
+        self.row().arity
+    }
+
+    /// Its formula, as lines of math.
+    pub fn formula(self) -> &'static [&'static str] {
+        self.row().formula
+    }
+
+    /// The family a user means, by its name or one of its aliases (spaces around allowed), as
+    /// the command line and lesson files write it.
+    ///
+    /// ```
+    /// use tetlab_core::constraints::Family;
+    /// assert_eq!(Family::parse(" edges"), Ok(Family::EDGES));
+    /// assert_eq!(Family::parse("plane"), Ok(Family::HEIGHT));
+    /// assert!(Family::parse("edgy").unwrap_err().contains("'edgy'"));
+    /// ```
+    pub fn parse(text: &str) -> Result<Family, String> {
+        let text = text.trim();
+        Family::all()
+            .find(|f| f.name() == text || f.row().aliases.contains(&text))
+            .ok_or_else(|| {
+                let names: Vec<&str> = Family::all().map(Family::name).collect();
+                format!(
+                    "'{text}' is not a constraint family: expected {}",
+                    names.join(", ")
+                )
+            })
+    }
+
+    /// Calls `visitor` with the family's [`Constraint`] type.
+    #[inline]
+    pub fn visit<T: Visit>(self, visitor: T) -> T::Output {
+        match self.row().kind {
+            Kind::Distance => visitor.visit(self, &Distance),
+            Kind::Height => visitor.visit(self, &Height),
+            Kind::Volume => visitor.visit(self, &Volume),
+        }
+    }
+
+    /// C and ∇C in f64 at `points` (the family's arity of them), with rest value `rest` and the
+    /// constraint's particles at rest at `rest_shape`: the gradients padded to four, for tools
+    /// (the gradient check, `tetlab gradient`).
+    ///
+    /// # Panics
+    /// If the number of points is not the family's arity; callers check it first.
+    pub fn evaluate(
+        self,
+        points: &[DVec3],
+        rest: f64,
+        rest_shape: &[DVec3],
+    ) -> Evaluation<DVec3, 4> {
+        struct At<'a>(&'a [DVec3], f64, &'a [DVec3]);
+        impl Visit for At<'_> {
+            type Output = Evaluation<DVec3, 4>;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
+                let (p, rest, shape) = (self.0, self.1, self.2);
+                let p: [DVec3; N] = std::array::from_fn(|k| p[k]);
+                let shape: [DVec3; N] = std::array::from_fn(|k| shape[k]);
+                let e = c.evaluate(&p, rest, &shape);
+                let mut gradients = [DVec3::ZERO; 4];
+                gradients[..N].copy_from_slice(&e.gradients);
+                Evaluation {
+                    value: e.value,
+                    gradients,
+                    degenerate: e.degenerate,
+                }
+            }
+        }
+        assert!(
+            points.len() == self.arity() && rest_shape.len() == self.arity(),
+            "wrong number of points for {self:?}"
+        );
+        self.visit(At(points, rest, rest_shape))
+    }
+
+    /// Whether its formula reads the rest shape ([`Constraint::USES_REST_SHAPE`]).
+    pub fn uses_rest_shape(self) -> bool {
+        struct Uses;
+        impl Visit for Uses {
+            type Output = bool;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, _: &C) -> bool {
+                C::USES_REST_SHAPE
+            }
+        }
+        self.visit(Uses)
+    }
+
+    /// The rest value (d, V) of a rest configuration: C there with rest value 0.
+    ///
+    /// # Panics
+    /// If the number of points is not the family's arity.
+    pub fn rest_value(self, points: &[DVec3]) -> f64 {
+        self.evaluate(points, 0.0, points).value
+    }
+}
+
+impl fmt::Debug for Family {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl fmt::Display for Family {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Binding {
+    /// The particles of every constraint of this binding on `mesh`, flat: `arity` indices per
+    /// constraint, in constraint order.
+    pub fn particles(self, mesh: &TetMesh) -> Vec<u32> {
+        match self {
+            Binding::Edges => mesh.edges().into_iter().flatten().collect(),
+            Binding::Tets => mesh.tets.iter().flatten().copied().collect(),
+            Binding::TetVertices => mesh
+                .tets
+                .iter()
+                .flat_map(|t| {
+                    super::height::tet_vertex_order()
+                        .into_iter()
+                        .flat_map(move |order| order.map(|k| t[k]))
+                })
+                .collect(),
+        }
+    }
+
+    /// The constraints of this binding on tet `tet` (whose corners are `corners`), as indices
+    /// among them; `edges` are the particles of an [`Binding::Edges`] family (sorted pairs,
+    /// flat), which are looked up.
+    pub fn of_tet<'a>(
+        self,
+        tet: usize,
+        corners: [u32; 4],
+        edges: &'a [u32],
+    ) -> impl Iterator<Item = usize> + 'a {
+        let (range, look_up) = match self {
+            Binding::Edges => (0..0, true),
+            Binding::Tets => (tet..tet + 1, false),
+            Binding::TetVertices => (4 * tet..4 * tet + 4, false),
+        };
+        let pairs = pairs(edges);
+        let looked_up = TET_EDGES
+            .iter()
+            .filter(move |_| look_up)
+            .filter_map(move |&(a, b)| {
+                let key = [corners[a].min(corners[b]), corners[a].max(corners[b])];
+                pairs.binary_search(&key).ok()
+            });
+        range.chain(looked_up)
+    }
+}
+
+/// Flat pairs as pairs.
+fn pairs(flat: &[u32]) -> &[[u32; 2]] {
+    let (pairs, rest) = flat.as_chunks::<2>();
+    debug_assert!(rest.is_empty(), "pairs come in twos");
+    pairs
+}
+
+/// One value per family of the table, indexed by [`Family`].
+#[derive(Clone, Copy, PartialEq)]
+pub struct PerFamily<T>([T; MAX_FAMILIES]);
+
+impl<T: Default> Default for PerFamily<T> {
+    fn default() -> Self {
+        PerFamily(std::array::from_fn(|_| T::default()))
+    }
+}
+
+impl<T> PerFamily<T> {
+    /// `f(family)` for each family of the table (and the default in the places beyond it).
+    pub fn build(mut f: impl FnMut(Family) -> T) -> Self
+    where
+        T: Default,
+    {
+        PerFamily(std::array::from_fn(|i| {
+            if i < TABLE.len() {
+                f(Family(i as u8))
+            } else {
+                T::default()
+            }
+        }))
+    }
+
+    /// Each family of the table with a reference to its value, in projection order.
+    pub fn iter_ref(&self) -> impl Iterator<Item = (Family, &T)> + '_ {
+        Family::all().map(|f| (f, &self.0[f.index()]))
+    }
+}
+
+impl<T: Copy> PerFamily<T> {
+    /// The same value for every family.
+    pub const fn splat(value: T) -> Self {
+        PerFamily([value; MAX_FAMILIES])
+    }
+
+    /// The value for `family`.
+    pub fn get(&self, family: Family) -> T {
+        self.0[family.index()]
+    }
+
+    /// Sets the value for `family`.
+    pub fn set(&mut self, family: Family, value: T) {
+        self.0[family.index()] = value;
+    }
+
+    /// `f(family)` for each family of the table.
+    pub fn from_fn(f: impl Fn(Family) -> T) -> Self
+    where
+        T: Default,
+    {
+        PerFamily::build(f)
+    }
+
+    /// Each family of the table with its value, in projection order.
+    pub fn iter(&self) -> impl Iterator<Item = (Family, T)> + '_ {
+        Family::all().map(|f| (f, self.get(f)))
+    }
+}
+
+impl<T> Index<Family> for PerFamily<T> {
+    type Output = T;
+    fn index(&self, family: Family) -> &T {
+        &self.0[family.index()]
+    }
+}
+
+impl<T> IndexMut<Family> for PerFamily<T> {
+    fn index_mut(&mut self, family: Family) -> &mut T {
+        &mut self.0[family.index()]
+    }
+}
+
+impl<T: fmt::Debug> fmt::Debug for PerFamily<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_map()
+            .entries(self.iter_ref().map(|(k, v)| (k.name(), v)))
+            .finish()
+    }
+}
+
+impl PerFamily<bool> {
+    /// The families named in a comma-separated list (`edges,volume`), each as [`Family::parse`]
+    /// reads it.
+    ///
+    /// ```
+    /// use tetlab_core::constraints::{Family, PerFamily};
+    /// let active = PerFamily::parse_list("edges, plane").unwrap();
+    /// assert!(active[Family::EDGES] && active[Family::HEIGHT] && !active[Family::VOLUME]);
+    /// assert_eq!(active.describe(), "edges+height");
+    /// ```
+    pub fn parse_list(text: &str) -> Result<PerFamily<bool>, String> {
+        let mut active = PerFamily::splat(false);
+        for name in text.split(',') {
+            active.set(Family::parse(name)?, true);
+        }
+        Ok(active)
+    }
+
+    /// The active families as `edges+height+volume`, or `none`.
+    pub fn describe(&self) -> String {
+        let names: Vec<&str> = self
+            .iter()
+            .filter(|&(_, on)| on)
+            .map(|(f, _)| f.name())
+            .collect();
+        if names.is_empty() {
+            "none".into()
+        } else {
+            names.join("+")
+        }
+    }
+
+    /// The active families, in projection order.
+    pub fn families(&self) -> impl Iterator<Item = Family> + '_ {
+        self.iter().filter(|&(_, on)| on).map(|(f, _)| f)
+    }
+}
+
+/// Written as a map from family name to value (`{"edges": …, "height": …}`), so that what is
+/// stored (the workbench's preferences) reads back whatever the table holds then: a family it
+/// does not know is left out, and one it lacks keeps its default.
+impl<T: serde::Serialize + Copy> serde::Serialize for PerFamily<T> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(TABLE.len()))?;
+        for (family, value) in self.iter() {
+            map.serialize_entry(family.name(), &value)?;
+        }
+        map.end()
+    }
+}
+
+impl<'de, T: serde::Deserialize<'de> + Copy + Default> serde::Deserialize<'de> for PerFamily<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        PerFamily::deserialize_over(deserializer, PerFamily::default())
+    }
+}
+
+impl<T: Copy> PerFamily<T> {
+    /// Reads the map that `Serialize` writes over `defaults`: a family the map lacks keeps its
+    /// default, and a name the table does not know is left out.
+    pub fn deserialize_over<'de, D: serde::Deserializer<'de>>(
+        deserializer: D,
+        mut defaults: PerFamily<T>,
+    ) -> Result<Self, D::Error>
+    where
+        T: serde::Deserialize<'de>,
+    {
+        let map: std::collections::BTreeMap<String, T> =
+            serde::Deserialize::deserialize(deserializer)?;
+        for (name, value) in map {
+            if let Ok(family) = Family::parse(&name) {
+                defaults.set(family, value);
+            }
+        }
+        Ok(defaults)
+    }
+}

@@ -1,0 +1,612 @@
+//! The fast solver: the substep of [`crate::solver`] in f32, on flat arrays laid out for speed, on
+//! one thread or several. For big meshes, headless runs and `tetlab bench`; the interactive f64
+//! solver stays the reference and the teaching path.
+//!
+//! What is the same: the constraint formulas (the [`crate::constraints::Constraint`] types of
+//! the family table), the projection rule ([`crate::projection`]), the integration
+//! (`integrate`), rest values, masses and pins (taken from a [`Simulation`]).
+//!
+//! What differs, for speed:
+//! - particles are renumbered along a Morton (Z-order) curve ([`morton`]), so that particles close
+//!   in space are close in memory; [`FastSimulation::positions`] gives them back in the scene's
+//!   numbering;
+//! - each family's constraints are coloured so that no two of one colour share a particle, and
+//!   projected colour by colour (Gauss–Seidel across colours) ([`batches`]). Within a colour the
+//!   order does not matter, so several threads can share a colour and the result is the same bits
+//!   whatever the thread count;
+//! - within a colour, [`crate::lanes::LANES`] constraints are projected at once ([`kernel`]): the formulas run
+//!   on [`crate::lanes::Vec3x8`], eight x, eight y and eight z in SIMD registers; a batch's
+//!   particles are loaded as padded 3-vectors and transposed, its inverse masses, rest values and
+//!   multipliers are stored lane by lane beside it; the loads skip their bounds checks
+//!   ([`particles`], the one `unsafe` module);
+//! - f32 instead of f64, and no grab or settling (nobody drags a benchmark);
+//! - optionally the [`Order::Jacobi`] order, for comparison.
+
+pub mod batches;
+mod kernel;
+mod morton;
+mod particles;
+
+pub use batches::{Batches, Colour};
+pub use kernel::PARALLEL_MIN;
+
+use crate::constraints::{Constraint, Family, PerFamily, Visit};
+use crate::divergence::Divergence;
+use crate::integrate;
+use crate::projection::Rule;
+use crate::solver::{Settings, Simulation};
+use glam::{DVec3, Vec3A};
+use std::time::{Duration, Instant};
+
+/// The largest coordinate (m) the f32 engine holds: an edge of twice this, raised to the fourth
+/// power (the squared gradient of a volume), stays below f32's 3.4·10³⁸. Velocities are held up
+/// to [`crate::solver::SOUND_LIMIT`], as in f64 (they are only ever multiplied by a substep).
+pub const POSITION_LIMIT: f64 = 1e9;
+
+/// Time spent projecting each family, and how many projections, since the last reset.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Per family: time spent in its sweeps.
+    pub time: PerFamily<Duration>,
+    /// Per family: constraints projected.
+    pub projections: PerFamily<u64>,
+}
+
+/// The soft body, fast. See the module documentation.
+pub struct FastSimulation {
+    settings: Settings,
+    positions: Vec<Vec3A>,
+    previous: Vec<Vec3A>,
+    velocities: Vec<Vec3A>,
+    /// The rest positions, for families whose formula reads the rest shape.
+    rest_positions: Vec<Vec3A>,
+    inverse_masses: Vec<f32>,
+    /// The scene's number of each particle, by new number.
+    original: Vec<u32>,
+    /// The constraints of each active family (the others are left empty).
+    sets: PerFamily<Batches>,
+    tets: usize,
+    jacobi: Option<Jacobi>,
+    #[cfg(feature = "parallel")]
+    pool: Option<rayon::ThreadPool>,
+    timings: Timings,
+    frame: u64,
+}
+
+/// How a sweep applies the corrections of a family's constraints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Order {
+    /// Gauss–Seidel: each colour starts from the positions the colours before it left.
+    GaussSeidel,
+    /// Jacobi: every constraint of a family is projected from the same positions, and then each
+    /// particle moves by `relaxation` × the mean of the corrections it got (ω/nᵢ Σ Δxᵢ).
+    Jacobi {
+        /// ω: 1 moves by the mean; larger values overrelax.
+        relaxation: f32,
+    },
+}
+
+/// What the Jacobi order needs: the corrections summed per particle, and per family the factor
+/// ω/nᵢ each particle's sum is applied with (nᵢ: the family's constraints on particle i).
+struct Jacobi {
+    relaxation: f32,
+    sums: Vec<Vec3A>,
+    factors: PerFamily<Vec<f32>>,
+}
+
+impl FastSimulation {
+    /// The fast solver for the current state of `simulation` (positions, velocities, pins,
+    /// settings), on `threads` threads (1 without the `parallel` feature).
+    pub fn new(simulation: &Simulation, threads: usize) -> FastSimulation {
+        let n = simulation.positions().len();
+        let original = morton::morton_order(simulation.positions());
+        let mut renumber = vec![0u32; n];
+        for (new, &old) in original.iter().enumerate() {
+            renumber[old as usize] = new as u32;
+        }
+        let take = |values: &[DVec3]| -> Vec<Vec3A> {
+            original
+                .iter()
+                .map(|&i| values[i as usize].as_vec3a())
+                .collect()
+        };
+        let inverse_masses: Vec<f32> = original
+            .iter()
+            .map(|&i| simulation.inverse_masses()[i as usize] as f32)
+            .collect();
+        // Only the families in use are built: the settings do not change after this.
+        let active = simulation.settings().active;
+        let sets = PerFamily::build(|family| {
+            if !active[family] {
+                return Batches::default();
+            }
+            struct Build<'a> {
+                simulation: &'a Simulation,
+                renumber: &'a [u32],
+                inverse_masses: &'a [f32],
+            }
+            impl Visit for Build<'_> {
+                type Output = Batches;
+                fn visit<const N: usize, C: Constraint<N>>(self, family: Family, _: &C) -> Batches {
+                    let set = self.simulation.constraints(family);
+                    let constraints = (0..set.len())
+                        .map(|c| {
+                            let particles: [u32; N] = std::array::from_fn(|k| {
+                                self.renumber[set.particles(c)[k] as usize]
+                            });
+                            (particles, set.rest()[c] as f32)
+                        })
+                        .collect();
+                    Batches::new(constraints, self.inverse_masses)
+                }
+            }
+            family.visit(Build {
+                simulation,
+                renumber: &renumber,
+                inverse_masses: &inverse_masses,
+            })
+        });
+        debug_assert!(sets.iter_ref().all(|(_, b)| b.colouring_is_valid(n)));
+        let positions = take(simulation.positions());
+        #[cfg(not(feature = "parallel"))]
+        let _ = threads;
+        FastSimulation {
+            settings: *simulation.settings(),
+            previous: positions.clone(),
+            positions,
+            velocities: take(simulation.velocities()),
+            rest_positions: take(simulation.rest_positions()),
+            inverse_masses,
+            original,
+            sets,
+            tets: simulation.tets().len(),
+            jacobi: None,
+            #[cfg(feature = "parallel")]
+            pool: (threads > 1)
+                .then(|| {
+                    rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .ok()
+                })
+                .flatten(),
+            timings: Timings::default(),
+            frame: 0,
+        }
+    }
+
+    /// The threads the projections run on.
+    pub fn threads(&self) -> usize {
+        #[cfg(feature = "parallel")]
+        if let Some(pool) = &self.pool {
+            return pool.current_num_threads();
+        }
+        1
+    }
+
+    /// The constraints of `family`, coloured and in batches (empty when it is not active).
+    pub fn batches(&self, family: Family) -> &Batches {
+        &self.sets[family]
+    }
+
+    /// Projects in `order` from now on (Gauss–Seidel unless set).
+    pub fn set_order(&mut self, order: Order) {
+        self.jacobi = match order {
+            Order::GaussSeidel => None,
+            Order::Jacobi { relaxation } => {
+                let factors = |count: Vec<u32>| -> Vec<f32> {
+                    count
+                        .into_iter()
+                        .map(|n| if n == 0 { 0.0 } else { relaxation / n as f32 })
+                        .collect()
+                };
+                Some(Jacobi {
+                    relaxation,
+                    sums: vec![Vec3A::ZERO; self.positions.len()],
+                    factors: PerFamily::build(|family| {
+                        factors(self.sets[family].constraints_per_particle())
+                    }),
+                })
+            }
+        }
+    }
+
+    /// The order the sweeps project in.
+    pub fn order(&self) -> Order {
+        match &self.jacobi {
+            None => Order::GaussSeidel,
+            Some(jacobi) => Order::Jacobi {
+                relaxation: jacobi.relaxation,
+            },
+        }
+    }
+
+    /// Per active family, how far its constraints are from holding now: √(mean (C / rest)²) (a
+    /// rest value of zero counts as one).
+    pub fn relative_error(&self) -> PerFamily<Option<f64>> {
+        struct RelativeError<'a> {
+            batches: &'a Batches,
+            positions: &'a [Vec3A],
+            rest_positions: &'a [Vec3A],
+        }
+        impl Visit for RelativeError<'_> {
+            type Output = f64;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> f64 {
+                let mut sum = 0.0;
+                for (particles, rest) in self.batches.constraints() {
+                    let at = |positions: &[Vec3A]| -> [Vec3A; N] {
+                        std::array::from_fn(|k| positions[particles[k] as usize])
+                    };
+                    let value = c
+                        .evaluate(&at(self.positions), rest, &at(self.rest_positions))
+                        .value;
+                    let scale = if rest == 0.0 { 1.0 } else { rest.abs() };
+                    sum += (f64::from(value) / f64::from(scale)).powi(2);
+                }
+                (sum / self.batches.len().max(1) as f64).sqrt()
+            }
+        }
+        let active = self.settings.active;
+        PerFamily::from_fn(|family| {
+            active[family].then(|| {
+                family.visit(RelativeError {
+                    batches: &self.sets[family],
+                    positions: &self.positions,
+                    rest_positions: &self.rest_positions,
+                })
+            })
+        })
+    }
+
+    /// The settings in force.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Positions in the scene's particle numbering.
+    pub fn positions(&self) -> Vec<DVec3> {
+        self.in_scene_order(&self.positions)
+    }
+
+    /// Velocities in the scene's particle numbering.
+    pub fn velocities(&self) -> Vec<DVec3> {
+        self.in_scene_order(&self.velocities)
+    }
+
+    fn in_scene_order(&self, values: &[Vec3A]) -> Vec<DVec3> {
+        let mut out = vec![DVec3::ZERO; values.len()];
+        for (v, &i) in values.iter().zip(&self.original) {
+            out[i as usize] = v.as_dvec3();
+        }
+        out
+    }
+
+    /// Ok while every coordinate is finite and below [`POSITION_LIMIT`] in size and every
+    /// velocity component below [`crate::solver::SOUND_LIMIT`]; otherwise the first that is not
+    /// (particles in the scene's numbering).
+    pub fn check(&self) -> Result<(), Divergence> {
+        let f64s = |v: &Vec3A| v.as_dvec3().to_array();
+        Divergence::find(
+            self.frame,
+            (POSITION_LIMIT, crate::solver::SOUND_LIMIT),
+            self.positions.iter().map(f64s),
+            self.velocities.iter().map(f64s),
+            |i| self.original[i] as usize,
+        )
+    }
+
+    /// Whether [`FastSimulation::check`] finds nothing.
+    pub fn is_sound(&self) -> bool {
+        self.check().is_ok()
+    }
+
+    /// Frames stepped.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// The tets in the scene.
+    pub fn tet_count(&self) -> usize {
+        self.tets
+    }
+
+    /// Constraint projections one frame makes with the current settings.
+    pub fn projections_per_frame(&self) -> u64 {
+        self.settings
+            .projections_per_frame(PerFamily::from_fn(|f| self.sets[f].len()))
+    }
+
+    /// The bytes of memory the solver's arrays take.
+    pub fn heap_bytes(&self) -> usize {
+        (self.positions.capacity()
+            + self.previous.capacity()
+            + self.velocities.capacity()
+            + self.rest_positions.capacity())
+            * size_of::<Vec3A>()
+            + self.inverse_masses.capacity() * size_of::<f32>()
+            + self.original.capacity() * size_of::<u32>()
+            + self
+                .sets
+                .iter_ref()
+                .map(|(_, b)| b.heap_bytes())
+                .sum::<usize>()
+            + self.jacobi.as_ref().map_or(0, |j| {
+                j.sums.capacity() * size_of::<Vec3A>()
+                    + j.factors
+                        .iter_ref()
+                        .map(|(_, f)| f.capacity())
+                        .sum::<usize>()
+                        * size_of::<f32>()
+            })
+    }
+
+    /// Time and projections per family since the last [`FastSimulation::reset_timings`].
+    pub fn timings(&self) -> Timings {
+        self.timings
+    }
+
+    /// Starts the timings afresh.
+    pub fn reset_timings(&mut self) {
+        self.timings = Timings::default();
+    }
+
+    /// Advances one frame: `substeps` substeps of predict, sweeps, velocities. With several
+    /// threads, the whole frame runs inside the thread pool (entering it once per frame, not once
+    /// per colour).
+    pub fn step(&mut self) {
+        #[cfg(feature = "parallel")]
+        if let Some(pool) = self.pool.take() {
+            pool.install(|| self.step_on(true));
+            self.pool = Some(pool);
+            self.frame += 1;
+            return;
+        }
+        self.step_on(false);
+        self.frame += 1;
+    }
+
+    /// One frame; `parallel`: large colours are shared by the threads of the current pool.
+    fn step_on(&mut self, parallel: bool) {
+        let settings = self.settings;
+        let h = settings.dt / settings.substeps.max(1) as f64;
+        for _ in 0..settings.substeps.max(1) {
+            integrate::predict(
+                &mut self.positions,
+                &mut self.previous,
+                &mut self.velocities,
+                &self.inverse_masses,
+                settings.gravity,
+                h,
+                settings.ground,
+            );
+            for family in settings.active.families() {
+                self.sets[family].reset_lambda();
+            }
+            for _ in 0..settings.iterations.max(1) {
+                self.sweep(h, parallel);
+            }
+            integrate::update_velocities(
+                &self.positions,
+                &self.previous,
+                &mut self.velocities,
+                h,
+                settings.damping,
+                false,
+            );
+        }
+    }
+
+    fn sweep(&mut self, h: f64, parallel: bool) {
+        let active = self.settings.active;
+        for family in active.families() {
+            let rule = Rule::for_settings(&self.settings, family, h);
+            let started = Instant::now();
+            let sums = self.jacobi.as_mut().map(|j| &mut j.sums[..]);
+            struct Project<'a> {
+                batches: &'a mut Batches,
+                positions: &'a mut [Vec3A],
+                rest_positions: &'a mut [Vec3A],
+                sums: Option<&'a mut [Vec3A]>,
+                rule: Rule<f64>,
+                parallel: bool,
+            }
+            impl Visit for Project<'_> {
+                type Output = usize;
+                #[inline]
+                fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> usize {
+                    kernel::project_family::<N, C>(
+                        c,
+                        self.batches,
+                        self.positions,
+                        self.rest_positions,
+                        self.sums,
+                        self.rule,
+                        self.parallel,
+                    )
+                }
+            }
+            let count = family.visit(Project {
+                batches: &mut self.sets[family],
+                positions: &mut self.positions,
+                rest_positions: &mut self.rest_positions,
+                sums,
+                rule,
+                parallel,
+            });
+            if let Some(jacobi) = &mut self.jacobi {
+                let factors = &jacobi.factors[family];
+                for ((p, sum), &factor) in
+                    self.positions.iter_mut().zip(&mut jacobi.sums).zip(factors)
+                {
+                    *p += *sum * factor;
+                    *sum = Vec3A::ZERO;
+                }
+            }
+            self.timings.time[family] += started.elapsed();
+            self.timings.projections[family] += count as u64;
+        }
+        if self.settings.ground {
+            integrate::project_ground(&mut self.positions, &self.inverse_masses);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraints::PerFamily;
+    use crate::metrics::Metrics;
+    use crate::scene::{Builtin, Perturbation, Scene};
+
+    fn cube(resolution: u32, active: PerFamily<bool>) -> Simulation {
+        let scene = Scene::builtin(Builtin::Cube, resolution).unwrap();
+        Simulation::new(
+            &scene,
+            Settings {
+                active,
+                ..Settings::default()
+            },
+        )
+    }
+
+    #[test]
+    fn colours_share_no_particle_and_cover_every_constraint_once() {
+        let simulation = cube(4, PerFamily::splat(true));
+        let fast = FastSimulation::new(&simulation, 1);
+        let n = simulation.positions().len();
+        for family in Family::all() {
+            assert!(fast.batches(family).colouring_is_valid(n), "{family}");
+            let set = simulation.constraints(family);
+            assert_eq!(fast.batches(family).len(), set.len(), "{family}");
+        }
+        let volumes = simulation.constraints(Family::VOLUME);
+        let mut before: Vec<&[u32]> = (0..volumes.len()).map(|c| volumes.particles(c)).collect();
+        let renumbered: Vec<[u32; 4]> = fast
+            .batches(Family::VOLUME)
+            .constraints()
+            .map(|(p, _)| p.map(|i| fast.original[i as usize]))
+            .collect();
+        let mut after: Vec<&[u32]> = renumbered.iter().map(|p| &p[..]).collect();
+        before.sort_unstable();
+        after.sort_unstable();
+        assert_eq!(before, after, "the same constraints, renumbered");
+    }
+
+    #[test]
+    fn a_mirrored_cube_recovers_on_the_fast_path_as_on_the_reference() {
+        let mut reference = cube(3, PerFamily::splat(true));
+        reference.set_settings(Settings {
+            settle_edits: false,
+            ..*reference.settings()
+        });
+        reference.perturb(Perturbation::Mirror);
+        let mut fast = FastSimulation::new(&reference, 1);
+        for _ in 0..60 {
+            reference.step();
+            fast.step();
+        }
+        let mut check = reference.clone();
+        check.set_positions(&fast.positions());
+        assert_eq!(Metrics::measure(&reference).inverted_tets, 0);
+        assert_eq!(Metrics::measure(&check).inverted_tets, 0);
+    }
+
+    #[test]
+    fn edges_alone_leave_a_mirrored_cube_inverted_on_the_fast_path_too() {
+        let mut reference = cube(3, PerFamily::parse_list("edges").unwrap());
+        reference.perturb(Perturbation::Mirror);
+        let mut fast = FastSimulation::new(&reference, 1);
+        for _ in 0..60 {
+            fast.step();
+        }
+        let mut check = reference.clone();
+        check.set_positions(&fast.positions());
+        assert_eq!(
+            Metrics::measure(&check).inverted_tets,
+            reference.tets().len()
+        );
+    }
+
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn two_threads_give_the_same_bits_as_one() {
+        let mut reference = cube(16, PerFamily::parse_list("edges,volume").unwrap());
+        reference.perturb(Perturbation::Scramble(4));
+        for order in [Order::GaussSeidel, Order::Jacobi { relaxation: 1.5 }] {
+            let mut one = FastSimulation::new(&reference, 1);
+            let mut two = FastSimulation::new(&reference, 2);
+            one.set_order(order);
+            two.set_order(order);
+            assert_eq!(two.threads(), 2);
+            assert!(
+                two.batches(Family::VOLUME)
+                    .colours
+                    .iter()
+                    .any(|c| c.constraints >= PARALLEL_MIN),
+                "some colour is large enough to be shared"
+            );
+            for _ in 0..5 {
+                one.step();
+                two.step();
+            }
+            assert_eq!(one.positions(), two.positions(), "{order:?}");
+        }
+    }
+
+    #[test]
+    fn a_mirrored_cube_recovers_in_jacobi_order_too() {
+        let mut reference = cube(3, PerFamily::splat(true));
+        reference.perturb(Perturbation::Mirror);
+        let mut fast = FastSimulation::new(&reference, 1);
+        fast.set_order(Order::Jacobi { relaxation: 1.0 });
+        assert_eq!(fast.order(), Order::Jacobi { relaxation: 1.0 });
+        for _ in 0..60 {
+            fast.step();
+        }
+        let mut check = reference.clone();
+        check.set_positions(&fast.positions());
+        assert!(fast.is_sound());
+        assert_eq!(Metrics::measure(&check).inverted_tets, 0);
+    }
+
+    /// Jacobi averages where Gauss–Seidel chains: with the same projections per frame, a body
+    /// resting under gravity holds its edges and volumes less tightly.
+    #[test]
+    fn the_jacobi_order_holds_the_constraints_less_tightly_than_gauss_seidel() {
+        let simulation = cube(4, PerFamily::parse_list("edges,volume").unwrap());
+        let error = |order| {
+            let mut fast = FastSimulation::new(&simulation, 1);
+            fast.set_order(order);
+            for _ in 0..60 {
+                fast.step();
+            }
+            fast.relative_error()
+        };
+        let gauss_seidel = error(Order::GaussSeidel);
+        let jacobi = error(Order::Jacobi { relaxation: 1.0 });
+        assert_eq!(gauss_seidel[Family::HEIGHT], None, "heights not active");
+        for family in [Family::EDGES, Family::VOLUME] {
+            let (gs, j) = (gauss_seidel[family], jacobi[family]);
+            let (gs, j) = (gs.unwrap(), j.unwrap());
+            assert!(gs > 0.0 && j > 2.0 * gs, "Gauss–Seidel {gs}, Jacobi {j}");
+        }
+    }
+
+    #[test]
+    fn projections_and_memory_are_counted() {
+        let simulation = cube(4, PerFamily::parse_list("edges,volume").unwrap());
+        let mut fast = FastSimulation::new(&simulation, 1);
+        let count = |f| simulation.constraint_count(f) as u64;
+        let per_frame = (count(Family::EDGES) + count(Family::VOLUME)) * 10;
+        assert_eq!(fast.projections_per_frame(), per_frame);
+        fast.step();
+        let t = fast.timings();
+        assert_eq!(
+            t.projections[Family::EDGES] + t.projections[Family::VOLUME],
+            per_frame
+        );
+        assert_eq!(t.projections[Family::HEIGHT], 0);
+        let per_tet = fast.heap_bytes() / fast.tet_count();
+        assert!((100..300).contains(&per_tet), "{per_tet} bytes per tet");
+    }
+}

@@ -1,0 +1,170 @@
+//! The projection rule both solvers share: how one constraint moves its particles, in any
+//! precision and for one constraint or eight in SIMD lanes.
+//!
+//! Projecting one constraint C with particles i, gradients ∇ᵢC and inverse masses wᵢ:
+//! - XPBD: α̃ = α / h², Δλ = (−C − α̃ λ) / (Σ wᵢ|∇ᵢC|² + α̃), λ += Δλ, Δxᵢ = wᵢ ∇ᵢC Δλ;
+//! - PBD: s = −C / Σ wᵢ|∇ᵢC|², Δxᵢ = k′ s wᵢ ∇ᵢC with k′ = 1 − (1 − k)^(1/iterations), so that
+//!   `iterations` sweeps of stiffness k′ compound to k.
+//!
+//! A constraint is skipped (no correction) where its evaluation is degenerate (undefined ∇C),
+//! where every particle is fixed, and where it is [`LOCKED`].
+
+use crate::constraints::{Evaluation, Family};
+use crate::solver::{Method, Settings};
+use crate::vector::{Real, Vector3};
+use glam::DVec3;
+
+/// The change one projection makes: Δλ (XPBD; the scaled step s for PBD) and Δx per particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Correction<const N: usize, V: Vector3 = DVec3> {
+    /// XPBD: Δλ. PBD: k′ s.
+    pub delta_lambda: V::Real,
+    /// Δx for each particle of the constraint.
+    pub delta_x: [V; N],
+}
+
+/// How a correction is scaled: XPBD with α̃ = α / h², or PBD with the per-iteration stiffness k′.
+#[derive(Clone, Copy, Debug)]
+pub enum Rule<R> {
+    /// XPBD with α̃ = α / h².
+    Xpbd {
+        /// α̃ = α / h².
+        alpha_tilde: R,
+    },
+    /// PBD with the per-sweep stiffness k′.
+    Pbd {
+        /// k′ = 1 − (1 − k)^(1/iterations).
+        k: R,
+    },
+}
+
+impl Rule<f64> {
+    /// The rule `settings` give `family` in a substep of length h: XPBD α̃ = α / h², or PBD
+    /// k′ = 1 − (1 − k)^(1/iterations), so that the sweeps of a substep compound to k.
+    pub fn for_settings(settings: &Settings, family: Family, h: f64) -> Rule<f64> {
+        match settings.method {
+            Method::Xpbd => Rule::Xpbd {
+                alpha_tilde: settings.compliance[family] / (h * h),
+            },
+            Method::Pbd => {
+                let k = settings.stiffness[family].clamp(0.0, 1.0);
+                let n = settings.iterations.max(1) as f64;
+                Rule::Pbd {
+                    k: 1.0 - (1.0 - k).powf(1.0 / n),
+                }
+            }
+        }
+    }
+
+    /// The same rule in another precision.
+    pub fn to<R: Real>(self) -> Rule<R> {
+        match self {
+            Rule::Xpbd { alpha_tilde } => Rule::Xpbd {
+                alpha_tilde: R::from_f64(alpha_tilde),
+            },
+            Rule::Pbd { k } => Rule::Pbd { k: R::from_f64(k) },
+        }
+    }
+}
+
+/// The correction that projecting one constraint would make, or `None` when it is skipped
+/// (degenerate, or every particle pinned). In any precision: the f64 path and the fast f32 path
+/// share it, through [`correction_lanes`].
+#[inline]
+pub(crate) fn correction<V: Vector3, const N: usize>(
+    evaluation: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: V::Real,
+    rule: Rule<V::Real>,
+) -> Option<Correction<N, V>>
+where
+    V::Real: Real<Mask = bool>,
+{
+    let (skipped, correction) = correction_lanes(evaluation, weights, lambda, rule);
+    (!skipped).then_some(correction)
+}
+
+/// The projection rule without a branch, for one constraint or several in lanes:
+/// Σ wᵢ|∇ᵢC|²; XPBD Δλ = (−C − α̃λ) / (Σ wᵢ|∇ᵢC|² + α̃), PBD Δλ = −k′C / Σ wᵢ|∇ᵢC|²; Δxᵢ = wᵢ ∇ᵢC Δλ.
+/// The mask is set and the correction is zero where the evaluation is degenerate, where
+/// Σ wᵢ|∇ᵢC|² is not positive and finite (every particle fixed), and where the constraint is
+/// [`LOCKED`]: its free particles can barely change it.
+#[inline(always)]
+pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
+    evaluation: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: V::Real,
+    rule: Rule<V::Real>,
+) -> (<V::Real as Real>::Mask, Correction<N, V>) {
+    // Σ wᵢ|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
+    let mut weighted_norm = V::Real::ZERO;
+    let mut norm = V::Real::ZERO;
+    let mut heaviest = V::Real::ZERO;
+    for (w, g) in weights.iter().zip(&evaluation.gradients) {
+        let squared = g.length_squared();
+        weighted_norm += *w * squared;
+        norm += squared;
+        heaviest = V::Real::select(w.gt(heaviest), *w, heaviest);
+    }
+    let locked = weighted_norm.le(V::Real::from_f64(LOCKED) * heaviest * norm);
+    let skipped =
+        evaluation.degenerate | !weighted_norm.gt(V::Real::ZERO) | !weighted_norm.finite() | locked;
+    let delta_lambda = match rule {
+        Rule::Xpbd { alpha_tilde } => {
+            (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
+        }
+        Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
+    };
+    let delta_lambda = V::Real::select(skipped, V::Real::ZERO, delta_lambda);
+    let mut delta_x = [V::ZERO; N];
+    for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
+        *dx = V::select(skipped, V::ZERO, *g * (w * delta_lambda));
+    }
+    (
+        skipped,
+        Correction {
+            delta_lambda,
+            delta_x,
+        },
+    )
+}
+
+/// One rigid XPBD projection of a constraint at `points` with rest value `rest` and inverse
+/// masses `weights`, starting from λ = 0: Δx per particle (zero when skipped). The kernel the
+/// solvers run per constraint, for benchmarks (`core/benches/kernels.rs`).
+pub fn project_kernel<V: Vector3, const N: usize>(
+    evaluate: impl Fn(&[V; N], V::Real) -> Evaluation<V, N>,
+    points: &[V; N],
+    rest: V::Real,
+    weights: [V::Real; N],
+) -> [V; N] {
+    let rule = Rule::Xpbd {
+        alpha_tilde: V::Real::ZERO,
+    };
+    correction_lanes(evaluate(points, rest), weights, V::Real::ZERO, rule)
+        .1
+        .delta_x
+}
+
+/// Below this fraction of max wᵢ · Σ|∇ᵢC|², Σ wᵢ|∇ᵢC|² says that the particles free to move
+/// (w > 0) can barely change the constraint: those that could are pinned or held, and the free
+/// ones' gradients nearly vanish. Projecting it would move a free particle by about |C| / |∇ᵢC|,
+/// unboundedly far as ∇ᵢC → 0 (a face vertex of a height constraint whose other corners are
+/// held flings out by millions of metres, and the next projections feed on it). At this
+/// threshold a projection moves no particle more than 1/√LOCKED = 100 times as far as it would
+/// with every particle free; at or below it the constraint is skipped, like a degenerate one:
+/// Σ wᵢ|∇ᵢC|² ≤ LOCKED · max wᵢ · Σ|∇ᵢC|².
+pub const LOCKED: f64 = 1e-4;
+
+/// Σ wᵢ |∇ₚᵢC|², the denominator of every projection.
+#[inline]
+pub(crate) fn weighted_norm<V: Vector3, const N: usize>(
+    weights: &[V::Real; N],
+    gradients: &[V; N],
+) -> V::Real {
+    let mut sum = V::Real::ZERO;
+    for (w, g) in weights.iter().zip(gradients) {
+        sum += *w * g.length_squared();
+    }
+    sum
+}

@@ -1,0 +1,106 @@
+//! The constraints of one family as the reference solver keeps them: flat arrays, one entry per
+//! constraint in projection order (the particles, `arity` of them each; the rest value; the XPBD
+//! multiplier λ), built once from the family's binding to the mesh.
+
+use crate::constraints::{Constraint, Family, Visit};
+use crate::mesh::TetMesh;
+use glam::DVec3;
+
+/// One family's constraints.
+#[derive(Clone, Debug, Default)]
+pub struct ConstraintSet {
+    arity: usize,
+    particles: Vec<u32>,
+    rest: Vec<f64>,
+    lambda: Vec<f64>,
+}
+
+impl ConstraintSet {
+    /// The constraints of `family` on `mesh` ([`crate::constraints::Binding::particles`]), each
+    /// with its rest value measured on the mesh's rest positions.
+    pub(crate) fn new(family: Family, mesh: &TetMesh) -> ConstraintSet {
+        let particles = family.row().binding.particles(mesh);
+        struct RestValues<'a>(&'a [u32], &'a [DVec3]);
+        impl Visit for RestValues<'_> {
+            type Output = Vec<f64>;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Vec<f64> {
+                let (particles, positions) = (self.0, self.1);
+                let (groups, _) = particles.as_chunks::<N>();
+                groups
+                    .iter()
+                    .map(|idx| {
+                        let p = idx.map(|i| positions[i as usize]);
+                        c.evaluate(&p, 0.0, &p).value
+                    })
+                    .collect()
+            }
+        }
+        let rest = family.visit(RestValues(&particles, &mesh.positions));
+        ConstraintSet {
+            arity: family.arity(),
+            lambda: vec![0.0; rest.len()],
+            particles,
+            rest,
+        }
+    }
+
+    /// The number of constraints.
+    pub fn len(&self) -> usize {
+        self.rest.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.rest.is_empty()
+    }
+
+    /// How many particles each constraint touches.
+    pub fn arity(&self) -> usize {
+        self.arity
+    }
+
+    /// The particles of constraint `c`, in the constraint's own order.
+    pub fn particles(&self, c: usize) -> &[u32] {
+        &self.particles[c * self.arity..(c + 1) * self.arity]
+    }
+
+    /// The particles of every constraint, flat (`arity` per constraint).
+    pub fn all_particles(&self) -> &[u32] {
+        &self.particles
+    }
+
+    /// The particles of constraint `c` as an array of the family's arity `N`.
+    #[inline]
+    pub(crate) fn indices<const N: usize>(&self, c: usize) -> [u32; N] {
+        debug_assert_eq!(N, self.arity);
+        let (groups, _) = self.particles.as_chunks::<N>();
+        groups[c]
+    }
+
+    /// The rest value (d, V) of each constraint.
+    pub fn rest(&self) -> &[f64] {
+        &self.rest
+    }
+
+    /// The XPBD multiplier λ of each constraint, accumulated within the current substep.
+    pub fn lambda(&self) -> &[f64] {
+        &self.lambda
+    }
+
+    /// λ of constraint `c` grows by `delta`.
+    #[inline]
+    pub(crate) fn add_lambda(&mut self, c: usize, delta: f64) {
+        self.lambda[c] += delta;
+    }
+
+    /// λ = 0 for every constraint (a new substep).
+    pub(crate) fn reset_lambda(&mut self) {
+        self.lambda.fill(0.0);
+    }
+
+    /// The bytes its arrays take (their capacities).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.particles.capacity() * size_of::<u32>()
+            + (self.rest.capacity() + self.lambda.capacity()) * size_of::<f64>()
+    }
+}

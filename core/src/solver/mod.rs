@@ -1,0 +1,682 @@
+//! The simulation that every front end drives: XPBD (default) or PBD on the constraint families
+//! of [`crate::constraints::TABLE`], with substeps, gravity, a ground plane, pins and a grab
+//! constraint.
+//!
+//! One substep of length h = Δt / substeps:
+//! 1. predict: v += g h, x_prev = x, x += v h; a particle predicted below the ground (y < 0) is put
+//!    back at its previous position, on the ground (sticking friction);
+//! 2. XPBD only: λ = 0 for every constraint;
+//! 3. `iterations` Gauss–Seidel sweeps over the active families in the table's order (edges,
+//!    heights, volume), then the grab, then the ground y ≥ 0, each constraint projected at once;
+//! 4. v = (x − x_prev) / h, then damped: v *= max(0, 1 − damping · h) — except, with
+//!    [`Settings::settle_edits`], while an edit settles: there |v| is also capped at the predicted
+//!    speed, so the projections may turn the motion but never speed it up.
+//!
+//! The correction Δp of a substep is, per particle, the position after the sweeps minus the
+//! predicted one ([`Simulation::corrections`]). An edit (a perturbation, a particle placed by hand)
+//! settles until the largest Δp of a substep is below [`Simulation::settle_tolerance`], or for at
+//! most [`MAX_SETTLE_FRAMES`] frames.
+//!
+//! Each constraint is projected by the rule of [`crate::projection`] (XPBD or PBD), which the
+//! fast solver shares. All state lives in flat arrays, one [`ConstraintSet`] per family,
+//! allocated once: a step allocates nothing, and the same inputs give the same bits.
+//!
+//! Reading map, for one volume projection: [`Simulation::step`] → [`Simulation::substep`] →
+//! `sweep` (each active family, through [`Family::visit`]) → `project_one` →
+//! [`crate::constraints::volume::evaluate`] → `correction` ([`crate::projection`]).
+
+mod constraint_set;
+mod masses;
+mod settings;
+
+pub use constraint_set::ConstraintSet;
+pub use masses::DENSITY;
+pub use settings::{Method, Settings};
+
+use crate::constraints::{Constraint, Family, PerFamily, Visit, distance};
+use crate::divergence::Divergence;
+use crate::integrate;
+use crate::mesh::TetMesh;
+use crate::projection::{Rule, correction};
+use crate::scene::Scene;
+use glam::DVec3;
+
+/// The largest coordinate or velocity component (in m or m/s) a sound simulation in f64 has:
+/// below it, volumes (cubes), squared residuals and their sums over any mesh stay finite.
+pub const SOUND_LIMIT: f64 = 1e30;
+
+/// The longest an edit settles, in frames (one second at 60 frames per second).
+pub const MAX_SETTLE_FRAMES: u32 = 60;
+
+/// An edit has settled when no particle is corrected by more than this fraction of the mean rest
+/// edge length in a substep (plus what gravity alone causes; see [`Simulation::settle_tolerance`]).
+pub const SETTLE_FRACTION: f64 = 1e-3;
+
+/// A particle held by the user.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grab {
+    /// The particle.
+    pub particle: usize,
+    /// Where the user holds it.
+    pub target: DVec3,
+    target_at_last_step: DVec3,
+    /// How fast the target moved over the last step.
+    pub target_velocity: DVec3,
+    lambda: f64,
+}
+
+/// The soft body in motion.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    settings: Settings,
+    rest_positions: Vec<DVec3>,
+    positions: Vec<DVec3>,
+    previous: Vec<DVec3>,
+    velocities: Vec<DVec3>,
+    /// Inverse masses from the lumped masses, 0 where pinned.
+    inverse_masses: Vec<f64>,
+    pinned: Vec<bool>,
+    lumped_inverse_masses: Vec<f64>,
+    tets: Vec<[u32; 4]>,
+    /// The constraints of each family, as its binding makes them.
+    sets: PerFamily<ConstraintSet>,
+    grab: Option<Grab>,
+    /// Δp of the last substep; during a substep, the predicted positions.
+    corrections: Vec<DVec3>,
+    /// The mean rest edge length, the scale of "settled".
+    mean_edge: f64,
+    /// Frames an edit has been settling, `None` when none is; see [`Settings::settle_edits`].
+    settling: Option<u32>,
+    frame: u64,
+    time: f64,
+}
+
+impl Simulation {
+    /// A simulation of `scene` at rest, with masses lumped from density × rest volume / 4 per tet.
+    pub fn new(scene: &Scene, settings: Settings) -> Simulation {
+        let mesh = &scene.mesh;
+        let positions = mesh.positions.clone();
+        let sets = PerFamily::build(|family| ConstraintSet::new(family, mesh));
+        let lumped_inverse_masses = masses::lumped_inverse_masses(mesh);
+        let edges = mesh.edges();
+        let mean_edge = if edges.is_empty() {
+            1.0
+        } else {
+            let length = |&[i, j]: &[u32; 2]| positions[i as usize].distance(positions[j as usize]);
+            edges.iter().map(length).sum::<f64>() / edges.len() as f64
+        };
+        let mut pinned = vec![false; positions.len()];
+        for &i in &scene.pinned {
+            pinned[i as usize] = true;
+        }
+        let n = positions.len();
+        let mut simulation = Simulation {
+            settings,
+            rest_positions: positions.clone(),
+            previous: positions.clone(),
+            positions,
+            velocities: vec![DVec3::ZERO; n],
+            inverse_masses: vec![0.0; n],
+            pinned,
+            lumped_inverse_masses,
+            tets: mesh.tets.clone(),
+            sets,
+            grab: None,
+            corrections: vec![DVec3::ZERO; n],
+            mean_edge,
+            settling: None,
+            frame: 0,
+            time: 0.0,
+        };
+        simulation.update_inverse_masses();
+        simulation
+    }
+
+    /// The settings in force.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Changes the settings; they apply from the next substep.
+    pub fn set_settings(&mut self, settings: Settings) {
+        self.settings = settings;
+    }
+
+    /// Current particle positions.
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// Rest positions (the scene as made).
+    pub fn rest_positions(&self) -> &[DVec3] {
+        &self.rest_positions
+    }
+
+    /// Current particle velocities.
+    pub fn velocities(&self) -> &[DVec3] {
+        &self.velocities
+    }
+
+    /// Δp of the last substep, per particle: the position after the constraint projections minus
+    /// the predicted position. Zero after a perturbation or a reset, and for a particle placed by
+    /// hand, until the next substep.
+    pub fn corrections(&self) -> &[DVec3] {
+        &self.corrections
+    }
+
+    /// Whether an edit is settling (see [`Settings::settle_edits`]).
+    pub fn is_settling(&self) -> bool {
+        self.settling.is_some()
+    }
+
+    /// The largest Δp per substep, in metres, at which an edit counts as settled:
+    /// [`SETTLE_FRACTION`] × the mean rest edge length, plus g h², the correction that gravity
+    /// alone causes in a body at rest on the ground.
+    pub fn settle_tolerance(&self) -> f64 {
+        let h = self.settings.dt / self.settings.substeps.max(1) as f64;
+        SETTLE_FRACTION * self.mean_edge + self.settings.gravity.abs() * h * h
+    }
+
+    /// Inverse masses in use (0 for pinned or grabbed-rigidly particles).
+    pub fn inverse_masses(&self) -> &[f64] {
+        &self.inverse_masses
+    }
+
+    /// The tets, as indices into the positions.
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// Frames stepped since the start.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Simulated time in seconds.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Ok while every coordinate and velocity component is finite and below [`SOUND_LIMIT`] in
+    /// size; otherwise the first that is not. Within the input [`crate::limits`] only an
+    /// instability leaves that range; front ends check after every frame and stop.
+    pub fn check(&self) -> Result<(), Divergence> {
+        Divergence::find(
+            self.frame,
+            (SOUND_LIMIT, SOUND_LIMIT),
+            self.positions.iter().map(|p| p.to_array()),
+            self.velocities.iter().map(|v| v.to_array()),
+            |i| i,
+        )
+    }
+
+    /// Whether [`Simulation::check`] finds nothing.
+    pub fn is_sound(&self) -> bool {
+        self.check().is_ok()
+    }
+
+    /// The bytes of memory the simulation's arrays take (their capacities).
+    pub fn heap_bytes(&self) -> usize {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * size_of::<T>()
+        }
+        bytes(&self.rest_positions)
+            + bytes(&self.positions)
+            + bytes(&self.previous)
+            + bytes(&self.velocities)
+            + bytes(&self.inverse_masses)
+            + bytes(&self.pinned)
+            + bytes(&self.lumped_inverse_masses)
+            + bytes(&self.tets)
+            + bytes(&self.corrections)
+            + self
+                .sets
+                .iter_ref()
+                .map(|(_, set)| set.heap_bytes())
+                .sum::<usize>()
+    }
+
+    /// Whether particle `i` is pinned.
+    pub fn is_pinned(&self, i: usize) -> bool {
+        self.pinned[i]
+    }
+
+    /// Pins or frees particle `i`.
+    pub fn set_pinned(&mut self, i: usize, pinned: bool) {
+        self.pinned[i] = pinned;
+        self.update_inverse_masses();
+    }
+
+    /// Applies a perturbation to the current positions and stops all motion.
+    pub fn perturb(&mut self, perturbation: crate::scene::Perturbation) {
+        let mesh = TetMesh {
+            positions: self.rest_positions.clone(),
+            tets: self.tets.clone(),
+        };
+        perturbation.apply(&mut self.positions, &mesh);
+        self.stop();
+        self.settling = Some(0);
+    }
+
+    /// Puts every particle at the given positions, at rest (e.g. a state computed elsewhere).
+    pub fn set_positions(&mut self, positions: &[DVec3]) {
+        self.positions.copy_from_slice(positions);
+        self.stop();
+    }
+
+    /// Puts particle `i` at `position` at rest (a kinematic move, e.g. a drag while paused).
+    pub fn place(&mut self, i: usize, position: DVec3) {
+        self.positions[i] = position;
+        self.previous[i] = position;
+        self.velocities[i] = DVec3::ZERO;
+        self.corrections[i] = DVec3::ZERO;
+        self.settling = Some(0);
+    }
+
+    /// Back to the rest shape, at rest, at frame 0.
+    pub fn reset(&mut self) {
+        self.positions.copy_from_slice(&self.rest_positions);
+        self.stop();
+        self.settling = None;
+        self.frame = 0;
+        self.time = 0.0;
+    }
+
+    /// Zeroes every velocity and multiplier.
+    fn stop(&mut self) {
+        self.previous.copy_from_slice(&self.positions);
+        self.velocities.fill(DVec3::ZERO);
+        self.corrections.fill(DVec3::ZERO);
+        for family in Family::all() {
+            self.sets[family].reset_lambda();
+        }
+    }
+
+    /// Starts holding particle `i` at `target`. With zero grab compliance the particle follows the
+    /// target exactly (its inverse mass is 0 meanwhile); otherwise a compliant zero-length
+    /// constraint pulls it.
+    pub fn grab(&mut self, i: usize, target: DVec3) {
+        self.release();
+        self.grab = Some(Grab {
+            particle: i,
+            target,
+            target_at_last_step: target,
+            target_velocity: DVec3::ZERO,
+            lambda: 0.0,
+        });
+        self.update_inverse_masses();
+    }
+
+    /// Moves the held target.
+    pub fn move_grab(&mut self, target: DVec3) {
+        if let Some(grab) = &mut self.grab {
+            grab.target = target;
+        }
+    }
+
+    /// The current grab, if any.
+    pub fn grabbed(&self) -> Option<&Grab> {
+        self.grab.as_ref()
+    }
+
+    /// Lets go: the particle's mass comes back, and it keeps the target's velocity over the last
+    /// step so it can be thrown.
+    pub fn release(&mut self) {
+        if let Some(grab) = self.grab.take() {
+            self.velocities[grab.particle] = grab.target_velocity;
+            self.update_inverse_masses();
+        }
+    }
+
+    fn rigid_grab(&self) -> Option<Grab> {
+        self.grab.filter(|_| self.settings.grab_compliance <= 0.0)
+    }
+
+    fn update_inverse_masses(&mut self) {
+        for i in 0..self.positions.len() {
+            self.inverse_masses[i] = if self.pinned[i] {
+                0.0
+            } else {
+                self.lumped_inverse_masses[i]
+            };
+        }
+        if let Some(grab) = self.rigid_grab() {
+            self.inverse_masses[grab.particle] = 0.0;
+        }
+    }
+
+    /// Advances one frame: `substeps` substeps of Δt / substeps.
+    pub fn step(&mut self) {
+        self.update_inverse_masses();
+        for _ in 0..self.settings.substeps.max(1) {
+            self.substep();
+        }
+        if let Some(grab) = &mut self.grab {
+            grab.target_velocity = (grab.target - grab.target_at_last_step) / self.settings.dt;
+            grab.target_at_last_step = grab.target;
+        }
+        if let Some(frames) = self.settling {
+            let largest = self.largest_correction();
+            self.settling = (self.settings.settle_edits
+                && largest > self.settle_tolerance()
+                && frames + 1 < MAX_SETTLE_FRAMES)
+                .then_some(frames + 1);
+        }
+        self.frame += 1;
+        self.time += self.settings.dt;
+    }
+
+    /// One substep: predict, project every active family `iterations` times, update velocities.
+    /// The same as [`Simulation::begin_substep`], then for each iteration every constraint of
+    /// [`Simulation::projection_order`] through [`Simulation::project`] and
+    /// [`Simulation::end_sweep`], then [`Simulation::end_substep`] — done here in tight loops.
+    pub fn substep(&mut self) {
+        let h = self.substep_length();
+        self.begin_substep();
+        for _ in 0..self.settings.iterations.max(1) {
+            self.sweep(h);
+        }
+        self.end_substep();
+    }
+
+    /// h = Δt / substeps.
+    pub fn substep_length(&self) -> f64 {
+        self.settings.dt / self.settings.substeps.max(1) as f64
+    }
+
+    /// The first part of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
+    pub fn begin_substep(&mut self) {
+        let h = self.substep_length();
+        self.predict(h);
+        for family in Family::all() {
+            self.sets[family].reset_lambda();
+        }
+        if let Some(grab) = &mut self.grab {
+            grab.lambda = 0.0;
+        }
+    }
+
+    /// The end of one sweep, after the constraint families: the grab, then the ground y ≥ 0.
+    pub fn end_sweep(&mut self) {
+        let h = self.substep_length();
+        self.project_soft_grab(h);
+        if self.settings.ground {
+            integrate::project_ground(&mut self.positions, &self.inverse_masses);
+        }
+    }
+
+    /// The last part of a substep: Δp = x − predicted x, then velocities from the positions.
+    pub fn end_substep(&mut self) {
+        let h = self.substep_length();
+        for (correction, p) in self.corrections.iter_mut().zip(&self.positions) {
+            *correction = *p - *correction;
+        }
+        self.update_velocities(h, self.settings.settle_edits && self.settling.is_some());
+    }
+
+    /// The constraints one sweep projects, in order: every constraint of each active family
+    /// (edges, then heights, then volumes), as (family, index in the family).
+    pub fn projection_order(&self) -> impl Iterator<Item = (Family, usize)> + '_ {
+        Family::all()
+            .filter(|&f| self.settings.active[f])
+            .flat_map(move |f| (0..self.constraint_count(f)).map(move |c| (f, c)))
+    }
+
+    /// The constraints of `family` on tet `tet`, as indices in the family: its edges (six), its
+    /// four heights, or its volume ([`crate::constraints::Binding::of_tet`]).
+    pub fn tet_constraints(&self, tet: usize, family: Family) -> impl Iterator<Item = usize> + '_ {
+        let edges = self.sets[Family::EDGES].all_particles();
+        family.row().binding.of_tet(tet, self.tets[tet], edges)
+    }
+
+    /// The constraints of `family`: their particles, rest values and multipliers.
+    pub fn constraints(&self, family: Family) -> &ConstraintSet {
+        &self.sets[family]
+    }
+
+    /// Constraint projections one frame makes with the current settings: the active families'
+    /// constraints × substeps × iterations.
+    pub fn projections_per_frame(&self) -> u64 {
+        self.settings
+            .projections_per_frame(PerFamily::from_fn(|f| self.constraint_count(f)))
+    }
+
+    /// How many constraints `family` has.
+    pub fn constraint_count(&self, family: Family) -> usize {
+        self.sets[family].len()
+    }
+
+    /// What projecting constraint `c` of `family` now would do, with the current λ and the rule
+    /// (XPBD or PBD) of the current settings: C, ∇C, the inverse masses, Δλ and Δx.
+    pub fn projection(&self, family: Family, c: usize) -> Projection {
+        let rule = self.rule(family, self.substep_length());
+        family.visit(Describe {
+            set: &self.sets[family],
+            positions: &self.positions,
+            rest_positions: &self.rest_positions,
+            inverse_masses: &self.inverse_masses,
+            rule,
+            c,
+        })
+    }
+
+    /// Projects constraint `c` of `family` once, exactly as a sweep does.
+    pub fn project(&mut self, family: Family, c: usize) {
+        let rule = self.rule(family, self.substep_length());
+        family.visit(Sweep {
+            set: &mut self.sets[family],
+            positions: &mut self.positions,
+            rest_positions: &self.rest_positions,
+            inverse_masses: &self.inverse_masses,
+            rule,
+            only: Some(c),
+        });
+    }
+
+    /// The longest Δp of the last substep among particles that can move.
+    fn largest_correction(&self) -> f64 {
+        self.corrections
+            .iter()
+            .zip(&self.inverse_masses)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(c, _)| c.length())
+            .fold(0.0, f64::max)
+    }
+
+    fn predict(&mut self, h: f64) {
+        integrate::predict(
+            &mut self.positions,
+            &mut self.previous,
+            &mut self.velocities,
+            &self.inverse_masses,
+            self.settings.gravity,
+            h,
+            self.settings.ground,
+        );
+        if let Some(grab) = self.rigid_grab() {
+            self.positions[grab.particle] = grab.target;
+        }
+        self.corrections.copy_from_slice(&self.positions);
+    }
+
+    pub(crate) fn rule(&self, family: Family, h: f64) -> Rule<f64> {
+        Rule::for_settings(&self.settings, family, h)
+    }
+
+    /// One Gauss–Seidel sweep over the active families, then the grab, then the ground.
+    fn sweep(&mut self, h: f64) {
+        for family in Family::all() {
+            if !self.settings.active[family] {
+                continue;
+            }
+            let rule = self.rule(family, h);
+            family.visit(Sweep {
+                set: &mut self.sets[family],
+                positions: &mut self.positions,
+                rest_positions: &self.rest_positions,
+                inverse_masses: &self.inverse_masses,
+                rule,
+                only: None,
+            });
+        }
+        self.end_sweep();
+    }
+
+    fn project_soft_grab(&mut self, h: f64) {
+        let compliance = self.settings.grab_compliance;
+        let Some(grab) = self.grab.as_mut().filter(|_| compliance > 0.0) else {
+            return;
+        };
+        let i = grab.particle;
+        let evaluation = distance::evaluate(&[self.positions[i], grab.target], 0.0);
+        let rule = Rule::Xpbd {
+            alpha_tilde: compliance / (h * h),
+        };
+        if let Some(c) = correction(evaluation, [self.inverse_masses[i], 0.0], grab.lambda, rule) {
+            grab.lambda += c.delta_lambda;
+            self.positions[i] += c.delta_x[0];
+        }
+    }
+
+    /// v = (x − x_prev) / h, damped; when `settling`, no faster than the predicted velocity.
+    fn update_velocities(&mut self, h: f64, settling: bool) {
+        integrate::update_velocities(
+            &self.positions,
+            &self.previous,
+            &mut self.velocities,
+            h,
+            self.settings.damping,
+            settling,
+        );
+    }
+}
+
+/// Projects the constraints of one family's `set` (every one in order, Gauss–Seidel, or `only`
+/// one): λ += Δλ, xᵢ += Δxᵢ.
+struct Sweep<'a> {
+    set: &'a mut ConstraintSet,
+    positions: &'a mut [DVec3],
+    rest_positions: &'a [DVec3],
+    inverse_masses: &'a [f64],
+    rule: Rule<f64>,
+    only: Option<usize>,
+}
+
+impl Visit for Sweep<'_> {
+    type Output = ();
+
+    #[inline]
+    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, constraint: &C) {
+        let range = match self.only {
+            Some(c) => c..c + 1,
+            None => 0..self.set.len(),
+        };
+        for c in range {
+            let idx = self.set.indices::<N>(c);
+            let p = idx.map(|i| self.positions[i as usize]);
+            let shape = if C::USES_REST_SHAPE {
+                idx.map(|i| self.rest_positions[i as usize])
+            } else {
+                p
+            };
+            let evaluation = constraint.evaluate(&p, self.set.rest()[c], &shape);
+            let weights = idx.map(|i| self.inverse_masses[i as usize]);
+            if let Some(correction) =
+                correction(evaluation, weights, self.set.lambda()[c], self.rule)
+            {
+                self.set.add_lambda(c, correction.delta_lambda);
+                for (&i, dx) in idx.iter().zip(correction.delta_x) {
+                    self.positions[i as usize] += dx;
+                }
+            }
+        }
+    }
+}
+
+/// One constraint, described for a reader: see [`Simulation::projection`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    /// The constraint's family.
+    pub family: Family,
+    /// Its index within the family.
+    pub constraint: usize,
+    /// Its particles; the first [`Projection::len`] are used (2 for an edge, 4 otherwise).
+    pub particles: [u32; 4],
+    /// How many particles it has.
+    pub len: usize,
+    /// C now.
+    pub value: f64,
+    /// The rest value, d or V.
+    pub rest: f64,
+    /// ∇ₚC for each particle.
+    pub gradients: [DVec3; 4],
+    /// The inverse mass w of each particle (0 if pinned or held).
+    pub inverse_masses: [f64; 4],
+    /// Σ wᵢ |∇ₚᵢC|².
+    pub weighted_norm: f64,
+    /// λ accumulated so far in this substep (XPBD).
+    pub lambda: f64,
+    /// XPBD: Δλ; PBD: k′ s. `None` when the projection is skipped (degenerate, every particle
+    /// fixed, or [`LOCKED`]).
+    pub delta_lambda: Option<f64>,
+    /// Δx the projection would give each particle (zero when skipped).
+    pub delta_x: [DVec3; 4],
+    /// Whether ∇C is undefined here.
+    pub degenerate: bool,
+}
+
+impl Projection {
+    /// The particles it uses.
+    pub fn particles(&self) -> &[u32] {
+        &self.particles[..self.len]
+    }
+}
+
+/// [`Projection`] of constraint `c` of `set`.
+struct Describe<'a> {
+    set: &'a ConstraintSet,
+    positions: &'a [DVec3],
+    rest_positions: &'a [DVec3],
+    inverse_masses: &'a [f64],
+    rule: Rule<f64>,
+    c: usize,
+}
+
+impl Visit for Describe<'_> {
+    type Output = Projection;
+
+    fn visit<const N: usize, C: Constraint<N>>(self, family: Family, constraint: &C) -> Projection {
+        let c = self.c;
+        let idx = self.set.indices::<N>(c);
+        let p = idx.map(|i| self.positions[i as usize]);
+        let shape = idx.map(|i| self.rest_positions[i as usize]);
+        let evaluation = constraint.evaluate(&p, self.set.rest()[c], &shape);
+        let weights = idx.map(|i| self.inverse_masses[i as usize]);
+        let lambda = self.set.lambda()[c];
+        let correction = correction(evaluation, weights, lambda, self.rule);
+        let mut projection = Projection {
+            family,
+            constraint: c,
+            particles: [0; 4],
+            len: N,
+            value: evaluation.value,
+            rest: self.set.rest()[c],
+            gradients: [DVec3::ZERO; 4],
+            inverse_masses: [0.0; 4],
+            weighted_norm: crate::projection::weighted_norm(&weights, &evaluation.gradients),
+            lambda,
+            delta_lambda: correction.map(|c| c.delta_lambda),
+            delta_x: [DVec3::ZERO; 4],
+            degenerate: evaluation.degenerate,
+        };
+        for k in 0..N {
+            projection.particles[k] = idx[k];
+            projection.gradients[k] = evaluation.gradients[k];
+            projection.inverse_masses[k] = weights[k];
+            if let Some(correction) = &correction {
+                projection.delta_x[k] = correction.delta_x[k];
+            }
+        }
+        projection
+    }
+}

@@ -1,0 +1,135 @@
+//! How a simulation runs: [`Settings`], and the rules they follow (their ranges are
+//! [`crate::limits`], checked by [`Settings::check`]; the ground is on when gravity is not zero,
+//! [`Settings::set_gravity`]). The command line, lessons, `tetlab bench` and the workbench all
+//! build their settings here.
+
+use crate::constraints::{Family, PerFamily};
+use crate::limits;
+
+/// XPBD or PBD.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Method {
+    /// Extended PBD: compliance per family, λ accumulated within a substep.
+    Xpbd,
+    /// Müller et al. 2006: stiffness per family, corrected for the iteration count.
+    Pbd,
+}
+
+impl Method {
+    /// `xpbd` or `pbd`.
+    pub fn parse(text: &str) -> Result<Method, String> {
+        match text.trim() {
+            "xpbd" => Ok(Method::Xpbd),
+            "pbd" => Ok(Method::Pbd),
+            other => Err(format!("'{other}' is not a solver: expected xpbd or pbd")),
+        }
+    }
+
+    /// The name [`Method::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Xpbd => "xpbd",
+            Method::Pbd => "pbd",
+        }
+    }
+}
+
+/// How the simulation runs. Every field may change between steps.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Settings {
+    /// XPBD or PBD.
+    pub method: Method,
+    /// Which families are projected.
+    pub active: PerFamily<bool>,
+    /// XPBD compliance α per family: the inverse of stiffness, 0 is rigid, larger is softer.
+    pub compliance: PerFamily<f64>,
+    /// PBD stiffness k ∈ [0, 1] per family.
+    #[serde(deserialize_with = "stiffness_over_the_default")]
+    pub stiffness: PerFamily<f64>,
+    /// Substeps per frame, ≥ 1.
+    pub substeps: u32,
+    /// Gauss–Seidel sweeps per substep, ≥ 1.
+    pub iterations: u32,
+    /// Frame length Δt in seconds.
+    pub dt: f64,
+    /// Gravity along −y in m/s².
+    pub gravity: f64,
+    /// Whether the ground plane y = 0 stops particles.
+    pub ground: bool,
+    /// Velocity damping per second.
+    pub damping: f64,
+    /// Compliance of the grab constraint; 0 moves the grabbed particle with the target exactly.
+    pub grab_compliance: f64,
+    /// After an edit (a perturbation or a particle placed by hand), constraint corrections may
+    /// move particles but not speed them up, until the edit's violation is undone. Otherwise rigid
+    /// constraints undo a large violation within a substep, and v = Δx/h launches the body.
+    pub settle_edits: bool,
+}
+
+impl Settings {
+    /// Sets gravity, and the ground with it: on when g ≠ 0, off in weightlessness (the rule of
+    /// the command line and of lessons; the workbench also lets the user set the ground apart).
+    pub fn set_gravity(&mut self, gravity: f64) {
+        self.gravity = gravity;
+        self.ground = gravity != 0.0;
+    }
+
+    /// Ok when every number is within its range of [`crate::limits`]; otherwise the first that
+    /// is not, named (e.g. settings remembered by an older workbench, or edited by hand).
+    pub fn check(&self) -> Result<(), String> {
+        limits::SUBSTEPS.check(self.substeps)?;
+        limits::ITERATIONS.check(self.iterations)?;
+        limits::DT.check(self.dt)?;
+        limits::GRAVITY.check(self.gravity)?;
+        limits::DAMPING.check(self.damping)?;
+        limits::COMPLIANCE
+            .check(self.grab_compliance)
+            .map_err(|e| format!("grab {e}"))?;
+        for family in Family::all() {
+            let name = family.name();
+            limits::COMPLIANCE
+                .check(self.compliance[family])
+                .map_err(|e| format!("{e} ({name})"))?;
+            limits::STIFFNESS
+                .check(self.stiffness[family])
+                .map_err(|e| format!("{e} ({name})"))?;
+        }
+        Ok(())
+    }
+
+    /// Constraint projections in one frame, given how many constraints each family has: the
+    /// active families' counts × substeps × iterations.
+    pub fn projections_per_frame(&self, counts: PerFamily<usize>) -> u64 {
+        let per_sweep: usize = self.active.families().map(|f| counts[f]).sum();
+        per_sweep as u64 * self.substeps.max(1) as u64 * self.iterations.max(1) as u64
+    }
+}
+
+impl Default for Settings {
+    /// XPBD, edges + volume, rigid, 10 substeps of 1 iteration, Δt = 1/60 s, gravity 9.81 m/s²,
+    /// ground on, no damping.
+    fn default() -> Self {
+        Self {
+            method: Method::Xpbd,
+            active: PerFamily::from_fn(|f| f == Family::EDGES || f == Family::VOLUME),
+            compliance: PerFamily::splat(0.0),
+            stiffness: PerFamily::splat(1.0),
+            substeps: 10,
+            iterations: 1,
+            dt: 1.0 / 60.0,
+            gravity: 9.81,
+            ground: true,
+            damping: 0.0,
+            grab_compliance: 0.0,
+            settle_edits: false,
+        }
+    }
+}
+
+/// Stiffnesses as stored (the workbench's preferences): a family the stored map lacks keeps the
+/// default of 1, rather than 0, which would turn it off under PBD.
+fn stiffness_over_the_default<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<PerFamily<f64>, D::Error> {
+    PerFamily::deserialize_over(deserializer, PerFamily::splat(1.0))
+}
