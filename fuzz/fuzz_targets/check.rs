@@ -40,12 +40,9 @@ pub fn scene(scene: Scene) {
     let mut simulation = Simulation::new(&scene, Settings::default());
     Metrics::measure_sound(&simulation).expect("a loaded mesh is sound at rest");
     simulation.step();
-    assert!(
-        Metrics::measure(&simulation)
-            .all()
-            .iter()
-            .all(|(_, v)| !v.is_nan())
-    );
+    let metrics = Metrics::measure(&simulation);
+    assert!(metrics.headline().iter().all(|(_, v)| !v.is_nan()));
+    assert!(metrics.residual.iter().all(|(_, v)| !v.is_nan()));
 }
 
 /// A Gmsh file of version `format` (its `$MeshFormat` line) whose sections are `data`.
