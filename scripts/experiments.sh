@@ -72,3 +72,23 @@ header "10. One substep: more iterations instead of substeps (bunny flattened, g
 for ec in 0 0.1; do for i in 1 2 5 20; do
   row --scene $bunny --perturb flatten --gravity 10 --compliance edges=$ec --constraints edges,height,volume --substeps 1 --iterations $i
 done; done
+
+armadillo=../shared/meshes/armadillo_4k.node
+materials="edges,volume edges,height,volume neohookean neohookean,height"
+
+header "11. Inversion: the neo-Hookean family (E = 1 MPa, ν = 0.3, the default material) against the geometric ones, 30 substeps"
+for c in $materials; do row --scene cube --perturb mirror --constraints $c --substeps 30; done
+for c in $materials; do row --scene cube --perturb flatten --constraints $c --substeps 30; done
+for c in $materials; do row --scene $bunny --perturb flatten --gravity 10 --constraints $c --substeps 30; done
+for c in $materials; do row --scene $bunny --perturb mirror --gravity 10 --constraints $c --substeps 30; done
+for c in $materials; do row --scene $armadillo --gravity 10 --constraints $c --substeps 30 --frames 600; done
+
+header "12. How stiff a material the substeps allow: the cube at rest under gravity, neo-Hookean, 300 frames"
+for e in 1e6 1e7 1e8 1e9; do for s in 10 30 100; do
+  row --scene cube --constraints neohookean --material E=$e,nu=0.3 --substeps $s
+done; done
+
+header "13. Iterations and the stiffness a material shows: the cube damped to rest (damping 20), volume error = sag"
+for m in xpbd pbd; do for i in 1 4 16; do for e in 2.5e6 1e7; do
+  row --scene cube --constraints neohookean --material E=$e,nu=0.3 --damping 20 --solver $m --iterations $i
+done; done; done

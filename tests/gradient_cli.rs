@@ -292,9 +292,64 @@ fn check_gradients_reports_every_family_within_bound() {
         .iter()
         .map(|r| r["constraint"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["edges", "height", "volume"]);
+    assert_eq!(
+        names,
+        [
+            "edges",
+            "height",
+            "volume",
+            "neohookean-deviatoric",
+            "neohookean-hydrostatic"
+        ]
+    );
     for row in &rows {
         assert_eq!(row["compared"], 2000);
         assert!(row["max_relative_error"].as_f64().unwrap() <= 1e-6, "{row}");
     }
+}
+
+/// A neo-Hookean constraint reads its rest shape: the unit tet mirrored through the face
+/// (p0, p2, p3) has det F = −1, so C_H = √V₀ (−1) − rest.
+#[test]
+fn the_hydrostatic_constraint_of_a_mirrored_tet() {
+    let v = json(&[
+        "gradient",
+        "--constraint",
+        "neohookean-hydrostatic",
+        "--points",
+        "0,0,0",
+        "-1,0,0",
+        "0,1,0",
+        "0,0,1",
+        "--rest-shape",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0,0,1",
+        "--json",
+    ]);
+    let s = (1.0f64 / 6.0).sqrt();
+    assert!((v["value"].as_f64().unwrap() + s).abs() < 1e-15, "{v}");
+    assert!(v["max_abs_error"].as_f64().unwrap() < 1e-9);
+    let at_p1 = &vectors(&v["gradients"])[1];
+    assert!(
+        at_p1[0] > 0.0,
+        "cof F points p1 back through the face: {at_p1:?}"
+    );
+    let output = tetlab(&[
+        "gradient",
+        "--constraint",
+        "volume",
+        "--points",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0,0,1",
+        "--rest-shape",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0,0,1",
+    ]);
+    assert_usage_error(&output, "does not read a rest shape");
 }

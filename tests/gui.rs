@@ -261,6 +261,56 @@ fn dragging_a_particle_while_paused_moves_it() {
     );
 }
 
+/// The neo-Hookean pair is one checkbox with the material beside it; its arrows have the
+/// colours of the table; a mirrored cube recovers under it; a material too stiff for the
+/// substeps is named in the readouts.
+#[test]
+fn the_neo_hookean_family_is_switched_on_with_its_material() {
+    use tetlab_core::constraints::Family;
+    let mut harness = workbench("cube", 2);
+    for label in ["edges", "volume"] {
+        harness.get_all_by_label(label).next().unwrap().click();
+    }
+    harness
+        .get_all_by_label("neo-Hookean")
+        .next()
+        .unwrap()
+        .click();
+    harness.run_steps(2);
+    let settings = *harness.state().bench.simulation.settings();
+    assert_eq!(settings.active.describe(), "neohookean");
+    assert!(harness.state().bench.stability_warning.is_none());
+    // At rest ∇C_H = √3 ∇C_D: the hydrostatic arrows cover the deviatoric ones.
+    let colour = |family| visual::family_colour(family);
+    assert!(pixels_like(&mut harness, colour(Family::NEOHOOKEAN_HYDROSTATIC)) > 20);
+    harness.key_press(egui::Key::M);
+    harness.run_steps(1);
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 48);
+    // Mirrored, cof F = −F: the two point opposite ways, and both show.
+    harness.snapshot("neohookean_mirrored");
+    for family in [
+        Family::NEOHOOKEAN_DEVIATORIC,
+        Family::NEOHOOKEAN_HYDROSTATIC,
+    ] {
+        assert!(
+            pixels_like(&mut harness, colour(family)) > 20,
+            "{family:?} arrows"
+        );
+    }
+    harness.key_press(egui::Key::Space);
+    harness.run_steps(60);
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 0, "recovered");
+    // Steel in ten substeps: the readouts say how many it needs.
+    let mut steel = settings;
+    steel.set_material(tetlab_core::material::Material {
+        young: 2e11,
+        poisson: 0.3,
+    });
+    harness.state_mut().set_settings(steel);
+    harness.run_steps(1);
+    harness.get_by_label_contains("needs at least");
+}
+
 #[test]
 fn the_controls_switch_solver_and_families() {
     let mut harness = workbench("cube", 2);

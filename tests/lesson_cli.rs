@@ -19,7 +19,7 @@ fn the_built_in_lessons_are_listed_and_observe_what_they_say() {
     let list = tetlab(&["lesson", "--list"]);
     assert!(list.status.success());
     let text = stdout(&list);
-    assert_eq!(text.lines().count(), 6, "{text}");
+    assert_eq!(text.lines().count(), 7, "{text}");
     assert!(text.contains("02-edges-cannot-uninvert.toml"));
 
     let output = tetlab(&["lesson", "2"]);
@@ -64,7 +64,7 @@ fn mistakes_in_a_lesson_file_name_the_file_and_line() {
     .unwrap();
     let line = assert_usage_error(&tetlab(&["lesson", path.to_str().unwrap()]), "typo.toml:5:");
     assert!(line.contains("'mirorr' is not an action"), "{line}");
-    assert_usage_error(&tetlab(&["lesson", "7"]), "no such lesson");
+    assert_usage_error(&tetlab(&["lesson", "8"]), "no such lesson");
     assert_usage_error(
         &tetlab(&["lesson", "/nonexistent.toml"]),
         "/nonexistent.toml",
@@ -91,4 +91,37 @@ fn a_recorded_lesson_holds_its_frames_its_text_and_the_comparison() {
         "the third step compares"
     );
     assert_eq!(entities["compare/metrics/inverted_tets"]["frame_rows"], 60);
+}
+
+/// A lesson's material is checked like `--material`, and named by file and line.
+#[test]
+fn a_bad_material_in_a_lesson_names_the_line() {
+    let dir = std::env::temp_dir().join(format!("tetlab-material-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("material.toml");
+    std::fs::write(
+        &path,
+        "title = \"m\"\nscene = \"tet\"\n\n[settings]\nconstraints = \"neohookean\"\nmaterial = \"E=1e6,nu=0.7\"\n\n[[step]]\ntext = \"x\"\n",
+    )
+    .unwrap();
+    let output = tetlab(&["lesson", path.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(
+        message.contains("material.toml:6") && message.contains("nu 0.7 is out of range"),
+        "{message}"
+    );
+    std::fs::write(
+        &path,
+        "title = \"m\"\nscene = \"tet\"\n\n[settings]\ncompliance = { neohookean-deviatoric = 1.0 }\n\n[[step]]\ntext = \"x\"\n",
+    )
+    .unwrap();
+    let output = tetlab(&["lesson", path.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("material.toml:5"),
+        "{}",
+        stderr(&output)
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -245,3 +245,91 @@ fn the_bipyramid_asset_inverts_one_tet_through_the_shared_face_and_recovers() {
     );
     assert!(text.contains("no inverted tets from frame"), "{text}");
 }
+
+/// The neo-Hookean family from the command line: one name for both constraints, its material in
+/// Pa, what it measures, and every wrong way to give it.
+#[test]
+fn the_neo_hookean_family_takes_a_material_in_physical_units() {
+    let lines = json_lines(&[
+        "run",
+        "--scene",
+        "cube",
+        "--perturb",
+        "mirror",
+        "--constraints",
+        "neohookean",
+        "--material",
+        "nu=0.3, E=2e6",
+        "--substeps",
+        "20",
+        "--frames",
+        "120",
+        "--json",
+    ]);
+    let last = lines.last().unwrap();
+    assert_eq!(last["inverted_tets"], 0, "the mirrored cube recovers");
+    for key in [
+        "residual_neohookean-deviatoric",
+        "residual_neohookean-hydrostatic",
+    ] {
+        assert!(last[key].as_f64().unwrap().is_finite(), "{key} in {last}");
+    }
+    let summary = tetlab(&["run", "--constraints", "neohookean", "--frames", "1"]);
+    assert!(summary.status.success());
+    assert!(
+        stdout(&summary).contains("neohookean")
+            && stdout(&summary).contains("material E=1e6,nu=0.3"),
+        "{}",
+        stdout(&summary)
+    );
+    for (material, says) in [
+        ("E=1e6,nu=0.5", "nu 0.5 is out of range"),
+        ("E=0,nu=0.3", "E 0 is out of range"),
+        ("E=NaN,nu=0.3", "E NaN is not a number"),
+        ("E=1e6", "nu is missing"),
+        ("E=1e6,nu=0.3,rho=1000", "unknown material parameter 'rho'"),
+        ("stiff", "'stiff' is not KEY=VALUE"),
+    ] {
+        let output = tetlab(&["run", "--material", material]);
+        assert_usage_error(&output, "--material");
+        assert!(
+            stderr(&output).contains(says),
+            "{material}: {}",
+            stderr(&output)
+        );
+    }
+    assert_usage_error(
+        &tetlab(&["run", "--compliance", "neohookean=1e-6"]),
+        "take their compliance from the material",
+    );
+    assert_usage_error(
+        &tetlab(&["run", "--constraints", "edges,hydrostatic"]),
+        "one of the constraints of neohookean",
+    );
+}
+
+/// A material too stiff for the substeps is named, with how many it needs.
+#[test]
+fn a_material_too_stiff_for_the_substeps_is_warned_about() {
+    let args = [
+        "run",
+        "--scene",
+        "cube",
+        "--constraints",
+        "neohookean",
+        "--frames",
+        "1",
+    ];
+    let steel = [&args[..], &["--material", "E=2e11,nu=0.3"]].concat();
+    let output = tetlab(&steel);
+    assert!(output.status.success());
+    assert!(
+        stderr(&output).contains("warning: neohookean with material E=2e11,nu=0.3 needs at least"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(
+        !stderr(&tetlab(&args)).contains("warning"),
+        "rubber at 10 substeps"
+    );
+}

@@ -31,6 +31,7 @@
 use crate::constraints::{Family, PerFamily};
 use crate::divergence::Divergence;
 use crate::limits::{self, Bounds};
+use crate::material::Material;
 use crate::metrics::Metrics;
 use crate::scene::{Perturbation, Scene, SceneError, reflect_through_opposite_face};
 use crate::solver::{Method, Settings, Simulation};
@@ -377,6 +378,7 @@ struct RawSettings {
     gravity: Option<Spanned<f64>>,
     damping: Option<Spanned<f64>>,
     settle_edits: Option<bool>,
+    material: Option<Spanned<String>>,
     #[serde(default)]
     compliance: BTreeMap<String, Spanned<f64>>,
     #[serde(default)]
@@ -553,6 +555,15 @@ impl Lesson {
             settings.damping = d;
         }
         settings.settle_edits = s.settle_edits.unwrap_or(settings.settle_edits);
+        if let Some(material) = &s.material {
+            let material = Material::parse(material.get_ref()).map_err(|e| {
+                error(
+                    Some(material.span()),
+                    format!("in [settings] material: {e}"),
+                )
+            })?;
+            settings.set_material(material);
+        }
         for (table, bounds, values, per_family) in [
             (
                 "compliance",
@@ -568,7 +579,7 @@ impl Lesson {
             ),
         ] {
             for (name, value) in values {
-                let family = Family::parse(name).map_err(at(value.span()))?;
+                let family = limits::settable_family(name).map_err(at(value.span()))?;
                 let v = bounds.check(*value.get_ref()).map_err(|e| {
                     error(
                         Some(value.span()),

@@ -27,6 +27,7 @@ mod integrate;
 pub mod lanes;
 pub mod lesson;
 pub mod limits;
+pub mod material;
 pub mod mesh;
 pub mod metrics;
 pub mod projection;

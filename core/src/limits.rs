@@ -204,7 +204,24 @@ pub fn family_value(text: &str, bounds: &Bounds<f64>) -> Result<(Family, f64), S
     let (name, value) = text
         .split_once('=')
         .ok_or_else(|| format!("'{text}' is not FAMILY=VALUE (e.g. edges=1e-6)"))?;
-    Ok((Family::parse(name)?, bounds.parse(value)?))
+    let family = settable_family(name)?;
+    Ok((family, bounds.parse(value)?))
+}
+
+/// The family whose compliance or stiffness a user sets by `name` (`--compliance NAME=…`, a
+/// lesson's `compliance.NAME`): one that stands on its own and whose compliance no material
+/// gives.
+pub fn settable_family(name: &str) -> Result<Family, String> {
+    let members = crate::constraints::PerFamily::parse_group(name)?;
+    let family = members.families().next().expect("a group has a family");
+    if family.row().compliance_from_material.is_some() {
+        return Err(format!(
+            "{}: its constraints take their compliance from the material: give --material \
+             E=PA,nu=N (or material = \"E=…,nu=…\" in a lesson)",
+            family.row().group
+        ));
+    }
+    Ok(family)
 }
 
 /// A coordinate of a mesh, if its size is at most [`MAX_COORDINATE`]; otherwise why not.

@@ -4,7 +4,10 @@
 //! Projecting one constraint C with particles i, gradients ∇ᵢC and inverse masses wᵢ:
 //! - XPBD: α̃ = α / h², Δλ = (−C − α̃ λ) / (Σ wᵢ|∇ᵢC|² + α̃), λ += Δλ, Δxᵢ = wᵢ ∇ᵢC Δλ;
 //! - PBD: s = −C / Σ wᵢ|∇ᵢC|², Δxᵢ = k′ s wᵢ ∇ᵢC with k′ = 1 − (1 − k)^(1/iterations), so that
-//!   `iterations` sweeps of stiffness k′ compound to k.
+//!   `iterations` sweeps of stiffness k′ compound to k;
+//! - PBD on a family whose compliance a material gives (the neo-Hookean pair, which has no
+//!   stiffness k): Δλ = −C / (Σ wᵢ|∇ᵢC|² + α̃) in every sweep, XPBD without the multiplier's
+//!   memory, so that more sweeps make the material stiffer, as in PBD.
 //!
 //! A constraint is skipped (no correction) where its evaluation is degenerate (undefined ∇C),
 //! where every particle is fixed, and where it is [`LOCKED`].
@@ -36,6 +39,11 @@ pub enum Rule<R> {
         /// k′ = 1 − (1 − k)^(1/iterations).
         k: R,
     },
+    /// PBD with a compliance: each sweep starts from λ = 0.
+    CompliantPbd {
+        /// α̃ = α / h².
+        alpha_tilde: R,
+    },
 }
 
 impl Rule<f64> {
@@ -44,6 +52,9 @@ impl Rule<f64> {
     pub fn for_settings(settings: &Settings, family: Family, h: f64) -> Rule<f64> {
         match settings.method {
             Method::Xpbd => Rule::Xpbd {
+                alpha_tilde: settings.compliance[family] / (h * h),
+            },
+            Method::Pbd if family.row().compliance_from_material.is_some() => Rule::CompliantPbd {
                 alpha_tilde: settings.compliance[family] / (h * h),
             },
             Method::Pbd => {
@@ -63,6 +74,9 @@ impl Rule<f64> {
                 alpha_tilde: R::from_f64(alpha_tilde),
             },
             Rule::Pbd { k } => Rule::Pbd { k: R::from_f64(k) },
+            Rule::CompliantPbd { alpha_tilde } => Rule::CompliantPbd {
+                alpha_tilde: R::from_f64(alpha_tilde),
+            },
         }
     }
 }
@@ -96,24 +110,13 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
     lambda: V::Real,
     rule: Rule<V::Real>,
 ) -> (<V::Real as Real>::Mask, Correction<N, V>) {
-    // Σ wᵢ|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
-    let mut weighted_norm = V::Real::ZERO;
-    let mut norm = V::Real::ZERO;
-    let mut heaviest = V::Real::ZERO;
-    for (w, g) in weights.iter().zip(&evaluation.gradients) {
-        let squared = g.length_squared();
-        weighted_norm += *w * squared;
-        norm += squared;
-        heaviest = V::Real::select(w.gt(heaviest), *w, heaviest);
-    }
-    let locked = weighted_norm.le(V::Real::from_f64(LOCKED) * heaviest * norm);
-    let skipped =
-        evaluation.degenerate | !weighted_norm.gt(V::Real::ZERO) | !weighted_norm.finite() | locked;
+    let (skipped, weighted_norm) = skipped_lanes(&evaluation, &weights);
     let delta_lambda = match rule {
         Rule::Xpbd { alpha_tilde } => {
             (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
         }
         Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
+        Rule::CompliantPbd { alpha_tilde } => -evaluation.value / (weighted_norm + alpha_tilde),
     };
     let delta_lambda = V::Real::select(skipped, V::Real::ZERO, delta_lambda);
     let mut delta_x = [V::ZERO; N];
@@ -127,6 +130,102 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
             delta_x,
         },
     )
+}
+
+/// Whether a projection skips the constraint (degenerate, every particle fixed, or [`LOCKED`]),
+/// and Σ wᵢ|∇ᵢC|².
+#[inline(always)]
+fn skipped_lanes<V: Vector3, const N: usize>(
+    evaluation: &Evaluation<V, N>,
+    weights: &[V::Real; N],
+) -> (<V::Real as Real>::Mask, V::Real) {
+    // Σ wᵢ|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
+    let mut weighted_norm = V::Real::ZERO;
+    let mut norm = V::Real::ZERO;
+    let mut heaviest = V::Real::ZERO;
+    for (w, g) in weights.iter().zip(&evaluation.gradients) {
+        let squared = g.length_squared();
+        weighted_norm += *w * squared;
+        norm += squared;
+        heaviest = V::Real::select(w.gt(heaviest), *w, heaviest);
+    }
+    let locked = weighted_norm.le(V::Real::from_f64(LOCKED) * heaviest * norm);
+    let skipped =
+        evaluation.degenerate | !weighted_norm.gt(V::Real::ZERO) | !weighted_norm.finite() | locked;
+    (skipped, weighted_norm)
+}
+
+/// What projecting two constraints of the same particles together makes: Δλ of each and the
+/// particles' Δx.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairCorrection<const N: usize, V: Vector3 = DVec3> {
+    /// Δλ of the first and of the second constraint (0 for one that is skipped).
+    pub delta_lambda: [V::Real; 2],
+    /// Δx for each particle.
+    pub delta_x: [V; N],
+}
+
+/// Two constraints on the same particles projected together (the neo-Hookean pair, whose two
+/// constraints pull against each other at rest): with gᵃ, gᵇ their gradients, W the inverse
+/// masses and α̃ each one's compliance / h², Δλ solves the 2 × 2 system
+///
+/// ⎡gᵃ·W gᵃ + α̃ᵃ   gᵃ·W gᵇ     ⎤ ⎡Δλᵃ⎤   ⎡−Cᵃ − α̃ᵃ λᵃ⎤
+/// ⎣gᵇ·W gᵃ        gᵇ·W gᵇ + α̃ᵇ⎦ ⎣Δλᵇ⎦ = ⎣−Cᵇ − α̃ᵇ λᵇ⎦,   Δxᵢ = wᵢ (gᵃᵢ Δλᵃ + gᵇᵢ Δλᵇ),
+///
+/// where projecting them one after the other would let the first undo itself fully before the
+/// second answers (a stiff material's deviatoric constraint then squashes each tet). A
+/// constraint that [`correction_lanes`] would skip takes no part; under PBD (no multiplier's
+/// memory) λ counts as 0. The diagonal gains ε (a + b) so that the system stays solvable when
+/// the gradients are parallel and the compliances nearly 0 (a tet at rest).
+#[inline(always)]
+pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
+    first: Evaluation<V, N>,
+    second: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: [V::Real; 2],
+    rules: [Rule<V::Real>; 2],
+) -> PairCorrection<N, V> {
+    let zero = V::Real::ZERO;
+    let one = V::Real::ONE;
+    let part = |e: &Evaluation<V, N>, lambda: V::Real, rule: Rule<V::Real>| {
+        let (skipped, weighted_norm) = skipped_lanes(e, &weights);
+        let (alpha, rhs) = match rule {
+            Rule::Xpbd { alpha_tilde } => (alpha_tilde, -e.value - alpha_tilde * lambda),
+            Rule::CompliantPbd { alpha_tilde } => (alpha_tilde, -e.value),
+            Rule::Pbd { k } => (zero, -(k * e.value)),
+        };
+        let mut gradients = [V::ZERO; N];
+        for (g, &kept) in gradients.iter_mut().zip(&e.gradients) {
+            *g = V::select(skipped, V::ZERO, kept);
+        }
+        let diagonal = V::Real::select(skipped, one, weighted_norm + alpha);
+        (
+            skipped,
+            gradients,
+            diagonal,
+            V::Real::select(skipped, zero, rhs),
+        )
+    };
+    let (skip_a, ga, mut a, rhs_a) = part(&first, lambda[0], rules[0]);
+    let (skip_b, gb, mut b, rhs_b) = part(&second, lambda[1], rules[1]);
+    let mut ab = zero;
+    for k in 0..N {
+        ab += weights[k] * ga[k].dot(gb[k]);
+    }
+    let ridge = V::Real::EPSILON * (a + b);
+    a += ridge;
+    b += ridge;
+    let det = a * b - ab * ab;
+    let delta_a = V::Real::select(skip_a, zero, (b * rhs_a - ab * rhs_b) / det);
+    let delta_b = V::Real::select(skip_b, zero, (a * rhs_b - ab * rhs_a) / det);
+    let mut delta_x = [V::ZERO; N];
+    for k in 0..N {
+        delta_x[k] = (ga[k] * delta_a + gb[k] * delta_b) * weights[k];
+    }
+    PairCorrection {
+        delta_lambda: [delta_a, delta_b],
+        delta_x,
+    }
 }
 
 /// One rigid XPBD projection of a constraint at `points` with rest value `rest` and inverse

@@ -202,7 +202,7 @@ mod tests {
                     Advanced::BeganSubstep => panic!("one substep only"),
                 }
             }
-            let per_sweep: usize = Family::all().map(|f| whole.constraint_count(f)).sum();
+            let per_sweep = whole.projection_order().count();
             assert_eq!((sweeps, projections), (2, 2 * per_sweep), "{method:?}");
             assert_eq!(stepper, StepByStep::BetweenSubsteps);
             assert_eq!(whole.positions(), stepped.positions(), "{method:?}");

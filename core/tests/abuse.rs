@@ -27,10 +27,11 @@ use glam::DVec3;
 use tetlab_core::constraints::Family;
 use tetlab_core::fast::FastSimulation;
 use tetlab_core::limits::{self, Bounds};
+use tetlab_core::material::{self, Material};
 use tetlab_core::metrics::Metrics;
 use tetlab_core::random::SplitMix64;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
-use tetlab_core::solver::{Method, Settings, Simulation};
+use tetlab_core::solver::{DENSITY, Method, Settings, Simulation};
 
 /// Frames per engine.
 const FRAMES: usize = 10_000;
@@ -91,7 +92,7 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
     };
     settings.set_gravity(gravity);
     settings.ground = settings.ground && !rng.next_u64().is_multiple_of(4);
-    for family in Family::all() {
+    for family in Family::all().filter(|f| f.row().compliance_from_material.is_none()) {
         settings
             .active
             .set(family, !rng.next_u64().is_multiple_of(3));
@@ -103,6 +104,30 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
         settings.compliance.set(family, alpha);
         settings.stiffness.set(family, rng.next_f64());
     }
+    // The families a material describes: on or off together, as the command line and the
+    // workbench have them, with any material in range.
+    let on = !rng.next_u64().is_multiple_of(3);
+    for family in Family::all().filter(|f| f.row().compliance_from_material.is_some()) {
+        settings.active.set(family, on);
+    }
+    // Within the material's documented stable range (Material::substeps_needed) on the
+    // arena's cube.
+    let poisson = rng.range(0.0, material::MAX_POISSON);
+    let h = settings.dt / settings.substeps as f64;
+    let unit = Material {
+        young: 1.0,
+        poisson,
+    };
+    let edge = Simulation::new(&cube(), Settings::default()).shortest_edge();
+    let stiffest = (material::STABLE_COURANT * edge / h / unit.wave_speed(DENSITY)).powi(2);
+    let bounds = Bounds {
+        max: stiffest.clamp(material::YOUNG.min, material::YOUNG.max),
+        ..material::YOUNG
+    };
+    settings.set_material(Material {
+        young: log_uniform(rng, &bounds, bounds.min),
+        poisson,
+    });
     settings.check().expect("drawn within the limits");
     settings
 }

@@ -86,7 +86,26 @@ struct Report {
     /// How the fast solver's SIMD lanes are held on this build.
     lanes: Option<String>,
     /// After the run, per active family: √(mean (C / rest value)²).
+    #[serde(serialize_with = "active_only")]
     relative_error: Option<PerFamily<Option<f64>>>,
+}
+
+/// A map of the families that have a value (the active ones), so that none is written `null`.
+fn active_only<S: serde::Serializer>(
+    values: &Option<PerFamily<Option<f64>>>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let Some(values) = values else {
+        return serializer.serialize_none();
+    };
+    let mut map = serializer.serialize_map(None)?;
+    for (family, value) in values.iter() {
+        if let Some(value) = value {
+            map.serialize_entry(family.name(), &value)?;
+        }
+    }
+    map.end()
 }
 
 /// Runs the benchmark and prints the report.
@@ -95,6 +114,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         .map_err(|e| UsageError(format!("--scene: {e}")))?;
     let settings = args.solver.settings();
     let mut simulation = Simulation::new(&scene, settings);
+    super::simulation_args::warn_if_unstable(&simulation);
     let report = if args.reference {
         time_reference(args, &scene, &mut simulation)?
     } else {

@@ -61,15 +61,16 @@ fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()>
          longest or (height) the face's edges meet at a sine below {CONDITIONING}",
         args.seed
     )?;
+    let w = rows.iter().map(|r| r.constraint.len()).max().unwrap_or(0) + 2;
     writeln!(
         out,
-        "{:<10}{:>10}{:>10}{:>22}{:>22}",
+        "{:<w$}{:>10}{:>10}{:>22}{:>22}",
         "family", "compared", "skipped", "max relative error", "mean relative error"
     )?;
     for r in rows {
         writeln!(
             out,
-            "{:<10}{:>10}{:>10}{:>22.3e}{:>22.3e}",
+            "{:<w$}{:>10}{:>10}{:>22.3e}{:>22.3e}",
             r.constraint,
             r.compared,
             r.skipped_near_degenerate,

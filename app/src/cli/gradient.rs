@@ -17,6 +17,10 @@ pub struct Args {
     /// The particles in the constraint's order, each X,Y,Z; negative numbers are fine.
     #[arg(long, value_name = "X,Y,Z", num_args = 1.., required = true, value_parser = args::point)]
     points: Vec<DVec3>,
+    /// The particles at rest, for a family that reads its rest shape (the neo-Hookean pair:
+    /// F = Ds Dm⁻¹); the same number as --points. Without it, the rest shape is --points (F = I).
+    #[arg(long, value_name = "X,Y,Z", num_args = 1.., value_parser = args::point)]
+    rest_shape: Vec<DVec3>,
     /// The rest value: distance d, signed height d or signed volume V.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = args::finite_number)]
     rest: f64,
@@ -48,8 +52,24 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             args.points.len()
         )));
     }
-    let evaluation = family.evaluate(&args.points, args.rest, &args.points);
-    let (analytic, numeric) = analytic_and_numeric(family, &args.points, args.rest, &args.points);
+    let rest_shape = if args.rest_shape.is_empty() {
+        &args.points
+    } else if !family.uses_rest_shape() {
+        return Err(UsageError(format!(
+            "--rest-shape: the {} constraint does not read a rest shape",
+            family.name()
+        )));
+    } else if args.rest_shape.len() != args.points.len() {
+        return Err(UsageError(format!(
+            "--rest-shape: {} points, as many as --points ({})",
+            args.rest_shape.len(),
+            args.points.len()
+        )));
+    } else {
+        &args.rest_shape
+    };
+    let evaluation = family.evaluate(&args.points, args.rest, rest_shape);
+    let (analytic, numeric) = analytic_and_numeric(family, &args.points, args.rest, rest_shape);
     let output = Output {
         constraint: family.name(),
         value: evaluation.value,

@@ -29,16 +29,24 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         None => writeln!(out, "{}: no frames", args.file.display()),
     }
     .map_err(io)?;
+    let w = summary
+        .entities
+        .keys()
+        .map(|p| p.len())
+        .max()
+        .unwrap_or(0)
+        .max(24)
+        + 2;
     writeln!(
         out,
-        "{:<26}{:>7}{:>7}  components (static | per frame)",
+        "{:<w$}{:>7}{:>7}  components (static | per frame)",
         "entity", "static", "frames"
     )
     .map_err(io)?;
     for (path, e) in &summary.entities {
         writeln!(
             out,
-            "{path:<26}{:>7}{:>7}  {} | {}",
+            "{path:<w$}{:>7}{:>7}  {} | {}",
             e.static_rows,
             e.frame_rows,
             e.static_components.join(", "),

@@ -74,6 +74,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     let spec = args.lesson.as_deref().expect("clap requires a lesson");
     let lesson = Lesson::find(spec).map_err(|e| UsageError(e.to_string()))?;
     let mut run = LessonRun::new(&lesson);
+    super::simulation_args::warn_if_unstable(&run.simulation);
     let frames: u64 = lesson.steps.iter().map(|s| s.frames).sum();
     let compares = lesson
         .steps

@@ -5,6 +5,7 @@ use super::UsageError;
 use tetlab_core::constraints::Family;
 use tetlab_core::constraints::PerFamily;
 use tetlab_core::limits::{self, Number};
+use tetlab_core::material::Material;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
 use tetlab_core::solver::{Method, Settings, Simulation};
@@ -39,7 +40,7 @@ pub struct SimulationArgs {
 /// ([`Settings::set_gravity`]).
 #[derive(Debug, Clone, clap::Args)]
 pub struct SolverArgs {
-    /// Active constraint families, comma-separated: edges, height, volume.
+    /// Active constraint families, comma-separated: edges, height, volume, neohookean.
     #[arg(long, default_value = "edges,volume", value_parser = PerFamily::parse_list)]
     pub constraints: PerFamily<bool>,
     /// xpbd or pbd.
@@ -67,6 +68,11 @@ pub struct SolverArgs {
     /// Velocity damping per second (0..=1e6).
     #[arg(long, default_value_t = 0.0, value_parser = |s: &str| limits::DAMPING.parse(s), allow_hyphen_values = true)]
     pub damping: f64,
+    /// The material of the neohookean family: Young's modulus E in Pa (1e-3..=1e13) and
+    /// Poisson's ratio nu (0 <= nu < 0.5), both required; gives its compliances 1/μ and 1/λ
+    /// [default: E=1e6,nu=0.3].
+    #[arg(long, value_name = "E=PA,nu=N", value_parser = Material::parse)]
+    pub material: Option<Material>,
 }
 
 impl SolverArgs {
@@ -82,6 +88,9 @@ impl SolverArgs {
             ..Settings::default()
         };
         settings.set_gravity(self.gravity);
+        if let Some(material) = self.material {
+            settings.set_material(material);
+        }
         for &(family, alpha) in &self.compliance {
             settings.compliance.set(family, alpha);
         }
@@ -111,6 +120,13 @@ impl SolverArgs {
         for (family, k) in &self.stiffness {
             text += &format!(", stiffness {}={k}", family.name());
         }
+        let uses_material = s
+            .active
+            .families()
+            .any(|f| f.row().compliance_from_material.is_some());
+        if uses_material || self.material.is_some() {
+            text += &format!(", material {}", s.material.describe());
+        }
         text
     }
 }
@@ -136,6 +152,7 @@ impl SimulationArgs {
         let scene = Scene::from_spec(&self.scene, self.resolution)
             .map_err(|e| UsageError(format!("--scene: {e}")))?;
         let mut simulation = Simulation::new(&scene, self.settings());
+        warn_if_unstable(&simulation);
         if let Some(perturbation) = self.perturb {
             simulation.perturb(perturbation);
         }
@@ -149,5 +166,12 @@ impl SimulationArgs {
             text += ", settle edits";
         }
         text
+    }
+}
+
+/// Prints [`Simulation::stability_warning`] on stderr, if there is one.
+pub fn warn_if_unstable(simulation: &Simulation) {
+    if let Some(warning) = simulation.stability_warning() {
+        eprintln!("warning: {warning}");
     }
 }

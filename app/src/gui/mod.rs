@@ -172,7 +172,8 @@ impl TetlabApp {
             comparison: None,
             classroom: false,
             lesson_path: String::new(),
-            compare_families: PerFamily::splat(true),
+            // The geometric families: the material ones are another model, added by choice.
+            compare_families: PerFamily::from_fn(|f| f.row().compliance_from_material.is_none()),
             frames_drawn: 0,
             #[cfg(target_arch = "wasm32")]
             inbox: files::Inbox::default(),

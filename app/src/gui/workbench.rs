@@ -49,6 +49,9 @@ pub struct Workbench {
     pub last_advance: Option<Advanced>,
     /// The simulation diverged (and was put back at rest): why, until the app shows it.
     pub diverged: Option<Divergence>,
+    /// Why the settings may blow up ([`Simulation::stability_warning`]), as of the last change
+    /// of settings.
+    pub stability_warning: Option<String>,
 }
 
 impl Workbench {
@@ -56,6 +59,7 @@ impl Workbench {
     pub fn new(scene: Scene, settings: Settings) -> Self {
         let simulation = Simulation::new(&scene, settings);
         let mut workbench = Workbench {
+            stability_warning: simulation.stability_warning(),
             scene,
             metrics: Metrics::measure(&simulation),
             simulation,
@@ -306,6 +310,7 @@ impl Workbench {
             self.finish_substep();
         }
         self.simulation.set_settings(settings);
+        self.stability_warning = self.simulation.stability_warning();
         self.after_change();
     }
 

@@ -7,7 +7,9 @@
 //!
 //! Per-family data has one shape, [`PerFamily`], indexed by [`Family`].
 
+use super::neohookean::{Deviatoric, Hydrostatic};
 use super::{Constraint, Evaluation, distance::Distance, height::Height, volume::Volume};
+use crate::material::Material;
 use crate::mesh::{TET_EDGES, TetMesh};
 use glam::DVec3;
 use std::fmt;
@@ -58,6 +60,16 @@ pub struct Row {
     /// leaves out random configurations where that face is nearly a line (the height's gradient
     /// grows without bound there).
     pub needs_face_p0_p2_p3: bool,
+    /// The name of the group it belongs to on the command line and in the workbench: its own
+    /// name, or that of the families it comes with (`neohookean` names both neo-Hookean ones).
+    pub group: &'static str,
+    /// Its XPBD compliance, when a [`Material`] gives it (per unit rest volume: the constraint is
+    /// scaled by √V₀); otherwise the compliance is set per family.
+    pub compliance_from_material: Option<fn(&Material) -> f64>,
+    /// The family its constraints are projected together with, constraint by constraint (the
+    /// same binding, so constraint c of each has the same particles), when both are active:
+    /// [`crate::projection::pair_correction_lanes`]. The first of the two in the table leads.
+    pub projected_with: Option<Family>,
     kind: Kind,
 }
 
@@ -67,10 +79,12 @@ enum Kind {
     Distance,
     Height,
     Volume,
+    Deviatoric,
+    Hydrostatic,
 }
 
-/// The families, in projection order (edges, then heights, then volumes).
-pub static TABLE: [Row; 3] = [
+/// The families, in projection order (edges, heights, volumes, then the neo-Hookean pair).
+pub static TABLE: [Row; 5] = [
     Row {
         name: "edges",
         aliases: &["edge", "distance"],
@@ -82,6 +96,9 @@ pub static TABLE: [Row; 3] = [
         arity: 2,
         binding: Binding::Edges,
         needs_face_p0_p2_p3: false,
+        group: "edges",
+        compliance_from_material: None,
+        projected_with: None,
         kind: Kind::Distance,
     },
     Row {
@@ -95,6 +112,9 @@ pub static TABLE: [Row; 3] = [
         arity: 4,
         binding: Binding::TetVertices,
         needs_face_p0_p2_p3: true,
+        group: "height",
+        compliance_from_material: None,
+        projected_with: None,
         kind: Kind::Height,
     },
     Row {
@@ -108,7 +128,42 @@ pub static TABLE: [Row; 3] = [
         arity: 4,
         binding: Binding::Tets,
         needs_face_p0_p2_p3: false,
+        group: "volume",
+        compliance_from_material: None,
+        projected_with: None,
         kind: Kind::Volume,
+    },
+    Row {
+        name: "neohookean-deviatoric",
+        aliases: &["deviatoric"],
+        title: "Neo-Hookean, deviatoric",
+        label: "neo-Hookean dev.",
+        colour: [160, 95, 40, 255],
+        formula: super::neohookean::DEVIATORIC_FORMULA,
+        rest_symbol: "0",
+        arity: 4,
+        binding: Binding::Tets,
+        needs_face_p0_p2_p3: false,
+        group: "neohookean",
+        compliance_from_material: Some(|m| 1.0 / m.mu()),
+        projected_with: Some(Family::NEOHOOKEAN_HYDROSTATIC),
+        kind: Kind::Deviatoric,
+    },
+    Row {
+        name: "neohookean-hydrostatic",
+        aliases: &["hydrostatic"],
+        title: "Neo-Hookean, hydrostatic",
+        label: "neo-Hookean hyd.",
+        colour: [135, 80, 225, 255],
+        formula: super::neohookean::HYDROSTATIC_FORMULA,
+        rest_symbol: "s γ",
+        arity: 4,
+        binding: Binding::Tets,
+        needs_face_p0_p2_p3: false,
+        group: "neohookean",
+        compliance_from_material: Some(|m| 1.0 / m.lambda()),
+        projected_with: Some(Family::NEOHOOKEAN_DEVIATORIC),
+        kind: Kind::Hydrostatic,
     },
 ];
 
@@ -125,6 +180,19 @@ pub trait Visit {
     ) -> Self::Output;
 }
 
+/// Code that works on the constraints of two families together (a pair projected as one,
+/// [`Row::projected_with`]) with both [`Constraint`] types known at compile time.
+pub trait VisitPair {
+    /// What the visit gives.
+    type Output;
+    /// Works on the pair: `first` and `second` evaluate the constraints of each family.
+    fn visit_pair<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
+        self,
+        first: &A,
+        second: &B,
+    ) -> Self::Output;
+}
+
 impl Family {
     /// Edge distance ([`super::distance`]).
     pub const EDGES: Family = Family(0);
@@ -132,6 +200,10 @@ impl Family {
     pub const HEIGHT: Family = Family(1);
     /// Signed volume ([`super::volume`]).
     pub const VOLUME: Family = Family(2);
+    /// The deviatoric half of a neo-Hookean tet ([`super::neohookean`]).
+    pub const NEOHOOKEAN_DEVIATORIC: Family = Family(3);
+    /// The hydrostatic half of a neo-Hookean tet ([`super::neohookean`]).
+    pub const NEOHOOKEAN_HYDROSTATIC: Family = Family(4);
 
     /// Every family of the table, in projection order.
     pub fn all() -> impl DoubleEndedIterator<Item = Family> + Clone {
@@ -178,6 +250,12 @@ impl Family {
             .find(|f| f.name() == text || f.row().aliases.contains(&text))
             .ok_or_else(|| {
                 let names: Vec<&str> = Family::all().map(Family::name).collect();
+                if Family::groups().any(|(group, _)| group == text) {
+                    return format!(
+                        "'{text}' names several families here: give one of {}",
+                        names.join(", ")
+                    );
+                }
                 format!(
                     "'{text}' is not a constraint family: expected {}",
                     names.join(", ")
@@ -192,7 +270,41 @@ impl Family {
             Kind::Distance => visitor.visit(self, &Distance),
             Kind::Height => visitor.visit(self, &Height),
             Kind::Volume => visitor.visit(self, &Volume),
+            Kind::Deviatoric => visitor.visit(self, &Deviatoric),
+            Kind::Hydrostatic => visitor.visit(self, &Hydrostatic),
         }
+    }
+
+    /// Calls `visitor` with this family's [`Constraint`] type and `second`'s (two nested
+    /// [`Family::visit`]s).
+    #[inline]
+    pub fn visit_pair<W: VisitPair>(self, second: Family, visitor: W) -> W::Output {
+        struct Outer<W> {
+            second: Family,
+            visitor: W,
+        }
+        struct Inner<'c, W, A, const N: usize> {
+            visitor: W,
+            first: &'c A,
+        }
+        impl<W: VisitPair, const N: usize, A: Constraint<N>> Visit for Inner<'_, W, A, N> {
+            type Output = W::Output;
+            #[inline]
+            fn visit<const M: usize, B: Constraint<M>>(self, _: Family, second: &B) -> W::Output {
+                self.visitor.visit_pair::<N, A, M, B>(self.first, second)
+            }
+        }
+        impl<W: VisitPair> Visit for Outer<W> {
+            type Output = W::Output;
+            #[inline]
+            fn visit<const N: usize, A: Constraint<N>>(self, _: Family, first: &A) -> W::Output {
+                self.second.visit(Inner::<W, A, N> {
+                    visitor: self.visitor,
+                    first,
+                })
+            }
+        }
+        self.visit(Outer { second, visitor })
     }
 
     /// C and ∇C in f64 at `points` (the family's arity of them), with rest value `rest` and the
@@ -243,12 +355,68 @@ impl Family {
         self.visit(Uses)
     }
 
-    /// The rest value (d, V) of a rest configuration: C there with rest value 0.
+    /// The rest value (d, V, …) of a rest configuration ([`Constraint::rest_value`]: C there
+    /// with rest value 0, unless the family says otherwise).
     ///
     /// # Panics
     /// If the number of points is not the family's arity.
-    pub fn rest_value(self, points: &[DVec3]) -> f64 {
-        self.evaluate(points, 0.0, points).value
+    pub fn rest_value(self, points: &[DVec3], material: &Material) -> f64 {
+        struct Rest<'a>(&'a [DVec3], &'a Material);
+        impl Visit for Rest<'_> {
+            type Output = f64;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> f64 {
+                let shape: [DVec3; N] = std::array::from_fn(|k| self.0[k]);
+                c.rest_value(&shape, self.1)
+            }
+        }
+        assert_eq!(
+            points.len(),
+            self.arity(),
+            "wrong number of points for {self:?}"
+        );
+        self.visit(Rest(points, material))
+    }
+
+    /// Among `active` families, the one this family is projected together with, if this one
+    /// leads the pair ([`Row::projected_with`]).
+    pub fn partner_in(self, active: &PerFamily<bool>) -> Option<Family> {
+        self.row()
+            .projected_with
+            .filter(|&partner| active[partner] && self < partner)
+    }
+
+    /// Whether, among `active` families, this one is projected by the family it is paired with
+    /// (which comes first in the table) rather than on its own.
+    pub fn projected_by_partner(self, active: &PerFamily<bool>) -> bool {
+        self.row()
+            .projected_with
+            .is_some_and(|partner| active[partner] && partner < self)
+    }
+
+    /// Whether its rest values depend on the material ([`Constraint::REST_USES_MATERIAL`]).
+    pub fn rest_uses_material(self) -> bool {
+        struct Uses;
+        impl Visit for Uses {
+            type Output = bool;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, _: &C) -> bool {
+                C::REST_USES_MATERIAL
+            }
+        }
+        self.visit(Uses)
+    }
+
+    /// The groups of families as the command line and the workbench show them, in table order:
+    /// each group's name and its families (`neohookean`: both neo-Hookean families).
+    pub fn groups() -> impl Iterator<Item = (&'static str, PerFamily<bool>)> {
+        let mut names: Vec<&'static str> = Vec::new();
+        for family in Family::all() {
+            if !names.contains(&family.row().group) {
+                names.push(family.row().group);
+            }
+        }
+        names
+            .into_iter()
+            .map(|name| (name, PerFamily::from_fn(|f| f.row().group == name)))
     }
 }
 
@@ -377,6 +545,24 @@ impl<T: Copy> PerFamily<T> {
     }
 }
 
+impl<T> PerFamily<T> {
+    /// The values of two different families, both mutable.
+    ///
+    /// # Panics
+    /// If `a` and `b` are the same family.
+    pub fn pair_mut(&mut self, a: Family, b: Family) -> (&mut T, &mut T) {
+        let (i, j) = (a.index(), b.index());
+        assert_ne!(i, j, "a pair of two different families");
+        if i < j {
+            let (low, high) = self.0.split_at_mut(j);
+            (&mut low[i], &mut high[0])
+        } else {
+            let (low, high) = self.0.split_at_mut(i);
+            (&mut high[0], &mut low[j])
+        }
+    }
+}
+
 impl<T> Index<Family> for PerFamily<T> {
     type Output = T;
     fn index(&self, family: Family) -> &T {
@@ -408,21 +594,60 @@ impl PerFamily<bool> {
     /// assert!(active[Family::EDGES] && active[Family::HEIGHT] && !active[Family::VOLUME]);
     /// assert_eq!(active.describe(), "edges+height");
     /// ```
+    ///
+    /// A group's name stands for all its families ([`Family::groups`]):
+    ///
+    /// ```
+    /// use tetlab_core::constraints::{Family, PerFamily};
+    /// let active = PerFamily::parse_list("edges,neohookean").unwrap();
+    /// assert!(active[Family::NEOHOOKEAN_DEVIATORIC] && active[Family::NEOHOOKEAN_HYDROSTATIC]);
+    /// assert_eq!(active.describe(), "edges+neohookean");
+    /// ```
     pub fn parse_list(text: &str) -> Result<PerFamily<bool>, String> {
         let mut active = PerFamily::splat(false);
         for name in text.split(',') {
-            active.set(Family::parse(name)?, true);
+            for family in PerFamily::parse_group(name)?.families() {
+                active.set(family, true);
+            }
         }
         Ok(active)
     }
 
-    /// The active families as `edges+height+volume`, or `none`.
+    /// The families one name stands for where families are switched on and set (lists,
+    /// `--compliance FAMILY=…`): a family of its own, by [`Family::parse`], or a group by its
+    /// name; a family that belongs to a larger group is not named on its own.
+    ///
+    /// ```
+    /// use tetlab_core::constraints::{Family, PerFamily};
+    /// assert!(PerFamily::parse_group("neohookean").unwrap()[Family::NEOHOOKEAN_HYDROSTATIC]);
+    /// assert!(PerFamily::parse_group("hydrostatic").unwrap_err().contains("neohookean"));
+    /// ```
+    pub fn parse_group(name: &str) -> Result<PerFamily<bool>, String> {
+        let name = name.trim();
+        if let Some((_, members)) = Family::groups().find(|(group, _)| *group == name) {
+            return Ok(members);
+        }
+        let family = Family::parse(name)?;
+        let group = family.row().group;
+        if group != family.name() {
+            return Err(format!(
+                "'{name}' is one of the constraints of {group}: name {group} for all of them"
+            ));
+        }
+        Ok(PerFamily::from_fn(|f| f == family))
+    }
+
+    /// The active families as `edges+height+volume`, or `none`; a group whose families are all
+    /// active by its name (`neohookean`).
     pub fn describe(&self) -> String {
-        let names: Vec<&str> = self
-            .iter()
-            .filter(|&(_, on)| on)
-            .map(|(f, _)| f.name())
-            .collect();
+        let mut names: Vec<&str> = Vec::new();
+        for (group, members) in Family::groups() {
+            if members.families().all(|f| self[f]) {
+                names.push(group);
+            } else {
+                names.extend(members.families().filter(|&f| self[f]).map(Family::name));
+            }
+        }
         if names.is_empty() {
             "none".into()
         } else {

@@ -10,6 +10,8 @@
 //! | [`distance`] (`edges`) | p0, p1 | \|p0 − p1\| − d |
 //! | [`height`] | p0, p1, p2, p3 | (p1 − p0)·n − d, n the unit normal of (p0, p2, p3) |
 //! | [`volume`] | p0, p1, p2, p3 | ⅙ (p1 − p0)·((p2 − p0)×(p3 − p0)) − V |
+//! | [`neohookean`] deviatoric | p0, p1, p2, p3 | √V₀ ‖F‖_F, F = Ds Dm⁻¹ |
+//! | [`neohookean`] hydrostatic | p0, p1, p2, p3 | √V₀ (det F − γ), γ = 1 + μ/λ |
 //!
 //! Each is a [`Constraint`] type; [`family`] holds the table of families that everything else
 //! reads.
@@ -20,11 +22,14 @@
 pub mod distance;
 pub mod family;
 pub mod height;
+pub mod neohookean;
 pub mod volume;
 
-pub use family::{Binding, Family, PerFamily, Row, TABLE, Visit};
+pub use family::{Binding, Family, PerFamily, Row, TABLE, Visit, VisitPair};
 
+use crate::material::Material;
 use crate::vector::{Real, Vector3};
+use glam::DVec3;
 
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or
 /// eight constraints at once in SIMD lanes).
@@ -32,6 +37,10 @@ pub trait Constraint<const N: usize>: Sync {
     /// Whether [`Constraint::evaluate`] reads `rest_shape`. When it does not, callers may pass
     /// the current positions there, and the solvers save themselves the loads.
     const USES_REST_SHAPE: bool = false;
+
+    /// Whether [`Constraint::rest_value`] depends on the material, so that the rest values are
+    /// measured again when it changes.
+    const REST_USES_MATERIAL: bool = false;
 
     /// C and ∇C at `p`, with rest value `rest` (d, V) and the particles' rest positions
     /// `rest_shape`.
@@ -41,6 +50,14 @@ pub trait Constraint<const N: usize>: Sync {
         rest: V::Real,
         rest_shape: &[V; N],
     ) -> Evaluation<V, N>;
+
+    /// The rest value of a constraint whose particles are at rest at `rest_shape`: unless the
+    /// family says otherwise, C there with rest value 0 (the rest length d, the rest volume V),
+    /// so that C = 0 at rest.
+    fn rest_value(&self, rest_shape: &[DVec3; N], material: &Material) -> f64 {
+        let _ = material;
+        self.evaluate(rest_shape, 0.0, rest_shape).value
+    }
 }
 
 /// A constraint evaluated at one configuration: C and ∇C for each of its N particles.

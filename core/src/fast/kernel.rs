@@ -6,7 +6,7 @@ use super::batches::{Batches, Typed};
 use super::particles::Particles;
 use crate::constraints::Constraint;
 use crate::lanes::{F32x8, LANES, Vec3x8};
-use crate::projection::{Rule, correction_lanes};
+use crate::projection::{Rule, correction_lanes, pair_correction_lanes};
 use crate::vector::Vector3;
 use glam::Vec3A;
 
@@ -166,6 +166,135 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
             _ => {
                 project_batches::<N, C>(constraint, particles, weights, rest, lambda, access, rule)
             }
+        }
+        count += colour.constraints;
+    }
+    count
+}
+
+/// [`project_batches`] for two families projected together ([`pair_correction_lanes`]): the
+/// batches of both have the same particles, in the same order; each has its own rest values and
+/// multipliers.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
+    (first, second): (&A, &B),
+    particles: &[[[u32; LANES]; N]],
+    weights: &[[F32x8; N]],
+    (rest_a, rest_b): (&[F32x8], &[F32x8]),
+    (lambda_a, lambda_b): (&mut [F32x8], &mut [F32x8]),
+    access: Access,
+    rules: [Rule<F32x8>; 2],
+) {
+    assert_eq!(N, M, "a pair shares its particles");
+    for (b, (indices, weights)) in particles.iter().zip(weights).enumerate() {
+        let p = gather_batch(access.read, indices);
+        let shape = if A::USES_REST_SHAPE || B::USES_REST_SHAPE {
+            gather_batch(access.rest_shape, indices)
+        } else {
+            p
+        };
+        let first_evaluation = first.evaluate(&p, rest_a[b], &shape);
+        let p2: [Vec3x8; M] = std::array::from_fn(|k| p[k]);
+        let shape2: [Vec3x8; M] = std::array::from_fn(|k| shape[k]);
+        let e = second.evaluate(&p2, rest_b[b], &shape2);
+        let second_evaluation = crate::constraints::Evaluation {
+            value: e.value,
+            gradients: std::array::from_fn(|k| e.gradients[k]),
+            degenerate: e.degenerate,
+        };
+        let d = pair_correction_lanes(
+            first_evaluation,
+            second_evaluation,
+            *weights,
+            [lambda_a[b], lambda_b[b]],
+            rules,
+        );
+        lambda_a[b] += d.delta_lambda[0];
+        lambda_b[b] += d.delta_lambda[1];
+        for (&indices, delta) in indices.iter().zip(d.delta_x) {
+            scatter_add(access.write, indices, delta);
+        }
+    }
+}
+
+/// [`project_family`] for two families projected together, constraint by constraint: their
+/// batches (`pair`) were built from the same particles, so they have the same colours and
+/// batches. Returns how many constraints of each it projected.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
+    constraints: (&A, &B),
+    (first, second): (&mut Batches, &mut Batches),
+    positions: &mut [Vec3A],
+    rest_positions: &mut [Vec3A],
+    sums: Option<&mut [Vec3A]>,
+    rules: [Rule<f64>; 2],
+    parallel: bool,
+) -> usize {
+    let rules: [Rule<F32x8>; 2] = rules.map(Rule::to);
+    let Typed {
+        particles,
+        weights,
+        rest: rest_a,
+        lambda: lambda_a,
+        colours,
+        particle_count,
+    } = first.typed::<N>();
+    let Typed {
+        particles: particles_b,
+        rest: rest_b,
+        lambda: lambda_b,
+        ..
+    } = second.typed::<M>();
+    assert_eq!(
+        particles.len(),
+        particles_b.len(),
+        "a pair has the same batches"
+    );
+    let read = Particles::new(positions, particle_count);
+    let access = Access {
+        read,
+        rest_shape: Particles::new(rest_positions, particle_count),
+        write: sums.map_or(read, |sums| Particles::new(sums, particle_count)),
+    };
+    let mut count = 0;
+    for colour in colours.iter() {
+        let range = colour.batches.clone();
+        let (particles, weights) = (&particles[range.clone()], &weights[range.clone()]);
+        let rest = (&rest_a[range.clone()], &rest_b[range.clone()]);
+        let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
+        match parallel && colour.constraints >= PARALLEL_MIN {
+            #[cfg(feature = "parallel")]
+            true => {
+                use rayon::prelude::*;
+                lambda_a
+                    .par_chunks_mut(CHUNK)
+                    .zip(lambda_b.par_chunks_mut(CHUNK))
+                    .zip(particles.par_chunks(CHUNK))
+                    .zip(weights.par_chunks(CHUNK))
+                    .zip(rest.0.par_chunks(CHUNK).zip(rest.1.par_chunks(CHUNK)))
+                    .for_each(|((((lambda_a, lambda_b), particles), weights), rest)| {
+                        project_pair_batches::<N, A, M, B>(
+                            constraints,
+                            particles,
+                            weights,
+                            rest,
+                            (lambda_a, lambda_b),
+                            access,
+                            rules,
+                        );
+                    })
+            }
+            _ => project_pair_batches::<N, A, M, B>(
+                constraints,
+                particles,
+                weights,
+                rest,
+                (lambda_a, lambda_b),
+                access,
+                rules,
+            ),
         }
         count += colour.constraints;
     }

@@ -30,7 +30,7 @@ mod particles;
 pub use batches::{Batches, Colour};
 pub use kernel::PARALLEL_MIN;
 
-use crate::constraints::{Constraint, Family, PerFamily, Visit};
+use crate::constraints::{Constraint, Family, PerFamily, Visit, VisitPair};
 use crate::divergence::Divergence;
 use crate::integrate;
 use crate::projection::Rule;
@@ -396,12 +396,82 @@ impl FastSimulation {
         }
     }
 
+    /// In Jacobi order, moves each particle by its share of the corrections `family`'s
+    /// projections summed, and clears the sums.
+    fn apply_jacobi(&mut self, family: Family) {
+        if let Some(jacobi) = &mut self.jacobi {
+            let factors = &jacobi.factors[family];
+            for ((p, sum), &factor) in self.positions.iter_mut().zip(&mut jacobi.sums).zip(factors)
+            {
+                *p += *sum * factor;
+                *sum = Vec3A::ZERO;
+            }
+        }
+    }
+
     fn sweep(&mut self, h: f64, parallel: bool) {
         let active = self.settings.active;
         for family in active.families() {
+            if family.projected_by_partner(&active) {
+                continue;
+            }
             let rule = Rule::for_settings(&self.settings, family, h);
             let started = Instant::now();
             let sums = self.jacobi.as_mut().map(|j| &mut j.sums[..]);
+            if let Some(partner) = family.partner_in(&active) {
+                struct ProjectPair<'a> {
+                    batches: (&'a mut Batches, &'a mut Batches),
+                    positions: &'a mut [Vec3A],
+                    rest_positions: &'a mut [Vec3A],
+                    sums: Option<&'a mut [Vec3A]>,
+                    rules: [Rule<f64>; 2],
+                    parallel: bool,
+                }
+                impl VisitPair for ProjectPair<'_> {
+                    type Output = usize;
+                    #[inline]
+                    fn visit_pair<
+                        const N: usize,
+                        A: Constraint<N>,
+                        const M: usize,
+                        B: Constraint<M>,
+                    >(
+                        self,
+                        first: &A,
+                        second: &B,
+                    ) -> usize {
+                        kernel::project_pair::<N, A, M, B>(
+                            (first, second),
+                            self.batches,
+                            self.positions,
+                            self.rest_positions,
+                            self.sums,
+                            self.rules,
+                            self.parallel,
+                        )
+                    }
+                }
+                let rules = [rule, Rule::for_settings(&self.settings, partner, h)];
+                let count = family.visit_pair(
+                    partner,
+                    ProjectPair {
+                        batches: self.sets.pair_mut(family, partner),
+                        positions: &mut self.positions,
+                        rest_positions: &mut self.rest_positions,
+                        sums,
+                        rules,
+                        parallel,
+                    },
+                );
+                self.apply_jacobi(family);
+                // One pair projection is a projection of each: each family gets half the time.
+                let half = started.elapsed() / 2;
+                for f in [family, partner] {
+                    self.timings.time[f] += half;
+                    self.timings.projections[f] += count as u64;
+                }
+                continue;
+            }
             struct Project<'a> {
                 batches: &'a mut Batches,
                 positions: &'a mut [Vec3A],
@@ -433,15 +503,7 @@ impl FastSimulation {
                 rule,
                 parallel,
             });
-            if let Some(jacobi) = &mut self.jacobi {
-                let factors = &jacobi.factors[family];
-                for ((p, sum), &factor) in
-                    self.positions.iter_mut().zip(&mut jacobi.sums).zip(factors)
-                {
-                    *p += *sum * factor;
-                    *sum = Vec3A::ZERO;
-                }
-            }
+            self.apply_jacobi(family);
             self.timings.time[family] += started.elapsed();
             self.timings.projections[family] += count as u64;
         }

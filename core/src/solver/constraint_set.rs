@@ -3,6 +3,7 @@
 //! multiplier λ), built once from the family's binding to the mesh.
 
 use crate::constraints::{Constraint, Family, Visit};
+use crate::material::Material;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
@@ -17,31 +18,40 @@ pub struct ConstraintSet {
 
 impl ConstraintSet {
     /// The constraints of `family` on `mesh` ([`crate::constraints::Binding::particles`]), each
-    /// with its rest value measured on the mesh's rest positions.
-    pub(crate) fn new(family: Family, mesh: &TetMesh) -> ConstraintSet {
+    /// with its rest value measured on the mesh's rest positions ([`Constraint::rest_value`]).
+    pub(crate) fn new(family: Family, mesh: &TetMesh, material: &Material) -> ConstraintSet {
         let particles = family.row().binding.particles(mesh);
-        struct RestValues<'a>(&'a [u32], &'a [DVec3]);
+        let mut set = ConstraintSet {
+            arity: family.arity(),
+            lambda: vec![0.0; particles.len() / family.arity()],
+            particles,
+            rest: Vec::new(),
+        };
+        set.measure_rest(family, &mesh.positions, material);
+        set
+    }
+
+    /// Measures the rest values again on `rest_positions`, with `material` (for a family whose
+    /// rest values depend on it, when the material changes).
+    pub(crate) fn measure_rest(
+        &mut self,
+        family: Family,
+        rest_positions: &[DVec3],
+        material: &Material,
+    ) {
+        struct RestValues<'a>(&'a [u32], &'a [DVec3], &'a Material);
         impl Visit for RestValues<'_> {
             type Output = Vec<f64>;
             fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Vec<f64> {
-                let (particles, positions) = (self.0, self.1);
+                let (particles, positions, material) = (self.0, self.1, self.2);
                 let (groups, _) = particles.as_chunks::<N>();
                 groups
                     .iter()
-                    .map(|idx| {
-                        let p = idx.map(|i| positions[i as usize]);
-                        c.evaluate(&p, 0.0, &p).value
-                    })
+                    .map(|idx| c.rest_value(&idx.map(|i| positions[i as usize]), material))
                     .collect()
             }
         }
-        let rest = family.visit(RestValues(&particles, &mesh.positions));
-        ConstraintSet {
-            arity: family.arity(),
-            lambda: vec![0.0; rest.len()],
-            particles,
-            rest,
-        }
+        self.rest = family.visit(RestValues(&self.particles, rest_positions, material));
     }
 
     /// The number of constraints.

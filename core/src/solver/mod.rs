@@ -27,6 +27,7 @@
 
 mod constraint_set;
 mod masses;
+mod pair;
 mod settings;
 
 pub use constraint_set::ConstraintSet;
@@ -96,7 +97,7 @@ impl Simulation {
     pub fn new(scene: &Scene, settings: Settings) -> Simulation {
         let mesh = &scene.mesh;
         let positions = mesh.positions.clone();
-        let sets = PerFamily::build(|family| ConstraintSet::new(family, mesh));
+        let sets = PerFamily::build(|family| ConstraintSet::new(family, mesh, &settings.material));
         let lumped_inverse_masses = masses::lumped_inverse_masses(mesh);
         let edges = mesh.edges();
         let mean_edge = if edges.is_empty() {
@@ -139,6 +140,11 @@ impl Simulation {
 
     /// Changes the settings; they apply from the next substep.
     pub fn set_settings(&mut self, settings: Settings) {
+        if settings.material != self.settings.material {
+            for family in Family::all().filter(|f| f.rest_uses_material()) {
+                self.sets[family].measure_rest(family, &self.rest_positions, &settings.material);
+            }
+        }
         self.settings = settings;
     }
 
@@ -357,7 +363,7 @@ impl Simulation {
         }
         if let Some(frames) = self.settling {
             let largest = self.largest_correction();
-            self.settling = (self.settings.settle_edits
+            self.settling = (self.settings.edits_settle()
                 && largest > self.settle_tolerance()
                 && frames + 1 < MAX_SETTLE_FRAMES)
                 .then_some(frames + 1);
@@ -411,14 +417,15 @@ impl Simulation {
         for (correction, p) in self.corrections.iter_mut().zip(&self.positions) {
             *correction = *p - *correction;
         }
-        self.update_velocities(h, self.settings.settle_edits && self.settling.is_some());
+        self.update_velocities(h, self.settings.edits_settle() && self.settling.is_some());
     }
 
     /// The constraints one sweep projects, in order: every constraint of each active family
     /// (edges, then heights, then volumes), as (family, index in the family).
     pub fn projection_order(&self) -> impl Iterator<Item = (Family, usize)> + '_ {
+        let active = self.settings.active;
         Family::all()
-            .filter(|&f| self.settings.active[f])
+            .filter(move |&f| active[f] && !f.projected_by_partner(&active))
             .flat_map(move |f| (0..self.constraint_count(f)).map(move |c| (f, c)))
     }
 
@@ -432,6 +439,40 @@ impl Simulation {
     /// The constraints of `family`: their particles, rest values and multipliers.
     pub fn constraints(&self, family: Family) -> &ConstraintSet {
         &self.sets[family]
+    }
+
+    /// The shortest edge of the rest shape (0 without edges).
+    pub fn shortest_edge(&self) -> f64 {
+        let lengths = self.sets[Family::EDGES].rest().iter().copied();
+        lengths.filter(|&l| l > 0.0).reduce(f64::min).unwrap_or(0.0)
+    }
+
+    /// Why the settings may blow up, when an active family takes its compliance from the
+    /// material and the substeps are too long for it
+    /// ([`crate::material::Material::substeps_needed`]): a warning
+    /// every front end shows.
+    pub fn stability_warning(&self) -> Option<String> {
+        let settings = &self.settings;
+        let material_family = settings
+            .active
+            .families()
+            .find(|f| f.row().compliance_from_material.is_some())?;
+        let shortest = self.shortest_edge();
+        let material = settings.material;
+        let needed = material.substeps_needed(settings.dt, shortest, DENSITY);
+        (needed > u64::from(settings.substeps)).then(|| {
+            format!(
+                "{} with material {} needs at least {needed} substeps per frame of {:.4} s on this \
+                 mesh (pressure waves {:.3e} m/s, shortest edge {:.3e} m); with {} it may blow \
+                 up",
+                material_family.row().group,
+                material.describe(),
+                settings.dt,
+                material.wave_speed(DENSITY),
+                shortest,
+                settings.substeps
+            )
+        })
     }
 
     /// Constraint projections one frame makes with the current settings: the active families'
@@ -448,28 +489,68 @@ impl Simulation {
 
     /// What projecting constraint `c` of `family` now would do, with the current λ and the rule
     /// (XPBD or PBD) of the current settings: C, ∇C, the inverse masses, Δλ and Δx.
+    ///
+    /// A family projected together with another ([`Family::partner_in`]) shows its own C and
+    /// ∇C, and the Δλ and Δx of the pair's projection.
     pub fn projection(&self, family: Family, c: usize) -> Projection {
-        let rule = self.rule(family, self.substep_length());
-        family.visit(Describe {
+        let h = self.substep_length();
+        let rule = self.rule(family, h);
+        let mut projection = family.visit(Describe {
             set: &self.sets[family],
             positions: &self.positions,
             rest_positions: &self.rest_positions,
             inverse_masses: &self.inverse_masses,
             rule,
             c,
-        })
+        });
+        if let Some(partner) = family.partner_in(&self.settings.active) {
+            let pair = pair::Pair {
+                first: &self.sets[family],
+                second: &self.sets[partner],
+                positions: &self.positions,
+                rest_positions: &self.rest_positions,
+                inverse_masses: &self.inverse_masses,
+                rules: [rule, self.rule(partner, h)],
+            };
+            let correction = family.visit_pair(partner, pair::PairAt { pair, c });
+            let skipped = projection.delta_lambda.is_none();
+            projection.delta_lambda = (!skipped).then_some(correction.delta_lambda[0]);
+            projection.delta_x = correction.delta_x;
+        }
+        projection
     }
 
-    /// Projects constraint `c` of `family` once, exactly as a sweep does.
+    /// Projects constraint `c` of `family` once, exactly as a sweep does (with its partner, if
+    /// it leads a pair).
     pub fn project(&mut self, family: Family, c: usize) {
-        let rule = self.rule(family, self.substep_length());
+        self.project_range(family, c..c + 1, self.substep_length());
+    }
+
+    /// Projects constraints `range` of `family` in turn, alone or with its partner.
+    fn project_range(&mut self, family: Family, range: std::ops::Range<usize>, h: f64) {
+        let rule = self.rule(family, h);
+        if let Some(partner) = family.partner_in(&self.settings.active) {
+            let rules = [rule, self.rule(partner, h)];
+            let (first, second) = self.sets.pair_mut(family, partner);
+            let sweep = pair::PairSweep {
+                first,
+                second,
+                positions: &mut self.positions,
+                rest_positions: &self.rest_positions,
+                inverse_masses: &self.inverse_masses,
+                rules,
+                range,
+            };
+            family.visit_pair(partner, sweep);
+            return;
+        }
         family.visit(Sweep {
             set: &mut self.sets[family],
             positions: &mut self.positions,
             rest_positions: &self.rest_positions,
             inverse_masses: &self.inverse_masses,
             rule,
-            only: Some(c),
+            range,
         });
     }
 
@@ -505,19 +586,12 @@ impl Simulation {
 
     /// One Gauss–Seidel sweep over the active families, then the grab, then the ground.
     fn sweep(&mut self, h: f64) {
+        let active = self.settings.active;
         for family in Family::all() {
-            if !self.settings.active[family] {
+            if !active[family] || family.projected_by_partner(&active) {
                 continue;
             }
-            let rule = self.rule(family, h);
-            family.visit(Sweep {
-                set: &mut self.sets[family],
-                positions: &mut self.positions,
-                rest_positions: &self.rest_positions,
-                inverse_masses: &self.inverse_masses,
-                rule,
-                only: None,
-            });
+            self.project_range(family, 0..self.sets[family].len(), h);
         }
         self.end_sweep();
     }
@@ -559,7 +633,7 @@ struct Sweep<'a> {
     rest_positions: &'a [DVec3],
     inverse_masses: &'a [f64],
     rule: Rule<f64>,
-    only: Option<usize>,
+    range: std::ops::Range<usize>,
 }
 
 impl Visit for Sweep<'_> {
@@ -567,11 +641,7 @@ impl Visit for Sweep<'_> {
 
     #[inline]
     fn visit<const N: usize, C: Constraint<N>>(self, _: Family, constraint: &C) {
-        let range = match self.only {
-            Some(c) => c..c + 1,
-            None => 0..self.set.len(),
-        };
-        for c in range {
+        for c in self.range {
             let idx = self.set.indices::<N>(c);
             let p = idx.map(|i| self.positions[i as usize]);
             let shape = if C::USES_REST_SHAPE {

@@ -5,6 +5,7 @@
 
 use crate::constraints::{Family, PerFamily};
 use crate::limits;
+use crate::material::Material;
 
 /// XPBD or PBD.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -43,6 +44,10 @@ pub struct Settings {
     pub active: PerFamily<bool>,
     /// XPBD compliance α per family: the inverse of stiffness, 0 is rigid, larger is softer.
     pub compliance: PerFamily<f64>,
+    /// The material of the families whose compliance it gives (the neo-Hookean pair): set it
+    /// with [`Settings::set_material`], which sets their compliances too.
+    #[serde(default)]
+    pub material: Material,
     /// PBD stiffness k ∈ [0, 1] per family.
     #[serde(deserialize_with = "stiffness_over_the_default")]
     pub stiffness: PerFamily<f64>,
@@ -74,6 +79,29 @@ impl Settings {
         self.ground = gravity != 0.0;
     }
 
+    /// Whether edits settle: [`Settings::settle_edits`], except while a family a material
+    /// describes is active. A material carries its own momentum through an inversion (a
+    /// mirrored tet's way back passes close to F = 0, where its hydrostatic gradient vanishes);
+    /// capping the speed there leaves the body squashed to a point.
+    pub fn edits_settle(&self) -> bool {
+        self.settle_edits
+            && !self
+                .active
+                .families()
+                .any(|f| f.row().compliance_from_material.is_some())
+    }
+
+    /// Sets the material, and the compliance of each family it gives one
+    /// ([`crate::constraints::Row::compliance_from_material`]: 1/μ and 1/λ).
+    pub fn set_material(&mut self, material: Material) {
+        self.material = material;
+        for family in Family::all() {
+            if let Some(compliance) = family.row().compliance_from_material {
+                self.compliance[family] = compliance(&material);
+            }
+        }
+    }
+
     /// Ok when every number is within its range of [`crate::limits`]; otherwise the first that
     /// is not, named (e.g. settings remembered by an older workbench, or edited by hand).
     pub fn check(&self) -> Result<(), String> {
@@ -82,6 +110,7 @@ impl Settings {
         limits::DT.check(self.dt)?;
         limits::GRAVITY.check(self.gravity)?;
         limits::DAMPING.check(self.damping)?;
+        self.material.check()?;
         limits::COMPLIANCE
             .check(self.grab_compliance)
             .map_err(|e| format!("grab {e}"))?;
@@ -107,9 +136,10 @@ impl Settings {
 
 impl Default for Settings {
     /// XPBD, edges + volume, rigid, 10 substeps of 1 iteration, Δt = 1/60 s, gravity 9.81 m/s²,
+    /// the default [`Material`] for the neo-Hookean families,
     /// ground on, no damping.
     fn default() -> Self {
-        Self {
+        let mut settings = Self {
             method: Method::Xpbd,
             active: PerFamily::from_fn(|f| f == Family::EDGES || f == Family::VOLUME),
             compliance: PerFamily::splat(0.0),
@@ -122,7 +152,10 @@ impl Default for Settings {
             damping: 0.0,
             grab_compliance: 0.0,
             settle_edits: false,
-        }
+            material: Material::default(),
+        };
+        settings.set_material(Material::default());
+        settings
     }
 }
 

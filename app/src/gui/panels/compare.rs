@@ -13,10 +13,15 @@ pub fn show(
 ) -> Option<Option<PerFamily<bool>>> {
     ui.heading("Compare");
     ui.horizontal(|ui| {
-        for family in Family::all() {
-            let mut on = families.get(family);
-            if ui.checkbox(&mut on, family.row().label).changed() {
-                families.set(family, on);
+        for (group, members) in Family::groups() {
+            let mut on = members.families().all(|f| families[f]);
+            if ui
+                .checkbox(&mut on, super::solver::group_label(group))
+                .changed()
+            {
+                for family in members.families() {
+                    families.set(family, on);
+                }
             }
         }
     });

@@ -8,6 +8,9 @@ use std::time::Duration;
 /// Shows the metrics of the current frame and plots of the recent ones.
 pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration) {
     let m = &bench.metrics;
+    if let Some(warning) = &bench.stability_warning {
+        ui.colored_label(egui::Color32::from_rgb(230, 160, 40), warning);
+    }
     egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
         for (label, value) in [
             (

@@ -2,7 +2,8 @@
 //! rest. The panel edits a copy; the app applies a change to every simulation shown.
 
 use eframe::egui;
-use tetlab_core::constraints::Family;
+use tetlab_core::constraints::{Family, PerFamily};
+use tetlab_core::material::{MAX_POISSON, YOUNG};
 use tetlab_core::solver::{Method, Settings};
 
 /// Shows `current`; returns the settings the user changed them to, if they did.
@@ -13,7 +14,12 @@ pub fn show(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
         ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");
         ui.radio_value(&mut settings.method, Method::Pbd, "PBD");
     });
-    for family in Family::all() {
+    for (group, members) in Family::groups() {
+        let family = members.families().next().expect("a group has a family");
+        if family.row().compliance_from_material.is_some() {
+            material_group(ui, &mut settings, group, members);
+            continue;
+        }
         ui.horizontal(|ui| {
             ui.checkbox(&mut settings.active[family], family.row().label);
             match settings.method {
@@ -43,4 +49,54 @@ pub fn show(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
          speed them up until the edit is undone",
         );
     (settings != *current).then_some(settings)
+}
+
+/// The families a material describes (the neo-Hookean pair): on or off together, with the
+/// material's E and ν (which give their compliances, under XPBD and PBD alike).
+fn material_group(
+    ui: &mut egui::Ui,
+    settings: &mut Settings,
+    group: &str,
+    members: PerFamily<bool>,
+) {
+    let mut on = members.families().all(|f| settings.active[f]);
+    let mut material = settings.material;
+    let speed = material.young * 0.01;
+    ui.horizontal(|ui| {
+        if ui.checkbox(&mut on, group_label(group)).changed() {
+            for family in members.families() {
+                settings.active[family] = on;
+            }
+        }
+        ui.add(
+            egui::DragValue::new(&mut material.young)
+                .range(YOUNG.min..=YOUNG.max)
+                .speed(speed)
+                .custom_formatter(|e, _| format!("{e:.2e}"))
+                .prefix("E ")
+                .suffix(" Pa"),
+        )
+        .on_hover_text("Young's modulus: a larger E is stiffer");
+        ui.add(
+            egui::DragValue::new(&mut material.poisson)
+                .range(0.0..=MAX_POISSON)
+                .speed(0.005)
+                .max_decimals(3)
+                .prefix("nu "),
+        )
+        .on_hover_text("Poisson's ratio: towards 0.5 the volume barely changes");
+    });
+    if material != settings.material && material.check().is_ok() {
+        settings.set_material(material);
+    }
+}
+
+/// "neo-Hookean" for `neohookean`: the table's label of a group's first family, up to its
+/// first space.
+pub fn group_label(group: &str) -> &'static str {
+    let family = Family::all()
+        .find(|f| f.row().group == group)
+        .expect("a group of the table");
+    let label = family.row().label;
+    label.split(' ').next().unwrap_or(label)
 }
