@@ -286,6 +286,15 @@ fn the_neo_hookean_family_is_switched_on_with_its_material() {
     harness.key_press(egui::Key::M);
     harness.run_steps(1);
     assert_eq!(harness.state().bench.metrics.inverted_tets, 48);
+    // The inspector shows F and J.
+    harness.key_press(egui::Key::E);
+    harness.run_steps(2);
+    harness
+        .get_all_by_label_contains("J = det F = -1.0000")
+        .next()
+        .unwrap();
+    harness.key_press(egui::Key::E);
+    harness.run_steps(2);
     // Mirrored, cof F = −F: the two point opposite ways, and both show.
     harness.snapshot("neohookean_mirrored");
     for family in [

@@ -63,6 +63,22 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
     }
 }
 
+/// What else the family shows of the inspected constraint ([`Family::describe_state`]: F and
+/// det F for the neo-Hookean pair), one line each.
+pub fn state_lines(simulation: &Simulation, projection: &Projection) -> Vec<String> {
+    let at = |positions: &[DVec3]| -> Vec<DVec3> {
+        projection
+            .particles()
+            .iter()
+            .map(|&i| positions[i as usize])
+            .collect()
+    };
+    projection.family.describe_state(
+        &at(simulation.positions()),
+        &at(simulation.rest_positions()),
+    )
+}
+
 /// Inspects every constraint of the active families on tet `tet`, family by family. Appends to
 /// `out`.
 pub fn inspect_tet(simulation: &Simulation, tet: usize, out: &mut Vec<Inspection>) {

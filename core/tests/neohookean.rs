@@ -200,3 +200,16 @@ fn a_mirrored_material_recovers_with_settle_edits_on() {
     assert_eq!(metrics.inverted_tets, 0);
     assert!(metrics.volume_error < 0.01, "{metrics:?}");
 }
+
+/// The inspector shows F and det F of a neo-Hookean constraint: a mirror is det F = −1.
+#[test]
+fn the_inspector_shows_f_and_its_determinant() {
+    let mut simulation = cube_with(rubber(1e6), 10, 0.0);
+    simulation.perturb(Perturbation::Mirror);
+    let projection = simulation.projection(Family::NEOHOOKEAN_HYDROSTATIC, 0);
+    let lines = tetlab_core::inspector::state_lines(&simulation, &projection);
+    assert!(lines[0].starts_with("F = ["), "{lines:?}");
+    assert!(lines[1].starts_with("J = det F = -1.0000"), "{lines:?}");
+    let edges = simulation.projection(Family::EDGES, 0);
+    assert!(tetlab_core::inspector::state_lines(&simulation, &edges).is_empty());
+}

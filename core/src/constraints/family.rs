@@ -393,6 +393,26 @@ impl Family {
             .is_some_and(|partner| active[partner] && partner < self)
     }
 
+    /// [`Constraint::describe_state`] of one of its constraints, its particles at `points` and
+    /// at rest at `rest_shape`.
+    pub fn describe_state(self, points: &[DVec3], rest_shape: &[DVec3]) -> Vec<String> {
+        struct State<'a>(&'a [DVec3], &'a [DVec3]);
+        impl Visit for State<'_> {
+            type Output = Vec<String>;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Vec<String> {
+                let p: [DVec3; N] = std::array::from_fn(|k| self.0[k]);
+                let shape: [DVec3; N] = std::array::from_fn(|k| self.1[k]);
+                c.describe_state(&p, &shape)
+            }
+        }
+        assert_eq!(
+            points.len(),
+            self.arity(),
+            "wrong number of points for {self:?}"
+        );
+        self.visit(State(points, rest_shape))
+    }
+
     /// Whether its rest values depend on the material ([`Constraint::REST_USES_MATERIAL`]).
     pub fn rest_uses_material(self) -> bool {
         struct Uses;

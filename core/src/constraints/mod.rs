@@ -58,6 +58,13 @@ pub trait Constraint<const N: usize>: Sync {
         let _ = material;
         self.evaluate(rest_shape, 0.0, rest_shape).value
     }
+
+    /// What else a reader should see of the constraint's particles at `p` (rest shape
+    /// `rest_shape`), one line each, beside C and ∇C: the neo-Hookean pair shows F and det F.
+    fn describe_state(&self, p: &[DVec3; N], rest_shape: &[DVec3; N]) -> Vec<String> {
+        let _ = (p, rest_shape);
+        Vec::new()
+    }
 }
 
 /// A constraint evaluated at one configuration: C and ∇C for each of its N particles.

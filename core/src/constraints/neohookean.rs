@@ -26,7 +26,7 @@
 //! flagged degenerate with C finite.
 //!
 //! ```
-//! use glam::DVec3;
+//! use glam::{DMat3, DVec3};
 //! use tetlab_core::constraints::neohookean::{deviatoric, hydrostatic};
 //! let rest = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
 //! // At rest F = I: ‖F‖ = √3, det F = 1, each scaled by √V₀ = √(1/6).
@@ -44,7 +44,7 @@
 use super::{Constraint, Evaluation, first_from_rest};
 use crate::material::Material;
 use crate::vector::{Mask, Real, Vector3, spans_no_plane};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 /// The deviatoric constraint and its gradients as lines of math (the inspector, lessons).
 pub const DEVIATORIC_FORMULA: &[&str] = &[
@@ -151,6 +151,31 @@ pub fn hydrostatic<V: Vector3>(p: &[V; 4], rest: V::Real, rest_shape: &[V; 4]) -
     Evaluation::unless_degenerate(degenerate, value, value, gradients)
 }
 
+/// F = Ds Dm⁻¹ of a tet at `p` with rest shape `rest_shape`; `None` when the rest shape has no
+/// volume.
+pub fn deformation_gradient(p: &[DVec3; 4], rest_shape: &[DVec3; 4]) -> Option<DMat3> {
+    let columns = |q: &[DVec3; 4]| DMat3::from_cols(q[1] - q[0], q[2] - q[0], q[3] - q[0]);
+    let dm = columns(rest_shape);
+    (!rest_frame(rest_shape).degenerate).then(|| columns(p) * dm.inverse())
+}
+
+/// F, det F and ‖F‖, for the inspector.
+fn describe(p: &[DVec3; 4], rest_shape: &[DVec3; 4]) -> Vec<String> {
+    let Some(f) = deformation_gradient(p, rest_shape) else {
+        return vec!["the rest tet has no volume: F = Ds Dm⁻¹ is undefined".to_owned()];
+    };
+    let row = |i: usize| {
+        let r = f.row(i);
+        format!("{:+.4} {:+.4} {:+.4}", r.x, r.y, r.z)
+    };
+    let norm =
+        (f.x_axis.length_squared() + f.y_axis.length_squared() + f.z_axis.length_squared()).sqrt();
+    vec![
+        format!("F = [{}; {}; {}]", row(0), row(1), row(2)),
+        format!("J = det F = {:+.4}   ‖F‖ = {norm:.4}", f.determinant()),
+    ]
+}
+
 /// √|V₀| of a rest tet (0 when it has no volume).
 fn scale(rest_shape: &[DVec3; 4]) -> f64 {
     rest_frame(rest_shape).scale
@@ -171,6 +196,10 @@ impl Constraint<4> for Deviatoric {
     fn rest_value(&self, _: &[DVec3; 4], _: &Material) -> f64 {
         0.0
     }
+
+    fn describe_state(&self, p: &[DVec3; 4], rest_shape: &[DVec3; 4]) -> Vec<String> {
+        describe(p, rest_shape)
+    }
 }
 
 /// The hydrostatic constraint, as the family table evaluates it ([`hydrostatic`]).
@@ -188,5 +217,9 @@ impl Constraint<4> for Hydrostatic {
     /// √|V₀| γ, γ = 1 + μ/λ: det F at rest is 1, and the constraint aims a little above it.
     fn rest_value(&self, rest_shape: &[DVec3; 4], material: &Material) -> f64 {
         scale(rest_shape) * material.gamma()
+    }
+
+    fn describe_state(&self, p: &[DVec3; 4], rest_shape: &[DVec3; 4]) -> Vec<String> {
+        describe(p, rest_shape)
     }
 }

@@ -6,8 +6,8 @@ use crate::gui::workbench::Workbench;
 use eframe::egui;
 use glam::DVec3;
 use tetlab_core::constraints::Family;
-use tetlab_core::inspector::{Inspection, inspect, inspect_tet};
-use tetlab_core::solver::Method;
+use tetlab_core::inspector::{Inspection, inspect, inspect_tet, state_lines};
+use tetlab_core::solver::{Method, Simulation};
 
 /// Shows the inspector as a window while `open` is true.
 pub fn show(ctx: &egui::Context, open: &mut bool, bench: &Workbench) {
@@ -28,7 +28,7 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
         let inspection = inspect(simulation, projection.family, projection.constraint);
         formula(ui, projection.family);
         // One id for whichever constraint is next, so the table keeps its column widths.
-        constraint(ui, &inspection, method, "next projection");
+        constraint(ui, simulation, &inspection, method, "next projection");
         ui.separator();
     }
     let Some(tet) = bench.selected_tet else {
@@ -51,13 +51,15 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
         }
         egui::CollapsingHeader::new(format!("{} ({})", family.row().title, of_family.len()))
             .id_salt(family.name())
-            .default_open(family == Family::VOLUME)
+            // Open where the tet has one constraint of the family (volume, neo-Hookean).
+            .default_open(of_family.len() == 1)
             .show(ui, |ui| {
                 formula(ui, family);
                 for inspection in of_family {
                     ui.separator();
                     let p = &inspection.projection;
-                    constraint(ui, inspection, method, (p.family.name(), p.constraint));
+                    let id = (p.family.name(), p.constraint);
+                    constraint(ui, simulation, inspection, method, id);
                 }
             });
     }
@@ -76,6 +78,7 @@ fn formula(ui: &mut egui::Ui, family: Family) {
 /// central-difference check.
 fn constraint(
     ui: &mut egui::Ui,
+    simulation: &Simulation,
     inspection: &Inspection,
     method: Method,
     id: impl std::hash::Hash + std::fmt::Debug,
@@ -99,6 +102,9 @@ fn constraint(
         ))
         .monospace(),
     );
+    for line in state_lines(simulation, p) {
+        ui.monospace(line);
+    }
     egui::Grid::new(("inspection", id))
         .striped(true)
         .show(ui, |ui| {
