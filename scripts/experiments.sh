@@ -92,3 +92,35 @@ header "13. Iterations and the stiffness a material shows: the cube damped to re
 for m in xpbd pbd; do for i in 1 4 16; do for e in 2.5e6 1e7; do
   row --scene cube --constraints neohookean --material E=$e,nu=0.3 --damping 20 --solver $m --iterations $i
 done; done; done
+
+# beam_row ARGS...: a cantilever run, its tip deflection against Euler–Bernoulli.
+beam_row() {
+  local args="$*"
+  "$tetlab" run $args --json | python3 -c '
+import json, sys
+args = sys.argv[1]
+frames = [json.loads(line) for line in sys.stdin]
+first, last = frames[0], frames[-1]
+words = args.split()
+def option(name, default):
+    return words[words.index(name) + 1] if name in words else default
+material = dict(kv.split("=") for kv in option("--material", "E=1e6,nu=0.3").split(","))
+E, rho, g, L, h = float(material["E"]), 1000.0, 9.81, 2.0, 0.5
+# Euler–Bernoulli: q = rho g A, I = h^4 / 12, delta = q L^4 / (8 E I) = 1.5 rho g L^4 / (E h^2)
+theory = 1.5 * rho * g * L**4 / (E * h**2)
+print("| {} | {} | {} | {} × {} | {:.4f} | {:.4f} | {:.3f} | `tetlab run {}` |".format(
+    option("--resolution", "4"), first["tets"], option("--solver", "xpbd"),
+    option("--substeps", "10"), option("--iterations", "1"),
+    last["max_displacement"], theory, last["max_displacement"] / theory, args))
+' "$args"
+}
+
+echo
+echo "### 14. A cantilever under gravity against Euler–Bernoulli: the beam (2 m × 0.5 m × 0.5 m, clamped at x = 0), E = 10 MPa, ν = 0.3, damped to rest (damping 10, 5 s)"
+echo
+echo "| resolution | tets | solver | substeps × iterations | tip deflection (m) | Euler–Bernoulli (m) | ratio | command |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
+beam="--scene beam --constraints neohookean --material E=1e7,nu=0.3 --damping 10 --frames 300"
+for r in 1 2 4; do beam_row $beam --resolution $r --substeps 40 --iterations 4; done
+for m in xpbd pbd; do for i in 1 4 16; do beam_row $beam --resolution 2 --substeps 20 --iterations $i --solver $m; done; done
+for s in 10 20 40; do beam_row $beam --resolution 2 --substeps $s --iterations 4; done

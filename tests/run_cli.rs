@@ -333,3 +333,36 @@ fn a_material_too_stiff_for_the_substeps_is_warned_about() {
         "rubber at 10 substeps"
     );
 }
+
+/// A cantilever of the neo-Hookean material sags under gravity: its tip is the particle farthest
+/// from rest, and a material four times stiffer deflects it about four times less.
+#[test]
+fn max_displacement_is_a_cantilevers_tip_deflection() {
+    let tip = |material: &str| {
+        let lines = json_lines(&[
+            "run",
+            "--scene",
+            "beam",
+            "--resolution",
+            "1",
+            "--constraints",
+            "neohookean",
+            "--material",
+            material,
+            "--substeps",
+            "20",
+            "--iterations",
+            "4",
+            "--damping",
+            "20",
+            "--frames",
+            "200",
+            "--json",
+        ]);
+        assert_eq!(lines[0]["max_displacement"], 0.0);
+        lines.last().unwrap()["max_displacement"].as_f64().unwrap()
+    };
+    let (soft, stiff) = (tip("E=2.5e6,nu=0.3"), tip("E=1e7,nu=0.3"));
+    assert!(stiff > 0.0 && soft < 0.5, "{soft} {stiff}");
+    assert!((3.0..5.0).contains(&(soft / stiff)), "{soft} / {stiff}");
+}

@@ -45,14 +45,7 @@ impl Inspection {
 /// ```
 pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection {
     let projection = simulation.projection(family, c);
-    let at = |positions: &[DVec3]| -> Vec<DVec3> {
-        projection
-            .particles()
-            .iter()
-            .map(|&i| positions[i as usize])
-            .collect()
-    };
-    let (points, rest_shape) = (at(simulation.positions()), at(simulation.rest_positions()));
+    let (points, rest_shape) = particles_of(simulation, &projection);
     let (analytic, numeric) = analytic_and_numeric(family, &points, projection.rest, &rest_shape);
     let mut numeric_gradients = [DVec3::ZERO; 4];
     numeric_gradients[..numeric.len()].copy_from_slice(&numeric);
@@ -66,6 +59,12 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
 /// What else the family shows of the inspected constraint ([`Family::describe_state`]: F and
 /// det F for the neo-Hookean pair), one line each.
 pub fn state_lines(simulation: &Simulation, projection: &Projection) -> Vec<String> {
+    let (points, rest_shape) = particles_of(simulation, projection);
+    projection.family.describe_state(&points, &rest_shape)
+}
+
+/// The constraint's particles now and at rest.
+fn particles_of(simulation: &Simulation, projection: &Projection) -> (Vec<DVec3>, Vec<DVec3>) {
     let at = |positions: &[DVec3]| -> Vec<DVec3> {
         projection
             .particles()
@@ -73,10 +72,7 @@ pub fn state_lines(simulation: &Simulation, projection: &Projection) -> Vec<Stri
             .map(|&i| positions[i as usize])
             .collect()
     };
-    projection.family.describe_state(
-        &at(simulation.positions()),
-        &at(simulation.rest_positions()),
-    )
+    (at(simulation.positions()), at(simulation.rest_positions()))
 }
 
 /// Inspects every constraint of the active families on tet `tet`, family by family. Appends to

@@ -26,6 +26,9 @@ pub struct Metrics {
     pub volume_error: f64,
     /// max over edges of |l − l₀| / l₀.
     pub max_edge_strain: f64,
+    /// max over particles of |x − x_rest|, in metres: how far the body moved from its rest
+    /// shape (a cantilever's tip deflection).
+    pub max_displacement: f64,
     /// Root mean square of C over each family's constraints (metres for edges and heights,
     /// cubic metres for volumes), whether or not the family is active.
     pub residual: PerFamily<f64>,
@@ -45,7 +48,9 @@ impl Metrics {
     /// Ok when every measurement is finite; otherwise the first that is not, as the divergence
     /// of a state at `frame`.
     pub fn check(&self, frame: u64) -> Result<(), Divergence> {
-        if let Some((name, value)) = self.headline().into_iter().find(|(_, v)| !v.is_finite()) {
+        let displacement = ("max_displacement", self.max_displacement);
+        let all = self.headline().into_iter().chain([displacement]);
+        if let Some((name, value)) = all.into_iter().find(|(_, v)| !v.is_finite()) {
             return Err(Divergence::new(frame, Cause::Metric { name, value }));
         }
         match self.residual.iter().find(|(_, v)| !v.is_finite()) {
@@ -104,6 +109,11 @@ impl Metrics {
                 0.0
             },
             max_edge_strain,
+            max_displacement: positions
+                .iter()
+                .zip(simulation.rest_positions())
+                .map(|(p, r)| p.distance(*r))
+                .fold(0.0, larger),
             residual: PerFamily::from_fn(|family| {
                 family.visit(Rms {
                     set: simulation.constraints(family),

@@ -28,6 +28,7 @@ pub struct FrameRecord {
     min_volume_ratio: f64,
     volume_error: f64,
     max_edge_strain: f64,
+    max_displacement: f64,
     /// `residual_<family>` for each family of the table, in its order.
     #[serde(flatten)]
     residuals: BTreeMap<String, f64>,
@@ -50,6 +51,7 @@ impl FrameRecord {
             min_volume_ratio: metrics.min_volume_ratio,
             volume_error: metrics.volume_error,
             max_edge_strain: metrics.max_edge_strain,
+            max_displacement: metrics.max_displacement,
             residuals: metrics
                 .residual
                 .iter()

@@ -43,7 +43,7 @@
 
 use super::{Constraint, Evaluation, first_from_rest};
 use crate::material::Material;
-use crate::vector::{Mask, Real, Vector3, spans_no_plane};
+use crate::vector::{Real, Vector3};
 use glam::{DMat3, DVec3};
 
 /// The deviatoric constraint and its gradients as lines of math (the inspector, lessons).
@@ -130,24 +130,18 @@ pub fn deviatoric<V: Vector3>(p: &[V; 4], rest: V::Real, rest_shape: &[V; 4]) ->
     Evaluation::unless_degenerate(degenerate, value, at_zero, gradients)
 }
 
-/// C_H = √|V₀| det F − `rest` (the rest value holds √|V₀| γ) and its gradients.
+/// C_H = √|V₀| det F − `rest` (the rest value holds √|V₀| γ) and its gradients: det F =
+/// 6V / det Dm, so this is the signed volume constraint ([`super::volume::evaluate`]) scaled by
+/// 6 √|V₀| / det Dm, degenerate where that one is (all four points on one line) or where the
+/// rest shape has no volume.
 #[inline]
 pub fn hydrostatic<V: Vector3>(p: &[V; 4], rest: V::Real, rest_shape: &[V; 4]) -> Evaluation<V, 4> {
     let frame = rest_frame(rest_shape);
-    let e1 = p[1] - p[0];
-    let e2 = p[2] - p[0];
-    let e3 = p[3] - p[0];
-    let c23 = e2.cross(e3);
-    let c31 = e3.cross(e1);
-    let c12 = e1.cross(e2);
-    let factor = frame.scale / frame.det;
-    let value = e1.dot(c23) * factor - rest;
-    // All four points on one line: cof F is zero, as for the volume constraint.
-    let on_a_line = spans_no_plane(e2, e3, c23)
-        .and_then(|| spans_no_plane(e3, e1, c31))
-        .and_then(|| spans_no_plane(e1, e2, c12));
-    let degenerate = frame.degenerate | on_a_line;
-    let gradients = first_from_rest(c23 * factor, c31 * factor, c12 * factor);
+    let volume = super::volume::evaluate(p, V::Real::ZERO);
+    let factor = frame.scale * V::Real::from_f64(6.0) / frame.det;
+    let value = volume.value * factor - rest;
+    let gradients = volume.gradients.map(|g| g * factor);
+    let degenerate = frame.degenerate | volume.degenerate;
     Evaluation::unless_degenerate(degenerate, value, value, gradients)
 }
 
