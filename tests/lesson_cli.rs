@@ -125,3 +125,22 @@ fn a_bad_material_in_a_lesson_names_the_line() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `tetlab lesson --material` replaces the lesson's material: the neo-Hookean lesson's cube of
+/// 1 MPa sags under 5 %; one of 10 kPa does not.
+#[test]
+fn a_lesson_runs_with_another_material() {
+    let output = tetlab(&["lesson", "7", "--quiet"]);
+    assert!(output.status.success(), "{}", stdout(&output));
+    let soft = tetlab(&["lesson", "7", "--quiet", "--material", "E=1e4,nu=0.3"]);
+    assert_eq!(soft.status.code(), Some(1), "{}", stdout(&soft));
+    assert!(
+        stdout(&soft).contains("NOT OBSERVED: max_edge_strain < 0.05"),
+        "{}",
+        stdout(&soft)
+    );
+    assert_usage_error(
+        &tetlab(&["lesson", "7", "--material", "E=1e4"]),
+        "--material",
+    );
+}

@@ -213,3 +213,34 @@ fn the_inspector_shows_f_and_its_determinant() {
     let edges = simulation.projection(Family::EDGES, 0);
     assert!(tetlab_core::inspector::state_lines(&simulation, &edges).is_empty());
 }
+
+/// XPBD's stiffness does not depend on the iterations once they converge; PBD's grows with
+/// them (docs/experiments.md, tables 13 and 14): a clamped beam's tip deflection.
+#[test]
+fn xpbd_stiffness_is_the_same_for_any_iteration_count_and_pbd_is_not() {
+    use tetlab_core::solver::Method;
+    let tip = |method: Method, iterations: u32| {
+        let scene = Scene::builtin(Builtin::Beam, 1).unwrap();
+        let mut settings = Settings {
+            active: PerFamily::parse_list("neohookean").unwrap(),
+            method,
+            substeps: 20,
+            iterations,
+            damping: 10.0,
+            ..Settings::default()
+        };
+        settings.set_material(rubber(1e7));
+        let mut simulation = Simulation::new(&scene, settings);
+        for _ in 0..300 {
+            simulation.step();
+        }
+        Metrics::measure_sound(&simulation)
+            .unwrap()
+            .max_displacement
+    };
+    let (xpbd_4, xpbd_16) = (tip(Method::Xpbd, 4), tip(Method::Xpbd, 16));
+    assert!((xpbd_16 / xpbd_4 - 1.0).abs() < 0.02, "{xpbd_4} {xpbd_16}");
+    let (pbd_4, pbd_16) = (tip(Method::Pbd, 4), tip(Method::Pbd, 16));
+    assert!(pbd_16 < 0.5 * pbd_4, "{pbd_4} {pbd_16}");
+    assert!(pbd_4 < 0.5 * xpbd_4, "{pbd_4} {xpbd_4}");
+}

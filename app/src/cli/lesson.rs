@@ -25,6 +25,9 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// The neo-Hookean material instead of the lesson's: E=PA,nu=N, as for `tetlab run`.
+    #[arg(long, value_name = "E=PA,nu=N", value_parser = tetlab_core::material::Material::parse, conflicts_with = "list")]
+    material: Option<tetlab_core::material::Material>,
 }
 
 /// Whether every expected observation of the lesson was observed.
@@ -72,7 +75,10 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
         return Ok(Outcome::Observed);
     }
     let spec = args.lesson.as_deref().expect("clap requires a lesson");
-    let lesson = Lesson::find(spec).map_err(|e| UsageError(e.to_string()))?;
+    let mut lesson = Lesson::find(spec).map_err(|e| UsageError(e.to_string()))?;
+    if let Some(material) = args.material {
+        lesson.settings.set_material(material);
+    }
     let mut run = LessonRun::new(&lesson);
     super::simulation_args::warn_if_unstable(&run.simulation);
     let frames: u64 = lesson.steps.iter().map(|s| s.frames).sum();
