@@ -427,16 +427,28 @@ impl Family {
 
     /// The groups of families as the command line and the workbench show them, in table order:
     /// each group's name and its families (`neohookean`: both neo-Hookean families).
+    ///
+    /// ```
+    /// use tetlab_core::constraints::Family;
+    /// let names: Vec<&str> = Family::groups().map(|(name, _)| name).collect();
+    /// assert_eq!(names, ["edges", "height", "volume", "neohookean"]);
+    /// let (_, pair) = Family::groups().last().unwrap();
+    /// assert_eq!(pair.families().count(), 2);
+    /// ```
     pub fn groups() -> impl Iterator<Item = (&'static str, PerFamily<bool>)> {
-        let mut names: Vec<&'static str> = Vec::new();
-        for family in Family::all() {
-            if !names.contains(&family.row().group) {
-                names.push(family.row().group);
-            }
-        }
-        names
-            .into_iter()
-            .map(|name| (name, PerFamily::from_fn(|f| f.row().group == name)))
+        // A group is named where its first family stands; nothing is allocated (the panels ask
+        // every frame).
+        Family::all()
+            .filter(|&family| {
+                let group = family.row().group;
+                Family::all()
+                    .take_while(|&earlier| earlier != family)
+                    .all(|earlier| earlier.row().group != group)
+            })
+            .map(|first| {
+                let name = first.row().group;
+                (name, PerFamily::from_fn(|f| f.row().group == name))
+            })
     }
 }
 
