@@ -32,15 +32,15 @@ print("| %s | %d | %s | %s, %d | %d | %.3f | %.1f | %.1f (%s) | %.0f | %s | `tet
 ' "$args"
 }
 
-row --scene $bunny --frames 1000
-row --scene $bunny --frames 300 --reference
-row --scene $bunny --frames 300 --constraints edges,height,volume
-row --scene $bunny --frames 1000 --jacobi
-row --scene cube --resolution 6 --frames 500
-row --scene cube --resolution 13 --frames 100
-row --scene cube --resolution 26 --frames 40
-row --scene cube --resolution 26 --frames 40 --threads 2
-row --scene cube --resolution 26 --frames 10 --constraints edges,height,volume
-row --scene cube --resolution 26 --frames 40 --jacobi
-row --scene cube --resolution 55 --frames 5 --warmup 1
-row --scene cube --resolution 55 --frames 5 --warmup 1 --threads 2
+row --scene $bunny --frames 1000 --substeps 10
+row --scene $bunny --frames 300 --reference --substeps 10
+row --scene $bunny --frames 300 --constraints edges,height,volume --substeps 10
+row --scene $bunny --frames 1000 --jacobi --substeps 10
+row --scene cube --resolution 6 --frames 500 --substeps 10
+row --scene cube --resolution 13 --frames 100 --substeps 10
+row --scene cube --resolution 26 --frames 40 --substeps 10
+row --scene cube --resolution 26 --frames 40 --threads 2 --substeps 10
+row --scene cube --resolution 26 --frames 10 --constraints edges,height,volume --substeps 10
+row --scene cube --resolution 26 --frames 40 --jacobi --substeps 10
+row --scene cube --resolution 55 --frames 5 --warmup 1 --substeps 10
+row --scene cube --resolution 55 --frames 5 --warmup 1 --threads 2 --substeps 10

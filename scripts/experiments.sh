@@ -29,7 +29,7 @@ def option(name, default):
     words = args.split()
     return words[words.index(name) + 1] if name in words else default
 constraints = option("--constraints", "edges,volume").replace(",", "+")
-steps = option("--substeps", "10") + " × " + option("--iterations", "1")
+steps = option("--substeps", "100") + " × " + option("--iterations", "1")
 print("| {} | {} | {} of {} | {} | {:.3g} | {:.2e} | {:.2e} | `tetlab run {}` |".format(
     constraints, steps, last["inverted_tets"], first["tets"],
     inverted[-1] if inverted else "none", last["min_volume_ratio"] + 0.0, last["volume_error"],
@@ -40,25 +40,25 @@ print("| {} | {} | {} of {} | {} | {:.3g} | {:.2e} | {:.2e} | `tetlab run {}` |"
 families="edges height volume edges,volume edges,height height,volume edges,height,volume"
 
 header "1. One tet, vertex 0 reflected through its opposite face (\`--perturb invert\`), 300 frames"
-for c in $families; do row --scene tet --perturb invert --constraints $c; done
+for c in $families; do row --scene tet --perturb invert --constraints $c --substeps 10; done
 
 header "2. One tet, inverted, no gravity (\`--gravity 0\`)"
-for c in $families; do row --scene tet --perturb invert --constraints $c --gravity 0; done
+for c in $families; do row --scene tet --perturb invert --constraints $c --gravity 0 --substeps 10; done
 
 header "3. Cube 4×4×4 (384 tets) mirrored: every tet inverted, every edge length kept"
-for c in $families; do row --scene cube --perturb mirror --constraints $c; done
+for c in $families; do row --scene cube --perturb mirror --constraints $c --substeps 10; done
 
 header "4. Cube 4×4×4 flattened onto the ground: every tet flat"
-for c in $families; do row --scene cube --perturb flatten --constraints $c; done
+for c in $families; do row --scene cube --perturb flatten --constraints $c --substeps 10; done
 
 header "5. Cube 4×4×4 at rest under gravity: does a family alone hold the shape?"
-for c in edges height volume; do row --scene cube --constraints $c; done
+for c in edges height volume; do row --scene cube --constraints $c --substeps 10; done
 
 header "6. Bunny flattened, rigid edges (compliance 0), gravity 10"
 for s in 1 10; do for c in $families; do row --scene $bunny --perturb flatten --gravity 10 --constraints $c --substeps $s; done; done
 
 header "7. Bunny mirrored, rigid edges, gravity 10"
-for c in $families; do row --scene $bunny --perturb mirror --gravity 10 --constraints $c; done
+for c in $families; do row --scene $bunny --perturb mirror --gravity 10 --constraints $c --substeps 10; done
 
 header "8. The headline: bunny flattened with the teaching demo's soft edges (compliance 0.1 at density 1000, its 100 at density 1), gravity 10"
 for s in 1 2 5 10; do for c in edges,volume edges,height,volume; do
@@ -66,7 +66,7 @@ for s in 1 2 5 10; do for c in edges,volume edges,height,volume; do
 done; done
 
 header "9. Bunny resting on the ground, soft edges as in the demo"
-for c in edges,volume edges,height,volume; do row --scene $bunny --gravity 10 --compliance edges=0.1 --constraints $c; done
+for c in edges,volume edges,height,volume; do row --scene $bunny --gravity 10 --compliance edges=0.1 --constraints $c --substeps 10; done
 
 header "10. One substep: more iterations instead of substeps (bunny flattened, gravity 10)"
 for ec in 0 0.1; do for i in 1 2 5 20; do
@@ -76,12 +76,35 @@ done; done
 armadillo=../shared/meshes/armadillo_4k.node
 materials="edges,volume edges,height,volume neohookean neohookean,height"
 
-header "11. Inversion: the neo-Hookean family (E = 1 MPa, ν = 0.3, the default material) against the geometric ones, 30 substeps"
-for c in $materials; do row --scene cube --perturb mirror --constraints $c --substeps 30; done
-for c in $materials; do row --scene cube --perturb flatten --constraints $c --substeps 30; done
-for c in $materials; do row --scene $bunny --perturb flatten --gravity 10 --constraints $c --substeps 30; done
-for c in $materials; do row --scene $bunny --perturb mirror --gravity 10 --constraints $c --substeps 30; done
-for c in $materials; do row --scene $armadillo --gravity 10 --constraints $c --substeps 30 --frames 600; done
+# inversion_row ARGS...: one row of table 11, with the inverted tets over time.
+inversion_row() {
+  local args="$*"
+  "$tetlab" run $args --json | python3 -c '
+import json, sys
+args = sys.argv[1]
+frames = [json.loads(line) for line in sys.stdin]
+first, last = frames[0], frames[-1]
+inverted = [f["frame"] for f in frames if f["inverted_tets"] > 0]
+words = args.split()
+constraints = words[words.index("--constraints") + 1].replace(",", "+")
+marks = [m for m in (1, 3, 10, 30, 100, 300) if m < last["frame"]] + [last["frame"]]
+curve = " / ".join(str(frames[m]["inverted_tets"]) for m in marks)
+print("| {} | {} | {} | {} | {:.3g} | {:.2e} | `tetlab run {}` |".format(
+    constraints, first["tets"], curve, inverted[-1] if inverted else "none",
+    last["min_volume_ratio"] + 0.0, last["max_edge_strain"], args))
+' "$args"
+}
+
+echo
+echo "### 11. Inversion: the neo-Hookean family (E = 1 MPa, ν = 0.3, the default material) against the geometric ones, 30 substeps"
+echo
+echo "| constraints | tets | inverted at frames 1 / 3 / 10 / 30 / 100 / 300 (/ 600) | last frame with an inverted tet | min V/V₀ at the end | max edge strain at the end | command |"
+echo "| --- | --- | --- | --- | --- | --- | --- |"
+for c in $materials; do inversion_row --scene cube --perturb mirror --constraints $c --substeps 30; done
+for c in $materials; do inversion_row --scene cube --perturb flatten --constraints $c --substeps 30; done
+for c in $materials; do inversion_row --scene $bunny --perturb flatten --gravity 10 --constraints $c --substeps 30; done
+for c in $materials; do inversion_row --scene $bunny --perturb mirror --gravity 10 --constraints $c --substeps 30; done
+for c in $materials; do inversion_row --scene $armadillo --gravity 10 --constraints $c --substeps 30 --frames 600; done
 
 header "12. How stiff a material the substeps allow: the cube at rest under gravity, neo-Hookean, 300 frames"
 for e in 1e6 1e7 1e8 1e9; do for s in 10 30 100; do
@@ -90,7 +113,7 @@ done; done
 
 header "13. Iterations and the stiffness a material shows: the cube damped to rest (damping 20), volume error = sag"
 for m in xpbd pbd; do for i in 1 4 16; do for e in 2.5e6 1e7; do
-  row --scene cube --constraints neohookean --material E=$e,nu=0.3 --damping 20 --solver $m --iterations $i
+  row --scene cube --constraints neohookean --material E=$e,nu=0.3 --damping 20 --solver $m --iterations $i --substeps 10
 done; done; done
 
 # beam_row ARGS...: a cantilever run, its tip deflection against Euler–Bernoulli.
@@ -110,7 +133,7 @@ E, rho, g, L, h = float(material["E"]), 1000.0, 9.81, 2.0, 0.5
 theory = 1.5 * rho * g * L**4 / (E * h**2)
 print("| {} | {} | {} | {} × {} | {:.4f} | {:.4f} | {:.3f} | `tetlab run {}` |".format(
     option("--resolution", "4"), first["tets"], option("--solver", "xpbd"),
-    option("--substeps", "10"), option("--iterations", "1"),
+    option("--substeps", "100"), option("--iterations", "1"),
     last["max_displacement"], theory, last["max_displacement"] / theory, args))
 ' "$args"
 }
@@ -124,3 +147,33 @@ beam="--scene beam --constraints neohookean --material E=1e7,nu=0.3 --damping 10
 for r in 1 2 4; do beam_row $beam --resolution $r --substeps 40 --iterations 4; done
 for m in xpbd pbd; do for i in 1 4 16; do beam_row $beam --resolution 2 --substeps 20 --iterations $i --solver $m; done; done
 for s in 10 20 40; do beam_row $beam --resolution 2 --substeps $s --iterations 4; done
+
+# defaults_row ARGS...: a scene under the defaults (or the substeps given), 10 s.
+defaults_row() {
+  local args="$*"
+  "$tetlab" run $args --frames 600 --json | python3 -c '
+import json, sys
+args = sys.argv[1]
+frames = [json.loads(line) for line in sys.stdin]
+first, last = frames[0], frames[-1]
+inverted = [f["frame"] for f in frames if f["inverted_tets"] > 0]
+words = args.split()
+scene = words[words.index("--scene") + 1].split("/")[-1]
+steps = words[words.index("--substeps") + 1] if "--substeps" in words else "100 (default)"
+worst = max(frames, key=lambda f: f["max_edge_strain"])
+print("| {} | {} | {} | {} | {} | {:.3f} (frame {}) | {:.4f} | `tetlab run {} --frames 600` |".format(
+    scene, first["tets"], steps, last["inverted_tets"], inverted[-1] if inverted else "none",
+    worst["max_edge_strain"], worst["frame"], last["max_edge_strain"], args))
+' "$args"
+}
+
+echo
+echo "### 15. Every scene under the defaults (edges + volume, rigid, gravity 9.81, 100 substeps), 10 s; then fewer substeps"
+echo
+echo "| scene | tets | substeps | inverted at the end | last frame with an inverted tet | largest edge strain during the run | edge strain at the end | command |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
+for s in tet cube beam ball $bunny $armadillo ../shared/meshes/ball_v41.msh ../shared/meshes/ball_v22.msh ../shared/meshes/beam_v41.msh; do
+  defaults_row --scene $s
+done
+for s in 10 30 50 60 80; do defaults_row --scene $armadillo --substeps $s; done
+for s in 10 30 50; do defaults_row --scene ../shared/meshes/ball_v41.msh --substeps $s; done

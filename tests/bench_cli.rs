@@ -6,6 +6,7 @@ mod support;
 
 use serde_json::Value;
 use support::{assert_usage_error, stderr, stdout, tetlab};
+use tetlab_core::solver::DEFAULT_SUBSTEPS;
 
 fn bench_json(args: &[&str]) -> Value {
     let mut all = vec!["bench", "--json"];
@@ -36,8 +37,8 @@ fn the_report_counts_the_work_of_a_frame() {
         assert_eq!(tets, 162);
         assert_eq!(
             report["projections_per_frame"].as_u64().unwrap(),
-            (edges + tets) * 10,
-            "edges + volume, 10 substeps of 1 iteration"
+            (edges + tets) * DEFAULT_SUBSTEPS as u64,
+            "edges + volume, the default substeps of 1 iteration"
         );
         for key in [
             "ns_per_projection",
@@ -104,7 +105,7 @@ fn the_heights_are_counted_and_timed_on_their_own() {
     let edges = report["edges"].as_u64().unwrap();
     assert_eq!(
         report["projections_per_frame"].as_u64().unwrap(),
-        (edges + 4 * tets + tets) * 10
+        (edges + 4 * tets + tets) * DEFAULT_SUBSTEPS as u64
     );
     let by_family = &report["ns_per_projection_by_family"];
     for family in ["edges", "height", "volume"] {

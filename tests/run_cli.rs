@@ -72,7 +72,9 @@ fn the_defaults_are_those_documented() {
         "{text}"
     );
     assert!(
-        text.contains("xpbd, edges+volume, 10 substeps x 1 iteration, dt 0.016667 s, gravity 9.81"),
+        text.contains(
+            "xpbd, edges+volume, 100 substeps x 1 iteration, dt 0.016667 s, gravity 9.81"
+        ),
         "{text}"
     );
 }

@@ -108,6 +108,7 @@ fn frame(c: &mut Criterion) {
     };
     let settings = Settings {
         active: PerFamily::parse_list("edges,volume").expect("two families"),
+        substeps: 10,
         ..Settings::default()
     };
     let simulation = Simulation::new(&scene, settings);

@@ -47,16 +47,16 @@ pub struct SolverArgs {
     #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
     pub solver: Method,
     /// Substeps per frame (1..=1000).
-    #[arg(long, default_value_t = 10, value_parser = |s: &str| limits::SUBSTEPS.parse(s), allow_hyphen_values = true)]
+    #[arg(long, default_value_t = Settings::default().substeps, value_parser = |s: &str| limits::SUBSTEPS.parse(s), allow_hyphen_values = true)]
     pub substeps: u32,
     /// Gauss–Seidel iterations per substep (1..=1000).
-    #[arg(long, default_value_t = 1, value_parser = |s: &str| limits::ITERATIONS.parse(s), allow_hyphen_values = true)]
+    #[arg(long, default_value_t = Settings::default().iterations, value_parser = |s: &str| limits::ITERATIONS.parse(s), allow_hyphen_values = true)]
     pub iterations: u32,
     /// Frame length in seconds (1e-6 <= dt <= 1).
-    #[arg(long, default_value_t = 1.0 / 60.0, value_parser = |s: &str| limits::DT.parse(s), allow_hyphen_values = true)]
+    #[arg(long, default_value_t = Settings::default().dt, value_parser = |s: &str| limits::DT.parse(s), allow_hyphen_values = true)]
     pub dt: f64,
     /// Gravity along −y in m/s² (-1e6..=1e6); 0 turns gravity and the ground off.
-    #[arg(long, default_value_t = 9.81, value_parser = |s: &str| limits::GRAVITY.parse(s), allow_hyphen_values = true)]
+    #[arg(long, default_value_t = Settings::default().gravity, value_parser = |s: &str| limits::GRAVITY.parse(s), allow_hyphen_values = true)]
     pub gravity: f64,
     /// XPBD compliance of a family, FAMILY=α (0 <= α <= 1e10; 0 is rigid, the default);
     /// repeatable.
@@ -66,7 +66,7 @@ pub struct SolverArgs {
     #[arg(long, value_name = "FAMILY=k", value_parser = |s: &str| limits::family_value(s, &limits::STIFFNESS))]
     pub stiffness: Vec<(Family, f64)>,
     /// Velocity damping per second (0..=1e6).
-    #[arg(long, default_value_t = 0.0, value_parser = |s: &str| limits::DAMPING.parse(s), allow_hyphen_values = true)]
+    #[arg(long, default_value_t = Settings::default().damping, value_parser = |s: &str| limits::DAMPING.parse(s), allow_hyphen_values = true)]
     pub damping: f64,
     /// The material of the neohookean family: Young's modulus E in Pa (1e-3..=1e13) and
     /// Poisson's ratio nu (0 <= nu < 0.5), both required; gives its compliances 1/μ and 1/λ
@@ -100,7 +100,7 @@ impl SolverArgs {
         settings
     }
 
-    /// "xpbd, edges+volume, 10 substeps × 1 iteration, dt 0.016667 s, gravity 9.81" and any
+    /// "xpbd, edges+volume, 100 substeps × 1 iteration, dt 0.016667 s, gravity 9.81" and any
     /// non-default compliance or stiffness.
     pub fn describe(&self) -> String {
         let s = self.settings();

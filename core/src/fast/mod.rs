@@ -659,7 +659,8 @@ mod tests {
         let simulation = cube(4, PerFamily::parse_list("edges,volume").unwrap());
         let mut fast = FastSimulation::new(&simulation, 1);
         let count = |f| simulation.constraint_count(f) as u64;
-        let per_frame = (count(Family::EDGES) + count(Family::VOLUME)) * 10;
+        let substeps = simulation.settings().substeps as u64;
+        let per_frame = (count(Family::EDGES) + count(Family::VOLUME)) * substeps;
         assert_eq!(fast.projections_per_frame(), per_frame);
         fast.step();
         let t = fast.timings();

@@ -14,8 +14,8 @@
 //!
 //! The correction Δp of a substep is, per particle, the position after the sweeps minus the
 //! predicted one ([`Simulation::corrections`]). An edit (a perturbation, a particle placed by hand)
-//! settles until the largest Δp of a substep is below [`Simulation::settle_tolerance`], or for at
-//! most [`MAX_SETTLE_FRAMES`] frames.
+//! settles until no particle's Δp, summed over a frame's substeps, exceeds
+//! [`Simulation::settle_tolerance`], or for at most [`MAX_SETTLE_FRAMES`] frames.
 //!
 //! Each constraint is projected by the rule of [`crate::projection`] (XPBD or PBD), which the
 //! fast solver shares. All state lives in flat arrays, one [`ConstraintSet`] per family,
@@ -32,7 +32,7 @@ mod settings;
 
 pub use constraint_set::ConstraintSet;
 pub use masses::DENSITY;
-pub use settings::{Method, Settings};
+pub use settings::{DEFAULT_SUBSTEPS, Method, Settings};
 
 use crate::constraints::{Constraint, Family, PerFamily, Visit, distance};
 use crate::divergence::Divergence;
@@ -49,9 +49,16 @@ pub const SOUND_LIMIT: f64 = 1e30;
 /// The longest an edit settles, in frames (one second at 60 frames per second).
 pub const MAX_SETTLE_FRAMES: u32 = 60;
 
-/// An edit has settled when no particle is corrected by more than this fraction of the mean rest
-/// edge length in a substep (plus what gravity alone causes; see [`Simulation::settle_tolerance`]).
-pub const SETTLE_FRACTION: f64 = 1e-3;
+/// An edit has settled when the speed the corrections of a frame would give a particle, ΣΔp / h
+/// over its substeps, is at most this many mean rest edge lengths per second (plus what gravity
+/// alone causes; see [`Simulation::settle_tolerance`]).
+///
+/// Why a frame's sum, as a speed: each substep's Δp adds Δp / h to the velocity once settling
+/// ends, so what is released is the sum, divided by h. The first rule, the largest Δp of the last
+/// substep below 10⁻³ of an edge, held at 10 substeps (where it is about this bound); at 100 a
+/// cube still being unmirrored at capped speed passed it (4 × 10⁻⁵ m a substep, a hundred
+/// substeps a frame) and took off at 2.6 m/s.
+pub const SETTLE_SPEED: f64 = 6.0;
 
 /// A particle held by the user.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,6 +91,8 @@ pub struct Simulation {
     grab: Option<Grab>,
     /// Δp of the last substep; during a substep, the predicted positions.
     corrections: Vec<DVec3>,
+    /// The sum of Δp over the substeps of the frame so far, the measure of "settled".
+    frame_corrections: Vec<DVec3>,
     /// The mean rest edge length, the scale of "settled".
     mean_edge: f64,
     /// Frames an edit has been settling, `None` when none is; see [`Settings::settle_edits`].
@@ -124,6 +133,7 @@ impl Simulation {
             sets,
             grab: None,
             corrections: vec![DVec3::ZERO; n],
+            frame_corrections: vec![DVec3::ZERO; n],
             mean_edge,
             settling: None,
             frame: 0,
@@ -175,12 +185,24 @@ impl Simulation {
         self.settling.is_some()
     }
 
-    /// The largest Δp per substep, in metres, at which an edit counts as settled:
-    /// [`SETTLE_FRACTION`] × the mean rest edge length, plus g h², the correction that gravity
-    /// alone causes in a body at rest on the ground.
+    /// The largest sum of Δp over a frame's substeps, in metres, at which an edit counts as
+    /// settled: [`SETTLE_SPEED`] × the mean rest edge length × h, plus g h Δt, the sum of the
+    /// g h² a substep that gravity alone causes in a body at rest on the ground.
+    ///
+    /// ```
+    /// use tetlab_core::scene::{Builtin, Scene};
+    /// use tetlab_core::solver::{Settings, Simulation};
+    /// let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
+    /// let at = |substeps| {
+    ///     let settings = Settings { substeps, gravity: 0.0, ..Settings::default() };
+    ///     Simulation::new(&scene, settings).settle_tolerance()
+    /// };
+    /// // The same speed at any substep count: ten times the substeps, a tenth of the length.
+    /// assert!((at(10) / at(100) - 10.0).abs() < 1e-9);
+    /// ```
     pub fn settle_tolerance(&self) -> f64 {
-        let h = self.settings.dt / self.settings.substeps.max(1) as f64;
-        SETTLE_FRACTION * self.mean_edge + self.settings.gravity.abs() * h * h
+        let h = self.substep_length();
+        (SETTLE_SPEED * self.mean_edge + self.settings.gravity.abs() * self.settings.dt) * h
     }
 
     /// Inverse masses in use (0 for pinned or grabbed-rigidly particles).
@@ -235,6 +257,7 @@ impl Simulation {
             + bytes(&self.lumped_inverse_masses)
             + bytes(&self.tets)
             + bytes(&self.corrections)
+            + bytes(&self.frame_corrections)
             + self
                 .sets
                 .iter_ref()
@@ -276,6 +299,7 @@ impl Simulation {
         self.previous[i] = position;
         self.velocities[i] = DVec3::ZERO;
         self.corrections[i] = DVec3::ZERO;
+        self.frame_corrections[i] = DVec3::ZERO;
         self.settling = Some(0);
     }
 
@@ -293,6 +317,7 @@ impl Simulation {
         self.previous.copy_from_slice(&self.positions);
         self.velocities.fill(DVec3::ZERO);
         self.corrections.fill(DVec3::ZERO);
+        self.frame_corrections.fill(DVec3::ZERO);
         for family in Family::all() {
             self.sets[family].reset_lambda();
         }
@@ -354,6 +379,7 @@ impl Simulation {
     /// Advances one frame: `substeps` substeps of Δt / substeps.
     pub fn step(&mut self) {
         self.update_inverse_masses();
+        self.frame_corrections.fill(DVec3::ZERO);
         for _ in 0..self.settings.substeps.max(1) {
             self.substep();
         }
@@ -362,7 +388,7 @@ impl Simulation {
             grab.target_at_last_step = grab.target;
         }
         if let Some(frames) = self.settling {
-            let largest = self.largest_correction();
+            let largest = self.largest_frame_correction();
             self.settling = (self.settings.edits_settle()
                 && largest > self.settle_tolerance()
                 && frames + 1 < MAX_SETTLE_FRAMES)
@@ -414,8 +440,14 @@ impl Simulation {
     /// The last part of a substep: Δp = x − predicted x, then velocities from the positions.
     pub fn end_substep(&mut self) {
         let h = self.substep_length();
-        for (correction, p) in self.corrections.iter_mut().zip(&self.positions) {
+        for ((correction, sum), p) in self
+            .corrections
+            .iter_mut()
+            .zip(&mut self.frame_corrections)
+            .zip(&self.positions)
+        {
             *correction = *p - *correction;
+            *sum += *correction;
         }
         self.update_velocities(h, self.settings.edits_settle() && self.settling.is_some());
     }
@@ -555,8 +587,8 @@ impl Simulation {
     }
 
     /// The longest Δp of the last substep among particles that can move.
-    fn largest_correction(&self) -> f64 {
-        self.corrections
+    fn largest_frame_correction(&self) -> f64 {
+        self.frame_corrections
             .iter()
             .zip(&self.inverse_masses)
             .filter(|(_, w)| **w > 0.0)

@@ -38,7 +38,12 @@ pub fn show(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
             }
         });
     }
-    ui.add(egui::Slider::new(&mut settings.substeps, 1..=50).text("substeps"));
+    ui.add(
+        egui::Slider::new(&mut settings.substeps, 1..=400)
+            .logarithmic(true)
+            .text("substeps"),
+    )
+    .on_hover_text("Rigid constraints converge as the substeps get shorter");
     ui.add(egui::Slider::new(&mut settings.iterations, 1..=20).text("iterations"));
     ui.add(egui::Slider::new(&mut settings.gravity, 0.0..=20.0).text("gravity"));
     ui.checkbox(&mut settings.ground, "ground (y = 0)");
