@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Runs every fuzz target of fuzz/ (cargo-fuzz on libFuzzer, on the stable toolchain), each seeded
 # from real files: the meshes of ../shared/meshes (when present) and assets/meshes, the lessons
-# of assets/lessons, and recordings tetlab writes. Prints, per target, the executions, the time
-# and the crashes; a crash's input is kept in fuzz/artifacts/TARGET/ and the run fails.
+# of assets/lessons, the constraint files of assets/constraints, and recordings tetlab writes.
+# Prints, per target, the executions, the time and the crashes; a crash's input is kept in
+# fuzz/artifacts/TARGET/ and the run fails.
 #
 # Usage: scripts/fuzz.sh [--seconds S | --runs N] [TARGET...]
 #   --seconds S   run each target for S seconds (default 60)
 #   --runs N      run each target for N executions
-#   TARGET        tetgen, gmsh_v22, gmsh_v41, lesson, rrd (default: all)
+#   TARGET        tetgen, gmsh_v22, gmsh_v41, lesson, rrd, constraint_file (default: all)
 # The corpus grows in $TETLAB_FUZZ_CORPUS (default /var/tmp/tetlab-fuzz-corpus), outside the
 # repository, so later runs start where earlier ones stopped; the instrumented build lives in
 # $TETLAB_FUZZ_TARGET (default /var/tmp/tetlab-fuzz-target), so later runs reuse it.
@@ -24,7 +25,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(tetgen gmsh_v22 gmsh_v41 lesson rrd)
+[ ${#targets[@]} -gt 0 ] || targets=(tetgen gmsh_v22 gmsh_v41 lesson rrd constraint_file)
 
 # cargo-fuzz of a version that builds with this toolchain, when missing.
 fuzz_version=0.13.1
@@ -66,6 +67,8 @@ seed() {
       fi ;;
     lesson)
       cp assets/lessons/*.toml "$dir/" ;;
+    constraint_file)
+      cp assets/constraints/*.toml "$dir/" ;;
     rrd)
       cargo run --quiet --locked -- record --scene tet --frames 2 --arrows none --quiet --out "$dir/tet.rrd" >/dev/null
       cargo run --quiet --locked -- record --scene cube --resolution 1 --frames 1 --quiet --out "$dir/cube.rrd" >/dev/null ;;

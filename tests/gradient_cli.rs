@@ -353,3 +353,135 @@ fn the_hydrostatic_constraint_of_a_mirrored_tet() {
     ]);
     assert_usage_error(&output, "does not read a rest shape");
 }
+
+/// A constraint file from assets/constraints.
+fn asset(name: &str) -> String {
+    format!(
+        "{}/../assets/constraints/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+#[test]
+fn a_right_constraint_file_agrees_and_exits_zero() {
+    let file = asset("height.toml");
+    let output = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &file,
+        "--configs",
+        "500",
+        "--json",
+    ]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    let v: Value = serde_json::from_str(&stdout(&output)).unwrap();
+    assert_eq!(v["agrees"], true);
+    assert_eq!(v["compared"], 500);
+    for p in ["p0", "p1", "p2", "p3"] {
+        assert!(v["max_relative_error"][p].as_f64().unwrap() < 1e-12, "{v}");
+    }
+    assert_eq!(v["translation_invariant"], true);
+    assert_eq!(v["rotation_invariant"], true);
+    assert_eq!(v["reflection"], "negated");
+    assert!(v["worst"].is_null());
+}
+
+#[test]
+fn a_flipped_sign_exits_one_and_names_the_particle_and_a_command_that_shows_it() {
+    let file = asset("height-wrong-sign.toml");
+    let output = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &file,
+        "--configs",
+        "300",
+    ]);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(text.contains("p3  2.00e0  WRONG"), "{text}");
+    assert!(text.contains("p1  ") && text.contains("agrees"), "{text}");
+    let json_output = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &file,
+        "--configs",
+        "300",
+        "--json",
+    ]);
+    assert_eq!(json_output.status.code(), Some(1));
+    let v: Value = serde_json::from_str(&stdout(&json_output)).unwrap();
+    assert_eq!(v["agrees"], false);
+    let worst = &v["worst"];
+    let particle = worst["particle"].as_str().unwrap();
+    assert!(particle == "p3" || particle == "p0", "{worst}");
+    // The command printed is ready to paste: run it, and it shows the difference.
+    let command = worst["command"].as_str().unwrap();
+    let words: Vec<&str> = command.split(' ').skip(1).collect();
+    let mut args = words.clone();
+    args.push("--json");
+    let shown = json(&args);
+    let k: usize = particle[1..].parse().unwrap();
+    let automatic = vectors(&shown["automatic"])[k];
+    let yours = vectors(&shown["yours"])[k];
+    let difference: f64 = (0..3)
+        .map(|i| (automatic[i] - yours[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        difference > 0.1 * automatic.iter().map(|x| x.abs()).fold(0.0, f64::max),
+        "{shown}"
+    );
+}
+
+#[test]
+fn a_mistake_in_a_constraint_file_exits_two_at_its_line_and_column() {
+    let dir = std::env::temp_dir().join(format!("tetlab-constraint-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("mine.toml");
+    std::fs::write(
+        &path,
+        "name = \"c\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p3)\"\n",
+    )
+    .unwrap();
+    let path = path.to_str().unwrap();
+    for command in ["check-gradients", "gradient"] {
+        let mut args = vec![command, "--constraint-file", path];
+        if command == "gradient" {
+            args.extend(["--points", "0,0,0", "1,0,0"]);
+        }
+        let output = tetlab(&args);
+        assert_eq!(output.status.code(), Some(2));
+        assert!(output.stdout.is_empty());
+        let err = stderr(&output);
+        assert!(err.starts_with(&format!("error: {path}:3:22: ")), "{err}");
+        assert!(err.contains("`p3`"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The unit right-angle tet: V = 1/6, and ∇V at p1 is e2 × e3 / 6 = (1/6, 0, 0).
+#[test]
+fn gradient_of_a_constraint_file_shows_automatic_yours_and_finite_differences() {
+    let v = json(&[
+        "gradient",
+        "--constraint-file",
+        &asset("volume.toml"),
+        "--points",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0,0,1",
+        "--json",
+    ]);
+    assert!((v["value"].as_f64().unwrap() - 1.0 / 6.0).abs() < 1e-15);
+    let automatic = vectors(&v["automatic"]);
+    let yours = vectors(&v["yours"]);
+    let numeric = vectors(&v["finite_difference"]);
+    assert_eq!(automatic[1], [1.0 / 6.0, 0.0, 0.0]);
+    for k in 0..4 {
+        for i in 0..3 {
+            assert!((automatic[k][i] - yours[k][i]).abs() < 1e-15);
+            assert!((automatic[k][i] - numeric[k][i]).abs() < 1e-8);
+        }
+    }
+    assert_eq!(v["degenerate"], false);
+}

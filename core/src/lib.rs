@@ -18,8 +18,10 @@
 //! - [`limits`]: the range of every setting and the size of every scene tetlab accepts;
 //!   [`divergence`]: when a simulation's numbers stop meaning anything, and why.
 
+pub mod constraint_file;
 pub mod constraints;
 pub mod divergence;
+pub mod dual;
 pub mod fast;
 pub mod finite_difference;
 pub mod inspector;

@@ -3,7 +3,8 @@
 //! The same routine backs the test suite (which asserts the bound) and `tetlab check-gradients`
 //! (which prints the figures quoted in `docs/gradients.md`).
 
-use crate::constraints::Family;
+use crate::constraints::{Constraint, Family, Visit};
+use crate::dual::{Dual64, DualVec3};
 use crate::finite_difference::central_difference;
 use crate::random::SplitMix64;
 use glam::DVec3;
@@ -42,6 +43,28 @@ pub fn analytic_and_numeric(
     (analytic, numeric)
 }
 
+/// ∇C of `family` by forward-mode automatic differentiation ([`crate::dual`]): the family's own
+/// formula evaluated on dual numbers, once per coordinate; the rest shape is held fixed. `None`
+/// where a derivative is not finite.
+pub fn automatic_gradient(
+    family: Family,
+    points: &[DVec3],
+    rest: f64,
+    rest_shape: &[DVec3],
+) -> Option<Vec<DVec3>> {
+    struct Value<'a>(&'a [DualVec3], f64, &'a [DVec3]);
+    impl Visit for Value<'_> {
+        type Output = Dual64;
+        fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Dual64 {
+            let p: [DualVec3; N] = std::array::from_fn(|k| self.0[k]);
+            let shape: [DualVec3; N] =
+                std::array::from_fn(|k| DualVec3::seeded(self.2[k], DVec3::ZERO));
+            c.evaluate(&p, Dual64::from(self.1), &shape).value
+        }
+    }
+    crate::dual::gradient(points, |p| family.visit(Value(p, rest, rest_shape)))
+}
+
 /// Whether a configuration is far enough from degeneracy for a finite-difference comparison:
 /// no edge shorter than [`CONDITIONING`] times the longest, and for the height constraint a face
 /// (p0, p2, p3) whose edges meet at a sine of at least [`CONDITIONING`].
@@ -77,6 +100,9 @@ pub struct Report {
     pub max_relative_error: f64,
     /// The mean [`relative_error`].
     pub mean_relative_error: f64,
+    /// The largest [`relative_error`] of the analytic gradient against automatic differentiation
+    /// ([`automatic_gradient`]), on the same configurations.
+    pub max_automatic_error: f64,
 }
 
 /// Draws configurations until `samples` well-conditioned ones have been compared: points uniform
@@ -86,7 +112,7 @@ pub struct Report {
 pub fn random_check(family: Family, samples: usize, seed: u64) -> Report {
     let mut rng = SplitMix64::new(seed);
     let (mut compared, mut skipped) = (0, 0);
-    let (mut max_error, mut sum_error) = (0.0_f64, 0.0);
+    let (mut max_error, mut sum_error, mut max_automatic) = (0.0_f64, 0.0, 0.0_f64);
     while compared < samples {
         let size = 10f64.powf(rng.range(-2.0, 2.0));
         let centre = rng.in_cube(size);
@@ -109,6 +135,9 @@ pub fn random_check(family: Family, samples: usize, seed: u64) -> Report {
         let (analytic, numeric) = analytic_and_numeric(family, &points, rest, &rest_shape);
         let error = relative_error(&analytic, &numeric);
         max_error = max_error.max(error);
+        if let Some(automatic) = automatic_gradient(family, &points, rest, &rest_shape) {
+            max_automatic = max_automatic.max(relative_error(&analytic, &automatic));
+        }
         sum_error += error;
         compared += 1;
     }
@@ -122,5 +151,6 @@ pub fn random_check(family: Family, samples: usize, seed: u64) -> Report {
         } else {
             0.0
         },
+        max_automatic_error: max_automatic,
     }
 }

@@ -4,7 +4,10 @@ use super::{UsageError, args};
 use glam::DVec3;
 use serde::Serialize;
 use std::io::Write;
+use std::path::PathBuf;
+use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::Family;
+use tetlab_core::finite_difference::central_difference;
 use tetlab_core::verify::{analytic_and_numeric, max_abs_error};
 
 /// Options of `tetlab gradient`.
@@ -12,8 +15,12 @@ use tetlab_core::verify::{analytic_and_numeric, max_abs_error};
 pub struct Args {
     /// The constraint family: edges (2 points: distance), height (4: height of p1 above the
     /// plane of p0, p2, p3) or volume (4: signed volume). `distance` and `plane` are aliases.
-    #[arg(long, value_parser = Family::parse)]
-    constraint: Family,
+    #[arg(long, value_parser = Family::parse, required_unless_present = "constraint_file", conflicts_with = "constraint_file")]
+    constraint: Option<Family>,
+    /// A constraint file (assets/constraints/*.toml) instead of a built-in family: C, its
+    /// gradient by automatic differentiation, the file's own, and central differences.
+    #[arg(long, value_name = "FILE")]
+    constraint_file: Option<PathBuf>,
     /// The particles in the constraint's order, each X,Y,Z; negative numbers are fine.
     #[arg(long, value_name = "X,Y,Z", num_args = 1.., required = true, value_parser = args::point)]
     points: Vec<DVec3>,
@@ -43,7 +50,9 @@ struct Output {
 
 /// Evaluates the constraint and writes the result to `out`.
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
-    let family = args.constraint;
+    let Some(family) = args.constraint else {
+        return run_file(args, out);
+    };
     if args.points.len() != family.arity() {
         return Err(UsageError(format!(
             "--points: the {} constraint takes {} points, got {}",
@@ -147,4 +156,117 @@ fn write_table(family: Family, o: &Output, out: &mut impl Write) -> std::io::Res
 
 fn triple(v: &[f64; 3]) -> String {
     format!("({:>13.6e},{:>13.6e},{:>13.6e})", v[0], v[1], v[2])
+}
+
+/// What `--constraint-file --json` prints.
+#[derive(Debug, Serialize)]
+struct FileOutput {
+    constraint_file: String,
+    name: String,
+    value: f64,
+    rest: f64,
+    /// ∇C by automatic differentiation; null where it is undefined.
+    automatic: Option<Vec<[f64; 3]>>,
+    /// The file's gradient per particle; null where it gives none or it is undefined.
+    yours: Vec<Option<[f64; 3]>>,
+    /// Whether the file gives a gradient for each particle.
+    given: Vec<bool>,
+    finite_difference: Vec<[f64; 3]>,
+    degenerate: bool,
+}
+
+fn run_file(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
+    let path = args
+        .constraint_file
+        .as_ref()
+        .expect("clap requires one of the two");
+    let file = ConstraintFile::load(path).map_err(|e| UsageError(e.to_string()))?;
+    if args.points.len() != file.arity() {
+        return Err(UsageError(format!(
+            "--points: {} applies to {} points, got {}",
+            path.display(),
+            file.arity(),
+            args.points.len()
+        )));
+    }
+    if !args.rest_shape.is_empty() {
+        return Err(UsageError(
+            "--rest-shape: a constraint file's rest value is given by --rest".into(),
+        ));
+    }
+    let evaluation = file.evaluate(&args.points, args.rest);
+    let numeric = central_difference(&args.points, |p| file.value(p, args.rest));
+    let finite = |v: &DVec3| v.is_finite();
+    let output = FileOutput {
+        constraint_file: path.display().to_string(),
+        name: file.name.clone(),
+        value: evaluation.value,
+        rest: args.rest,
+        automatic: evaluation
+            .automatic
+            .as_ref()
+            .map(|g| g.iter().map(|&v| without_negative_zero(v)).collect()),
+        yours: evaluation
+            .yours
+            .iter()
+            .map(|g| g.filter(finite).map(without_negative_zero))
+            .collect(),
+        given: (0..file.arity()).map(|k| file.gives_gradient(k)).collect(),
+        finite_difference: numeric
+            .iter()
+            .map(|&v| without_negative_zero(if v.is_finite() { v } else { DVec3::ZERO }))
+            .collect(),
+        degenerate: evaluation.automatic.is_none(),
+    };
+    let written = if args.json {
+        serde_json::to_writer(&mut *out, &output)
+            .map_err(std::io::Error::from)
+            .and_then(|()| writeln!(out))
+    } else {
+        write_file_table(&output, out)
+    };
+    written.map_err(UsageError::stdout)
+}
+
+fn write_file_table(o: &FileOutput, out: &mut impl Write) -> std::io::Result<()> {
+    writeln!(out, "constraint  {} ({})", o.name, o.constraint_file)?;
+    if o.value.is_finite() {
+        writeln!(out, "C           {}", o.value)?;
+    } else {
+        writeln!(out, "C           undefined here")?;
+    }
+    writeln!(out, "rest        {}", o.rest)?;
+    writeln!(
+        out,
+        "degenerate  {}",
+        if o.degenerate {
+            "yes: the gradient is undefined here (a length or normalisation of a zero vector, or a division by zero)"
+        } else {
+            "no"
+        }
+    )?;
+    writeln!(out)?;
+    writeln!(
+        out,
+        "{:<9}{:<46}{:<46}∇C central difference",
+        "particle", "∇C automatic differentiation", "∇C yours"
+    )?;
+    for (i, numeric) in o.finite_difference.iter().enumerate() {
+        let automatic = o
+            .automatic
+            .as_ref()
+            .map_or_else(|| "undefined".to_owned(), |g| triple(&g[i]));
+        let yours = match (&o.yours[i], o.given[i]) {
+            (Some(g), _) => triple(g),
+            (None, true) => "undefined".to_owned(),
+            (None, false) => "not given".to_owned(),
+        };
+        writeln!(
+            out,
+            "{:<9}{automatic:<46}{yours:<46}{}",
+            format!("p{i}"),
+            triple(numeric)
+        )?;
+    }
+    Ok(())
 }

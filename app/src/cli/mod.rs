@@ -86,7 +86,11 @@ pub fn main() -> ExitCode {
     };
     let outcome = match command {
         Command::Gradient(args) => gradient::run(&args, &mut stdout),
-        Command::CheckGradients(args) => check_gradients::run(&args, &mut stdout),
+        Command::CheckGradients(args) => check_gradients::run(&args, &mut stdout).map(|agrees| {
+            if !agrees {
+                success = ExitCode::FAILURE;
+            }
+        }),
         Command::Run(args) => run::run(&args, &mut stdout),
         Command::Bench(args) => bench::run(&args, &mut stdout),
         #[cfg(not(target_arch = "wasm32"))]

@@ -1,0 +1,187 @@
+//! The constraint files of assets/constraints: each loads, and its gradient is checked against
+//! automatic differentiation as `tetlab check-gradients --constraint-file` checks it.
+
+use std::path::{Path, PathBuf};
+use tetlab_core::constraint_file::ConstraintFile;
+use tetlab_core::constraint_file::check::{Reflection, check};
+
+fn asset(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/constraints")
+        .join(name)
+}
+
+fn load(name: &str) -> ConstraintFile {
+    ConstraintFile::load(&asset(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn the_source_notes_height_agrees_with_automatic_differentiation() {
+    let report = check(&load("height.toml"), 2000, 1);
+    assert_eq!(report.compared, 2000);
+    assert!(report.agrees(), "{report:?}");
+    assert!(
+        report.translation_invariant() && report.rotation_invariant(),
+        "{report:?}"
+    );
+    assert_eq!(report.reflection, Reflection::Negated);
+    assert!(report.automatic_vs_finite_difference < 1e-5, "{report:?}");
+}
+
+#[test]
+fn the_signed_volume_agrees_and_is_negated_by_a_reflection() {
+    let report = check(&load("volume.toml"), 2000, 2);
+    assert!(report.agrees(), "{report:?}");
+    assert!(report.translation_invariant() && report.rotation_invariant());
+    assert_eq!(report.reflection, Reflection::Negated);
+}
+
+#[test]
+fn the_volume_gradient_without_its_sixth_is_reported() {
+    let report = check(&load("volume-without-sixth.toml"), 500, 3);
+    assert!(!report.agrees());
+    // Six times too large: the error is 5 × the gradient's largest component, at most 5 |∇C|.
+    let worst = report.worst.expect("a worst configuration");
+    assert!(
+        worst.relative_error > 4.0 && worst.relative_error < 5.0 + 1e-9,
+        "{worst:?}"
+    );
+    for error in report.max_relative_error.iter().flatten() {
+        assert!(*error > 1.0);
+    }
+}
+
+#[test]
+fn the_edge_agrees_and_a_reflection_leaves_it_unchanged() {
+    let report = check(&load("edge.toml"), 2000, 4);
+    assert!(report.agrees(), "{report:?}");
+    assert_eq!(report.max_relative_error.len(), 2);
+    assert_eq!(report.reflection, Reflection::Unchanged);
+    assert!(report.translation_invariant() && report.rotation_invariant());
+}
+
+#[test]
+fn the_triangle_area_agrees() {
+    let report = check(&load("triangle-area.toml"), 2000, 5);
+    assert!(report.agrees(), "{report:?}");
+    assert_eq!(report.reflection, Reflection::Unchanged);
+}
+
+#[test]
+fn a_flipped_sign_is_found_at_the_particle_it_is_in() {
+    let report = check(&load("height-wrong-sign.toml"), 500, 6);
+    assert!(!report.agrees());
+    let errors = &report.max_relative_error;
+    assert!(
+        errors[1].unwrap() < 1e-9 && errors[2].unwrap() < 1e-9,
+        "{errors:?}"
+    );
+    assert!(
+        errors[3].unwrap() > 0.1 && errors[0].unwrap() > 0.1,
+        "{errors:?}"
+    );
+    let worst = report.worst.unwrap();
+    assert!(worst.particle == 3 || worst.particle == 0);
+    // The configuration shown really shows it.
+    let file = load("height-wrong-sign.toml");
+    let at = file.evaluate(&worst.points, worst.rest);
+    let automatic = at.automatic.unwrap();
+    let yours = at.yours[worst.particle].unwrap();
+    assert!((yours - automatic[worst.particle]).length() > 0.1 * automatic[1].length());
+}
+
+#[test]
+fn near_degenerate_configurations_are_flagged_never_nan() {
+    for name in [
+        "height.toml",
+        "volume.toml",
+        "edge.toml",
+        "triangle-area.toml",
+    ] {
+        let file = load(name);
+        let report = check(&file, 10, 7);
+        assert_eq!(report.near_degenerate, 200);
+        // Coincident points: C or ∇C undefined for the normalised ones, flagged.
+        if name != "volume.toml" {
+            assert!(report.undefined > 0, "{name}");
+        }
+        let flat = [glam::DVec3::ZERO; 4];
+        let e = file.evaluate(&flat[..file.arity()], 0.0);
+        if let Some(g) = &e.automatic {
+            assert!(g.iter().all(|v| v.is_finite()), "{name}");
+        }
+    }
+}
+
+/// The error for `text`, as one line.
+fn error(text: &str) -> String {
+    ConstraintFile::parse(Path::new("mine.toml"), text)
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn every_mistake_names_file_line_and_column() {
+    let header = "name = \"c\"\napplies_to = \"edges\"\n";
+    let cases = [
+        (
+            "value = \"length(p0 - q) - rest\"",
+            "mine.toml:3:22: ",
+            "unknown name `q`",
+        ),
+        (
+            "value = \"lenght(p0 - p1)\"",
+            "mine.toml:3:10: ",
+            "unknown function `lenght`",
+        ),
+        (
+            "value = \"dot(p0)\"",
+            "mine.toml:3:10: ",
+            "`dot` takes 2 arguments, and is given 1",
+        ),
+        (
+            "value = \"p0 - p1\"",
+            "mine.toml:3:10: ",
+            "value must be a scalar, and this is a vector",
+        ),
+        (
+            "value = \"p0 * p1\"",
+            "mine.toml:3:10: ",
+            "type error: a vector * a vector",
+        ),
+        (
+            "value = \"length(p3 - p0)\"",
+            "mine.toml:3:17: ",
+            "p0…p1 only",
+        ),
+        (
+            "value = \"length(p0 - p1\"",
+            "mine.toml:3:24: ",
+            "expected an operator or `)`",
+        ),
+        (
+            "value = \"sqrt(p0)\"",
+            "mine.toml:3:15: ",
+            "argument 1 of `sqrt` must be a scalar",
+        ),
+        (
+            "value = \"1\"\n[gradient]\np3 = \"p0\"",
+            "mine.toml:5:1: ",
+            "p0…p1 only",
+        ),
+    ];
+    for (body, at, what) in cases {
+        let message = error(&format!("{header}{body}\n"));
+        assert!(message.starts_with(at), "{body}: {message}");
+        assert!(message.contains(what), "{body}: {message}");
+    }
+    let message = error(header);
+    assert!(message.contains("no `value`"), "{message}");
+    let message = error("name = \"c\"\napplies_to = \"faces\"\nvalue = \"1\"\n");
+    assert!(message.starts_with("mine.toml:2:14: "), "{message}");
+    // Inside a multi-line define, the line of the definition.
+    let message = error(&format!(
+        "{header}define = \"\"\"\nu = p0 - p1\nw = u * u\n\"\"\"\nvalue = \"1\"\n"
+    ));
+    assert!(message.starts_with("mine.toml:5:5: "), "{message}");
+}

@@ -1,0 +1,42 @@
+//! A constraint file. Whatever the bytes, reading gives a compiled constraint or an error naming a
+//! line and column that exist; never a panic. A compiled one is evaluated (C, its gradient by
+//! automatic differentiation and the file's own) at a regular tet and at coincident points: the
+//! results are finite or flagged undefined, and evaluating never panics.
+
+#![no_main]
+
+use glam::DVec3;
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+use tetlab_core::constraint_file::ConstraintFile;
+use tetlab_core::text_file::decode;
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(text) = decode(data) else {
+        return;
+    };
+    match ConstraintFile::parse(Path::new("fuzz.toml"), text) {
+        Ok(file) => {
+            let tet = [
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(0.0, 0.0, 1.0),
+            ];
+            for points in [&tet[..], &[DVec3::ZERO; 4][..]] {
+                let points = &points[..file.arity()];
+                let rest = file.rest_value(points);
+                let e = file.evaluate(points, if rest.is_finite() { rest } else { 0.0 });
+                if let Some(g) = &e.automatic {
+                    assert!(g.iter().all(|v| v.is_finite()));
+                }
+            }
+        }
+        Err(e) => {
+            if let Some((line, column)) = e.at {
+                let lines = text.lines().count() + 1;
+                assert!(line >= 1 && line <= lines && column >= 1, "{e}");
+            }
+        }
+    }
+});
