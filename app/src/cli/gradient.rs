@@ -126,18 +126,13 @@ fn write_table(family: Family, o: &Output, out: &mut impl Write) -> std::io::Res
     for line in definition {
         writeln!(out, "            {line}")?;
     }
-    writeln!(out, "C           {}", o.value)?;
-    writeln!(out, "rest        {}", o.rest)?;
-    writeln!(
+    write_value(
         out,
-        "degenerate  {}",
-        if o.degenerate {
-            "yes: ∇C is undefined here and reported as zero"
-        } else {
-            "no"
-        }
+        o.value,
+        o.rest,
+        o.degenerate
+            .then_some("yes: ∇C is undefined here and reported as zero"),
     )?;
-    writeln!(out)?;
     writeln!(
         out,
         "{:<9}{:<46}∇C central difference",
@@ -230,22 +225,15 @@ fn run_file(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
 
 fn write_file_table(o: &FileOutput, out: &mut impl Write) -> std::io::Result<()> {
     writeln!(out, "constraint  {} ({})", o.name, o.constraint_file)?;
-    if o.value.is_finite() {
-        writeln!(out, "C           {}", o.value)?;
-    } else {
-        writeln!(out, "C           undefined here")?;
-    }
-    writeln!(out, "rest        {}", o.rest)?;
-    writeln!(
+    write_value(
         out,
-        "degenerate  {}",
-        if o.degenerate {
-            "yes: the gradient is undefined here (a length or normalisation of a zero vector, or a division by zero)"
-        } else {
-            "no"
-        }
+        o.value,
+        o.rest,
+        o.degenerate.then_some(
+            "yes: the gradient is undefined here (a length or normalisation of a zero vector, \
+             or a division by zero)",
+        ),
     )?;
-    writeln!(out)?;
     writeln!(
         out,
         "{:<9}{:<46}{:<46}∇C central difference",
@@ -269,4 +257,21 @@ fn write_file_table(o: &FileOutput, out: &mut impl Write) -> std::io::Result<()>
         )?;
     }
     Ok(())
+}
+
+/// The lines of C, the rest value and whether the configuration is degenerate (`Some(why)`).
+fn write_value(
+    out: &mut impl Write,
+    value: f64,
+    rest: f64,
+    degenerate: Option<&str>,
+) -> std::io::Result<()> {
+    if value.is_finite() {
+        writeln!(out, "C           {value}")?;
+    } else {
+        writeln!(out, "C           undefined here")?;
+    }
+    writeln!(out, "rest        {rest}")?;
+    writeln!(out, "degenerate  {}", degenerate.unwrap_or("no"))?;
+    writeln!(out)
 }
