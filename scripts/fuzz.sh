@@ -79,7 +79,7 @@ seed() {
 echo "== building the fuzz targets"
 "${fuzz_env[@]}" cargo fuzz build "${build[@]}"
 failed=0
-printf '%-10s %14s %9s %8s\n' target executions seconds crashes
+printf '%-16s %14s %9s %8s\n' target executions seconds crashes
 for target in "${targets[@]}"; do
   corpus="$corpus_root/$target"
   mkdir -p "$corpus" "fuzz/artifacts/$target"
@@ -99,7 +99,7 @@ for target in "${targets[@]}"; do
   seconds=$(python3 -c "import time; print(f'{time.time() - $started:.0f}')")
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   crashes=$(find "fuzz/artifacts/$target" -type f | wc -l)
-  printf '%-10s %14s %9s %8s\n' "$target" "${runs:-0}" "$seconds" "$crashes"
+  printf '%-16s %14s %9s %8s\n' "$target" "${runs:-0}" "$seconds" "$crashes"
   if [ "$status" -ne 0 ] || [ "$crashes" -ne 0 ]; then
     failed=1
     echo "-- $target failed (status $status); the end of its log:" >&2

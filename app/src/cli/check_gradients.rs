@@ -25,7 +25,7 @@ pub struct Args {
     /// Seed of the random configurations.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Print one JSON object per family instead of a table.
+    /// Print one JSON object per family (one for the constraint file) instead of a table.
     #[arg(long)]
     json: bool,
 }

@@ -31,9 +31,11 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Evaluate one constraint and its gradient at given points, checked by finite differences.
+    /// Evaluate one constraint (a family or a constraint file) and its gradient at given points,
+    /// checked by finite differences.
     Gradient(gradient::Args),
-    /// Compare every analytic gradient with central differences on random configurations.
+    /// Compare every analytic gradient with central differences and automatic differentiation
+    /// on random configurations, or check your own (--constraint-file).
     CheckGradients(check_gradients::Args),
     /// Run a scene headless and print its metrics per frame (--json) or a summary.
     Run(run::Args),
