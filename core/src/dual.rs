@@ -127,6 +127,135 @@ impl Vector3 for DualVec3 {
     fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
         if mask { if_true } else { if_false }
     }
+    fn to_array(self) -> [Dual64; 3] {
+        self.0
+    }
+    fn from_array(a: [Dual64; 3]) -> Self {
+        DualVec3(a)
+    }
+}
+
+/// A dual number over any [`Real`] (f64, f32, the fast solver's lanes): `value + slope ε`, for
+/// forward-mode differentiation where num-dual's types do not reach (they need a scalar
+/// primitive; lanes are eight).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tangent<T> {
+    /// The value.
+    pub value: T,
+    /// Its derivative along the seeded direction.
+    pub slope: T,
+}
+
+impl<T: Real> Tangent<T> {
+    /// `value` with slope 0 (a constant) or 1 (the variable differentiated by).
+    pub fn new(value: T, slope: T) -> Self {
+        Tangent { value, slope }
+    }
+}
+
+impl<T: Real> Add for Tangent<T> {
+    type Output = Self;
+    #[inline]
+    fn add(self, b: Self) -> Self {
+        Tangent::new(self.value + b.value, self.slope + b.slope)
+    }
+}
+impl<T: Real> Sub for Tangent<T> {
+    type Output = Self;
+    #[inline]
+    fn sub(self, b: Self) -> Self {
+        Tangent::new(self.value - b.value, self.slope - b.slope)
+    }
+}
+impl<T: Real> Mul for Tangent<T> {
+    type Output = Self;
+    /// (a + a′ε)(b + b′ε) = ab + (a′b + ab′)ε.
+    #[inline]
+    fn mul(self, b: Self) -> Self {
+        Tangent::new(
+            self.value * b.value,
+            self.slope * b.value + self.value * b.slope,
+        )
+    }
+}
+impl<T: Real> Div for Tangent<T> {
+    type Output = Self;
+    /// (a + a′ε) / (b + b′ε) = a/b + (a′b − ab′)/b² ε.
+    #[inline]
+    fn div(self, b: Self) -> Self {
+        Tangent::new(
+            self.value / b.value,
+            (self.slope * b.value - self.value * b.slope) / (b.value * b.value),
+        )
+    }
+}
+impl<T: Real> Neg for Tangent<T> {
+    type Output = Self;
+    #[inline]
+    fn neg(self) -> Self {
+        Tangent::new(-self.value, -self.slope)
+    }
+}
+impl<T: Real> AddAssign for Tangent<T> {
+    #[inline]
+    fn add_assign(&mut self, b: Self) {
+        *self = *self + b;
+    }
+}
+impl<T: Real> SubAssign for Tangent<T> {
+    #[inline]
+    fn sub_assign(&mut self, b: Self) {
+        *self = *self - b;
+    }
+}
+
+impl<T: Real> Real for Tangent<T> {
+    type Mask = T::Mask;
+    const ZERO: Self = Tangent {
+        value: T::ZERO,
+        slope: T::ZERO,
+    };
+    const ONE: Self = Tangent {
+        value: T::ONE,
+        slope: T::ZERO,
+    };
+    const EPSILON: Self = Tangent {
+        value: T::EPSILON,
+        slope: T::ZERO,
+    };
+    const MIN_POSITIVE: Self = Tangent {
+        value: T::MIN_POSITIVE,
+        slope: T::ZERO,
+    };
+    #[inline]
+    fn from_f64(x: f64) -> Self {
+        Tangent::new(T::from_f64(x), T::ZERO)
+    }
+    /// √(a + a′ε) = √a + a′ / (2√a) ε.
+    #[inline]
+    fn sqrt(self) -> Self {
+        let root = self.value.sqrt();
+        Tangent::new(root, self.slope / (root + root))
+    }
+    #[inline]
+    fn finite(self) -> T::Mask {
+        self.value.finite() & self.slope.finite()
+    }
+    #[inline]
+    fn le(self, other: Self) -> T::Mask {
+        self.value.le(other.value)
+    }
+    #[inline]
+    fn gt(self, other: Self) -> T::Mask {
+        self.value.gt(other.value)
+    }
+    #[inline]
+    fn select(mask: T::Mask, if_true: Self, if_false: Self) -> Self {
+        Tangent::new(
+            T::select(mask, if_true.value, if_false.value),
+            T::select(mask, if_true.slope, if_false.slope),
+        )
+    }
 }
 
 /// ∇C by forward-mode automatic differentiation: for every coordinate of every point, `value`

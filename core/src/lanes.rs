@@ -351,6 +351,18 @@ impl Vector3 for Vec3x8 {
             z: F32x8::select(mask, if_true.z, if_false.z),
         }
     }
+    #[inline(always)]
+    fn to_array(self) -> [F32x8; 3] {
+        [self.x, self.y, self.z]
+    }
+    #[inline(always)]
+    fn from_array(a: [F32x8; 3]) -> Self {
+        Vec3x8 {
+            x: a[0],
+            y: a[1],
+            z: a[2],
+        }
+    }
 }
 
 #[cfg(test)]

@@ -144,6 +144,10 @@ pub trait Vector3:
     fn set_y(&mut self, y: Self::Real);
     /// `if_true` where `mask` is set, `if_false` elsewhere.
     fn select(mask: <Self::Real as Real>::Mask, if_true: Self, if_false: Self) -> Self;
+    /// The components x, y, z.
+    fn to_array(self) -> [Self::Real; 3];
+    /// The vector of components x, y, z.
+    fn from_array(a: [Self::Real; 3]) -> Self;
 }
 
 macro_rules! impl_vector3 {
@@ -174,6 +178,14 @@ macro_rules! impl_vector3 {
             #[inline]
             fn set_y(&mut self, y: $t) {
                 self.y = y;
+            }
+            #[inline]
+            fn to_array(self) -> [$t; 3] {
+                [self.x, self.y, self.z]
+            }
+            #[inline]
+            fn from_array(a: [$t; 3]) -> Self {
+                <$v>::new(a[0], a[1], a[2])
             }
         }
     };

@@ -185,3 +185,85 @@ fn every_mistake_names_file_line_and_column() {
     ));
     assert!(message.starts_with("mine.toml:5:5: "), "{message}");
 }
+
+/// Random well-conditioned configurations of `n` points.
+fn configurations(n: usize, count: usize, seed: u64) -> Vec<Vec<glam::DVec3>> {
+    let mut rng = tetlab_core::random::SplitMix64::new(seed);
+    let mut out = Vec::new();
+    while out.len() < count {
+        let points: Vec<glam::DVec3> = (0..n).map(|_| rng.in_cube(1.0)).collect();
+        if tetlab_core::constraint_file::check::well_conditioned(&points) {
+            out.push(points);
+        }
+    }
+    out
+}
+
+/// The evaluation a simulation uses, in f64, f32 and eight f32 lanes, against the AD of the check.
+#[test]
+fn the_same_program_evaluates_in_f64_f32_and_lanes() {
+    use glam::{DVec3, Vec3A};
+    use tetlab_core::lanes::{F32x8, Vec3x8};
+    use tetlab_core::vector::{Real, Vector3};
+    let file = load("height.toml");
+    let configs = configurations(4, 8, 11);
+    let mut lanes = [[[0.0f32; 8]; 3]; 4];
+    for (lane, points) in configs.iter().enumerate() {
+        let rest = 0.1;
+        let checked = file.evaluate(points, rest);
+        let automatic = checked.automatic.unwrap();
+        let p: [DVec3; 4] = std::array::from_fn(|k| points[k]);
+        let f64s = file.evaluate_vectors(&p, rest);
+        assert!((f64s.value - checked.value).abs() < 1e-14);
+        assert!(!f64s.degenerate);
+        let scale = automatic.iter().map(|g| g.length()).fold(0.0, f64::max);
+        for (g, a) in f64s.gradients.iter().zip(&automatic) {
+            assert!((*g - *a).length() < 1e-13 * scale);
+        }
+        let q: [Vec3A; 4] = std::array::from_fn(|k| points[k].as_vec3a());
+        let f32s = file.evaluate_vectors(&q, rest as f32);
+        for (k, (g, a)) in f32s.gradients.iter().zip(&automatic).enumerate() {
+            let g = g.as_dvec3();
+            assert!((g - *a).length() < 1e-4 * scale, "{g} {a}");
+            for (axis, component) in lanes[k].iter_mut().enumerate() {
+                component[lane] = q[k][axis];
+            }
+        }
+    }
+    let p: [Vec3x8; 4] = std::array::from_fn(|k| Vec3x8::from_array(lanes[k].map(F32x8::new)));
+    let wide = file.evaluate_vectors(&p, F32x8::from_f64(0.1));
+    for (lane, points) in configs.iter().enumerate() {
+        let q: [Vec3A; 4] = std::array::from_fn(|k| points[k].as_vec3a());
+        let one = file.evaluate_vectors(&q, 0.1f32);
+        assert_eq!(wide.value.to_array()[lane], one.value);
+        for (w, g) in wide.gradients.iter().zip(&one.gradients) {
+            assert_eq!(w.lane(lane), *g);
+        }
+    }
+}
+
+#[test]
+fn a_simulation_gets_a_zero_gradient_where_it_is_undefined_and_yours_when_asked() {
+    use glam::DVec3;
+    let edge = load("edge.toml");
+    let e = edge.evaluate_vectors(&[DVec3::ONE, DVec3::ONE], 0.5);
+    assert!(e.degenerate);
+    assert_eq!(e.gradients, [DVec3::ZERO; 2]);
+    assert_eq!(e.value, -0.5);
+    // The wrong height, simulated with its own gradient (a top-level key, before [gradient]).
+    let text = std::fs::read_to_string(asset("height-wrong-sign.toml")).unwrap();
+    let text = text.replacen("[gradient]", "use_gradient = true\n\n[gradient]", 1);
+    let wrong = ConstraintFile::parse(Path::new("wrong.toml"), &text).unwrap();
+    assert!(wrong.use_gradient);
+    let points = &configurations(4, 1, 12)[0];
+    let p: [DVec3; 4] = std::array::from_fn(|k| points[k]);
+    let used = wrong.evaluate_vectors(&p, 0.0);
+    let checked = wrong.evaluate(points, 0.0);
+    for k in 0..4 {
+        assert_eq!(
+            used.gradients[k],
+            checked.yours[k].unwrap(),
+            "the file's own, wrong as it is"
+        );
+    }
+}

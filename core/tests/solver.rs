@@ -588,3 +588,21 @@ fn a_constraint_its_free_particles_can_barely_change_is_skipped() {
     let moved = fast.positions()[0].distance(positions[0]);
     assert!(moved < 2.0, "fast engine: flung {moved} m");
 }
+
+/// What a simulation will call per projection of a constraint file's family: no allocation (the
+/// compiled program's registers are on the stack).
+#[test]
+fn a_constraint_file_evaluates_without_allocating() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints/height.toml");
+    let file = tetlab_core::constraint_file::ConstraintFile::load(&path).unwrap();
+    let p = [DVec3::ZERO, DVec3::new(0.2, 0.3, 1.0), DVec3::X, DVec3::Y];
+    let before = allocations();
+    let mut sum = 0.0;
+    for _ in 0..100 {
+        let e = file.evaluate_vectors(&p, 0.5);
+        sum += e.value + e.gradients[1].z;
+    }
+    assert_eq!(allocations(), before, "allocations in 100 evaluations");
+    assert!((sum - 100.0 * (1.0 - 0.5 + 1.0)).abs() < 1e-9, "{sum}");
+}

@@ -36,6 +36,10 @@ pub struct CompileError {
 
 type Reg = u16;
 
+/// The most registers a program may use: [`super::ConstraintFile::evaluate_vectors`] keeps them
+/// on the stack, so that an evaluation allocates nothing. Each operation takes one.
+pub const MAX_REGISTERS: usize = 160;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Op {
     Const(Reg, f64),
@@ -187,10 +191,12 @@ impl Program {
     }
 
     fn compile(&mut self, expr: &Expr) -> Result<(Reg, Type), CompileError> {
-        if self.registers >= Reg::MAX as usize - 4 {
+        if self.registers + 1 >= MAX_REGISTERS {
             return Err(CompileError {
                 span: expr.span(),
-                message: "the expressions are too long".to_owned(),
+                message: format!(
+                    "the expressions are too long: more than {MAX_REGISTERS} operations in all"
+                ),
             });
         }
         match expr {
