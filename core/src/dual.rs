@@ -1,143 +1,16 @@
-//! Forward-mode automatic differentiation for the constraint code: [`Real`] for num-dual's
-//! [`Dual64`] (a + b ε with ε² = 0), and [`DualVec3`], a 3-vector of them, as a [`Vector3`]. Any
-//! formula written over those traits (the built-in families, a constraint file's compiled
-//! program) then gives, beside its value, its derivative along one direction of the inputs:
-//! seed one coordinate's ε with 1 and read ∂C/∂x from the value's ε part.
+//! Forward-mode automatic differentiation for the constraint code: [`Tangent`], a dual number
+//! a + a′ε (ε² = 0) over any [`Real`], and [`DualVec3`], a 3-vector of f64 ones, as a
+//! [`Vector3`]. Any formula written over those traits (the built-in families, a constraint file's
+//! compiled program) then gives, beside its value, its derivative along one direction of the
+//! inputs: seed one coordinate's slope with 1 and read ∂C/∂x from the value's slope.
 
-pub use num_dual::Dual64;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 
 use crate::vector::{Real, Vector3};
 
-const fn dual(re: f64) -> Dual64 {
-    Dual64 { re, eps: 0.0 }
-}
-
-impl Real for Dual64 {
-    type Mask = bool;
-    const ZERO: Self = dual(0.0);
-    const ONE: Self = dual(1.0);
-    const EPSILON: Self = dual(f64::EPSILON);
-    const MIN_POSITIVE: Self = dual(f64::MIN_POSITIVE);
-    fn from_f64(x: f64) -> Self {
-        dual(x)
-    }
-    /// √(a + b ε) = √a + b / (2√a) ε.
-    fn sqrt(self) -> Self {
-        let root = self.re.sqrt();
-        Dual64 {
-            re: root,
-            eps: self.eps / (2.0 * root),
-        }
-    }
-    /// Both parts finite.
-    fn finite(self) -> bool {
-        self.re.is_finite() && self.eps.is_finite()
-    }
-    /// Compares the values (the real parts).
-    fn le(self, other: Self) -> bool {
-        self.re <= other.re
-    }
-    fn gt(self, other: Self) -> bool {
-        self.re > other.re
-    }
-    fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
-        if mask { if_true } else { if_false }
-    }
-}
-
-/// A 3-vector of dual numbers.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DualVec3(pub [Dual64; 3]);
-
-impl DualVec3 {
-    /// The point `p` with the ε part `direction`.
-    pub fn seeded(p: glam::DVec3, direction: glam::DVec3) -> Self {
-        DualVec3([0, 1, 2].map(|i| Dual64 {
-            re: p[i],
-            eps: direction[i],
-        }))
-    }
-}
-
-impl Add for DualVec3 {
-    type Output = Self;
-    fn add(self, b: Self) -> Self {
-        DualVec3([0, 1, 2].map(|i| self.0[i] + b.0[i]))
-    }
-}
-impl Sub for DualVec3 {
-    type Output = Self;
-    fn sub(self, b: Self) -> Self {
-        DualVec3([0, 1, 2].map(|i| self.0[i] - b.0[i]))
-    }
-}
-impl Neg for DualVec3 {
-    type Output = Self;
-    fn neg(self) -> Self {
-        DualVec3(self.0.map(|x| -x))
-    }
-}
-impl Mul<Dual64> for DualVec3 {
-    type Output = Self;
-    fn mul(self, k: Dual64) -> Self {
-        DualVec3(self.0.map(|x| x * k))
-    }
-}
-impl Div<Dual64> for DualVec3 {
-    type Output = Self;
-    fn div(self, k: Dual64) -> Self {
-        DualVec3(self.0.map(|x| x / k))
-    }
-}
-impl AddAssign for DualVec3 {
-    fn add_assign(&mut self, b: Self) {
-        *self = *self + b;
-    }
-}
-impl SubAssign for DualVec3 {
-    fn sub_assign(&mut self, b: Self) {
-        *self = *self - b;
-    }
-}
-
-impl Vector3 for DualVec3 {
-    type Real = Dual64;
-    const ZERO: Self = DualVec3([dual(0.0); 3]);
-    fn dot(self, b: Self) -> Dual64 {
-        self.0[0] * b.0[0] + self.0[1] * b.0[1] + self.0[2] * b.0[2]
-    }
-    fn cross(self, b: Self) -> Self {
-        let (a, b) = (self.0, b.0);
-        DualVec3([
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ])
-    }
-    fn from_f64s(x: f64, y: f64, z: f64) -> Self {
-        DualVec3([dual(x), dual(y), dual(z)])
-    }
-    fn y(self) -> Dual64 {
-        self.0[1]
-    }
-    fn set_y(&mut self, y: Dual64) {
-        self.0[1] = y;
-    }
-    fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
-        if mask { if_true } else { if_false }
-    }
-    fn to_array(self) -> [Dual64; 3] {
-        self.0
-    }
-    fn from_array(a: [Dual64; 3]) -> Self {
-        DualVec3(a)
-    }
-}
-
-/// A dual number over any [`Real`] (f64, f32, the fast solver's lanes): `value + slope ε`, for
-/// forward-mode differentiation where num-dual's types do not reach (they need a scalar
-/// primitive; lanes are eight).
+/// A dual number over any [`Real`] (f64, f32, the fast solver's lanes): `value + slope ε` with
+/// ε² = 0. Its own type rather than num-dual's, whose dual numbers need a scalar primitive and so
+/// cannot carry the eight lanes of the fast solver.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tangent<T> {
     /// The value.
@@ -258,8 +131,97 @@ impl<T: Real> Real for Tangent<T> {
     }
 }
 
+/// A dual number over f64.
+pub type Dual64 = Tangent<f64>;
+
+/// A 3-vector of dual numbers over f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualVec3(pub [Dual64; 3]);
+
+impl DualVec3 {
+    /// The point `p` with the slopes `direction`.
+    pub fn seeded(p: glam::DVec3, direction: glam::DVec3) -> Self {
+        DualVec3([0, 1, 2].map(|i| Tangent::new(p[i], direction[i])))
+    }
+}
+
+impl Add for DualVec3 {
+    type Output = Self;
+    fn add(self, b: Self) -> Self {
+        DualVec3([0, 1, 2].map(|i| self.0[i] + b.0[i]))
+    }
+}
+impl Sub for DualVec3 {
+    type Output = Self;
+    fn sub(self, b: Self) -> Self {
+        DualVec3([0, 1, 2].map(|i| self.0[i] - b.0[i]))
+    }
+}
+impl Neg for DualVec3 {
+    type Output = Self;
+    fn neg(self) -> Self {
+        DualVec3(self.0.map(|x| -x))
+    }
+}
+impl Mul<Dual64> for DualVec3 {
+    type Output = Self;
+    fn mul(self, k: Dual64) -> Self {
+        DualVec3(self.0.map(|x| x * k))
+    }
+}
+impl Div<Dual64> for DualVec3 {
+    type Output = Self;
+    fn div(self, k: Dual64) -> Self {
+        DualVec3(self.0.map(|x| x / k))
+    }
+}
+impl AddAssign for DualVec3 {
+    fn add_assign(&mut self, b: Self) {
+        *self = *self + b;
+    }
+}
+impl SubAssign for DualVec3 {
+    fn sub_assign(&mut self, b: Self) {
+        *self = *self - b;
+    }
+}
+
+impl Vector3 for DualVec3 {
+    type Real = Dual64;
+    const ZERO: Self = DualVec3([Dual64::ZERO; 3]);
+    fn dot(self, b: Self) -> Dual64 {
+        self.0[0] * b.0[0] + self.0[1] * b.0[1] + self.0[2] * b.0[2]
+    }
+    fn cross(self, b: Self) -> Self {
+        let (a, b) = (self.0, b.0);
+        DualVec3([
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ])
+    }
+    fn from_f64s(x: f64, y: f64, z: f64) -> Self {
+        DualVec3([x, y, z].map(Dual64::from_f64))
+    }
+    fn y(self) -> Dual64 {
+        self.0[1]
+    }
+    fn set_y(&mut self, y: Dual64) {
+        self.0[1] = y;
+    }
+    fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
+        if mask { if_true } else { if_false }
+    }
+    fn to_array(self) -> [Dual64; 3] {
+        self.0
+    }
+    fn from_array(a: [Dual64; 3]) -> Self {
+        DualVec3(a)
+    }
+}
+
 /// ∇C by forward-mode automatic differentiation: for every coordinate of every point, `value`
-/// evaluated on dual numbers seeded with ε = 1 on that coordinate; ∂C/∂x is the ε part.
+/// evaluated on dual numbers seeded with slope 1 on that coordinate; ∂C/∂x is the value's slope.
 /// `None` when a derivative is not finite (a length or normalisation of a zero vector, a
 /// division by zero: the gradient is undefined there).
 ///
@@ -284,9 +246,9 @@ pub fn gradient(
     let mut gradients = vec![glam::DVec3::ZERO; points.len()];
     for (i, gradient) in gradients.iter_mut().enumerate() {
         for axis in 0..3 {
-            seeded[i].0[axis].eps = 1.0;
-            let d = value(&seeded).eps;
-            seeded[i].0[axis].eps = 0.0;
+            seeded[i].0[axis].slope = 1.0;
+            let d = value(&seeded).slope;
+            seeded[i].0[axis].slope = 0.0;
             if !d.is_finite() {
                 return None;
             }

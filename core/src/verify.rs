@@ -7,6 +7,7 @@ use crate::constraints::{Constraint, Family, Visit};
 use crate::dual::{Dual64, DualVec3};
 use crate::finite_difference::central_difference;
 use crate::random::SplitMix64;
+use crate::vector::Real;
 use glam::DVec3;
 
 /// Below this sine of the angle between two edges, or this fraction of the configuration's size
@@ -59,7 +60,7 @@ pub fn automatic_gradient(
             let p: [DualVec3; N] = std::array::from_fn(|k| self.0[k]);
             let shape: [DualVec3; N] =
                 std::array::from_fn(|k| DualVec3::seeded(self.2[k], DVec3::ZERO));
-            c.evaluate(&p, Dual64::from(self.1), &shape).value
+            c.evaluate(&p, Dual64::from_f64(self.1), &shape).value
         }
     }
     crate::dual::gradient(points, |p| family.visit(Value(p, rest, rest_shape)))

@@ -12,10 +12,11 @@ use tetlab_core::verify::{analytic_and_numeric, max_abs_error};
 
 /// Options of `tetlab gradient`.
 #[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("what").required(true).args(["constraint", "constraint_file"])))]
 pub struct Args {
     /// The constraint family: edges (2 points: distance), height (4: height of p1 above the
     /// plane of p0, p2, p3) or volume (4: signed volume). `distance` and `plane` are aliases.
-    #[arg(long, value_parser = Family::parse, required_unless_present = "constraint_file", conflicts_with = "constraint_file")]
+    #[arg(long, value_parser = Family::parse)]
     constraint: Option<Family>,
     /// A constraint file (assets/constraints/*.toml) instead of a built-in family: C, its
     /// gradient by automatic differentiation, the file's own, and central differences.

@@ -26,7 +26,7 @@ pub mod expression;
 pub mod program;
 
 use crate::constraints::Binding;
-use crate::dual::{Dual64, DualVec3, Tangent};
+use crate::dual::Tangent;
 use crate::text_file;
 use crate::vector::{Real, Vector3};
 use glam::DVec3;
@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 /// A mistake in a constraint file: where (line and column from 1, when one is to blame) and what,
-/// with the line's text.
+/// quoting the offending text. Shown on one line, `FILE:LINE:COLUMN: message`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConstraintFileError {
     /// The file.
@@ -46,8 +46,6 @@ pub struct ConstraintFileError {
     pub at: Option<(usize, usize)>,
     /// What is wrong, naming the offending text.
     pub message: String,
-    /// The line the mistake is on, to show under the message.
-    pub line_text: Option<String>,
 }
 
 impl fmt::Display for ConstraintFileError {
@@ -58,18 +56,9 @@ impl fmt::Display for ConstraintFileError {
                 "{}:{line}:{column}: {}",
                 self.path.display(),
                 self.message
-            )?,
-            None => write!(f, "{}: {}", self.path.display(), self.message)?,
+            ),
+            None => write!(f, "{}: {}", self.path.display(), self.message),
         }
-        if let (Some(text), Some((_, column))) = (&self.line_text, self.at) {
-            let pad: String = text
-                .chars()
-                .take(column - 1)
-                .map(|c| if c == '\t' { '\t' } else { ' ' })
-                .collect();
-            write!(f, "\n    {text}\n    {pad}^")?;
-        }
-        Ok(())
     }
 }
 
@@ -138,7 +127,6 @@ impl ConstraintFile {
             path: path.to_owned(),
             at: e.line.map(|l| (l, 1)),
             message: e.message,
-            line_text: None,
         })?;
         ConstraintFile::parse(path, &text)
     }
@@ -151,12 +139,13 @@ impl ConstraintFile {
             ConstraintFileError {
                 path: path.to_owned(),
                 at,
-                line_text: at.and_then(|(l, _)| text.lines().nth(l - 1).map(str::to_owned)),
                 message,
             }
         };
-        let raw: Raw = toml::from_str(text)
-            .map_err(|e| error(e.span().map(|s| s.start), e.message().trim().to_owned()))?;
+        let raw: Raw = toml::from_str(text).map_err(|e| {
+            let message = e.message().trim().replace('\n', " ");
+            error(e.span().map(|s| s.start), message)
+        })?;
         let binding = match raw.applies_to.get_ref().as_str() {
             "edges" => Binding::Edges,
             "tets" => Binding::Tets,
@@ -300,12 +289,10 @@ impl ConstraintFile {
     /// C, its gradient by AD and the file's own, at `points` with rest value `rest`.
     pub fn evaluate(&self, points: &[DVec3], rest: f64) -> Evaluation {
         let value = self.value(points, rest);
-        let mut registers = vec![[Dual64::from(0.0); 3]; self.program.registers()];
-        let automatic = crate::dual::gradient(points, |p: &[DualVec3]| {
-            let p: Vec<[Dual64; 3]> = p.iter().map(|v| v.0).collect();
-            self.program.run(0, &p, Dual64::from(rest), &mut registers);
-            self.program.scalar(0, &registers)
-        });
+        let automatic = match self.arity() {
+            2 => self.automatic::<2>(points, rest),
+            _ => self.automatic::<4>(points, rest),
+        };
         let mut registers = vec![[0.0; 3]; self.program.registers()];
         let flat: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
         let last = self.gradient_outputs.iter().flatten().max().copied();
@@ -352,6 +339,23 @@ impl ConstraintFile {
         p: &[V; N],
         rest: V::Real,
     ) -> VectorEvaluation<V, N> {
+        self.evaluate_with(p, rest, self.use_gradient)
+    }
+
+    /// ∇C by AD in f64, `None` where it is undefined.
+    fn automatic<const N: usize>(&self, points: &[DVec3], rest: f64) -> Option<Vec<DVec3>> {
+        let p: [DVec3; N] = std::array::from_fn(|k| points[k]);
+        let e = self.evaluate_with(&p, rest, false);
+        (!e.degenerate).then(|| e.gradients.to_vec())
+    }
+
+    /// [`ConstraintFile::evaluate_vectors`], with the file's gradient when `own`, AD's otherwise.
+    fn evaluate_with<V: Vector3, const N: usize>(
+        &self,
+        p: &[V; N],
+        rest: V::Real,
+        own: bool,
+    ) -> VectorEvaluation<V, N> {
         assert_eq!(
             N,
             self.arity(),
@@ -362,7 +366,7 @@ impl ConstraintFile {
         let coordinates: [[V::Real; 3]; N] = std::array::from_fn(|i| p[i].to_array());
         let mut value = V::Real::ZERO;
         let mut gradients = [[V::Real::ZERO; 3]; N];
-        if self.use_gradient {
+        if own {
             let mut registers = [[V::Real::ZERO; 3]; program::MAX_REGISTERS];
             let registers = &mut registers[..self.program.registers()];
             let last = self
