@@ -1,31 +1,54 @@
-//! Builds the lessons of `assets/lessons/*.toml` into the library, in file-name order, so that
-//! adding a lesson is adding a file.
+//! Builds the lessons of `assets/lessons/*.toml` and the example constraint files of
+//! `assets/constraints/*.toml` into the library, in file-name order, so that adding a lesson or
+//! an example is adding a file (and so that the lessons that name an example find it where there
+//! is no file system, in the browser).
 
 use std::fmt::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-fn main() {
-    let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
-    let folder = manifest.join("../assets/lessons");
+/// The `.toml` files of `folder`, in file-name order, as absolute paths.
+fn toml_files(folder: &Path) -> Vec<PathBuf> {
     println!("cargo:rerun-if-changed={}", folder.display());
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
-        .expect("assets/lessons is readable")
-        .map(|entry| entry.expect("assets/lessons is readable").path())
+    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
+        .unwrap_or_else(|e| panic!("{} is readable: {e}", folder.display()))
+        .map(|entry| entry.expect("the folder is readable").path())
         .filter(|path| path.extension().is_some_and(|e| e == "toml"))
+        .map(|path| path.canonicalize().expect("a listed file exists"))
         .collect();
     files.sort();
-    let mut code = String::from("/// The lessons in assets/lessons, in file-name order.\n");
-    code += "pub const BUILTIN: &[BuiltinLesson] = &[\n";
-    for path in files {
-        let path = path.canonicalize().expect("a listed file exists");
-        let name = path.file_name().expect("a file").to_string_lossy();
+    files
+}
+
+/// `const NAME: &[TYPE] = &[TYPE { file, path, text }, …];` for the files of `folder`.
+fn table(name: &str, kind: &str, doc: &str, folder: &Path) -> String {
+    let mut code = format!("/// {doc}\npub const {name}: &[{kind}] = &[\n");
+    for path in toml_files(folder) {
+        let file = path.file_name().expect("a file").to_string_lossy();
         writeln!(
             code,
-            "    BuiltinLesson {{ file: {name:?}, path: {path:?}, text: include_str!({path:?}) }},",
+            "    {kind} {{ file: {file:?}, path: {path:?}, text: include_str!({path:?}) }},",
         )
         .expect("writing to a String");
     }
     code += "];\n";
-    let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo")).join("lessons.rs");
-    std::fs::write(out, code).expect("OUT_DIR is writable");
+    code
+}
+
+fn main() {
+    let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
+    let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo"));
+    let lessons = table(
+        "BUILTIN",
+        "BuiltinLesson",
+        "The lessons in assets/lessons, in file-name order.",
+        &manifest.join("../assets/lessons"),
+    );
+    std::fs::write(out.join("lessons.rs"), lessons).expect("OUT_DIR is writable");
+    let constraints = table(
+        "EXAMPLES",
+        "Example",
+        "The example constraint files in assets/constraints, in file-name order.",
+        &manifest.join("../assets/constraints"),
+    );
+    std::fs::write(out.join("constraint_examples.rs"), constraints).expect("OUT_DIR is writable");
 }

@@ -5,7 +5,7 @@
 mod support;
 
 use serde_json::Value;
-use support::{assert_usage_error, stderr, stdout, tetlab};
+use support::{assert_usage_error, asset, stderr, stdout, tetlab};
 use tetlab_core::solver::DEFAULT_SUBSTEPS;
 
 fn bench_json(args: &[&str]) -> Value {
@@ -110,6 +110,46 @@ fn the_heights_are_counted_and_timed_on_their_own() {
     let by_family = &report["ns_per_projection_by_family"];
     for family in ["edges", "height", "volume"] {
         assert!(by_family[family].as_f64().unwrap() > 0.0, "{family}");
+    }
+}
+
+/// A constraint file's family is benchmarked like the others, on both engines: counted, timed on
+/// its own, and named in the report.
+#[test]
+fn a_constraint_files_family_is_benchmarked_on_both_engines() {
+    let height = asset("constraints/height.toml");
+    for engine in [&[][..], &["--reference"][..]] {
+        let mut args = vec![
+            "--scene",
+            "cube",
+            "--resolution",
+            "2",
+            "--constraints",
+            "none",
+            "--constraint-file",
+            &height,
+            "--frames",
+            "3",
+        ];
+        args.extend_from_slice(engine);
+        let report = bench_json(&args);
+        assert_eq!(report["constraints"], "my-height", "{engine:?}");
+        let tets = report["tets"].as_u64().unwrap();
+        assert_eq!(
+            report["projections_per_frame"].as_u64().unwrap(),
+            4 * tets * DEFAULT_SUBSTEPS as u64
+        );
+        assert!(report["ns_per_projection"].as_f64().unwrap() > 0.0);
+        if engine.is_empty() {
+            let by_family = &report["ns_per_projection_by_family"]["my-height"];
+            assert!(by_family.as_f64().unwrap() > 0.0);
+            assert!(
+                report["relative_error"]["my-height"]
+                    .as_f64()
+                    .unwrap()
+                    .is_finite()
+            );
+        }
     }
 }
 

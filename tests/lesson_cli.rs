@@ -6,7 +6,7 @@ mod support;
 
 use serde_json::Value;
 use std::path::PathBuf;
-use support::{assert_usage_error, stderr, stdout, tetlab};
+use support::{assert_usage_error, asset, stderr, stdout, tetlab};
 
 fn scratch(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tetlab-lesson-{}-{test}", std::process::id()));
@@ -19,7 +19,7 @@ fn the_built_in_lessons_are_listed_and_observe_what_they_say() {
     let list = tetlab(&["lesson", "--list"]);
     assert!(list.status.success());
     let text = stdout(&list);
-    assert_eq!(text.lines().count(), 7, "{text}");
+    assert_eq!(text.lines().count(), 8, "{text}");
     assert!(text.contains("02-edges-cannot-uninvert.toml"));
 
     let output = tetlab(&["lesson", "2"]);
@@ -28,6 +28,51 @@ fn the_built_in_lessons_are_listed_and_observe_what_they_say() {
     assert!(text.starts_with("# 2. Why edges alone cannot un-invert a tet"));
     assert_eq!(text.matches("observed: ").count(), 6, "{text}");
     assert!(!text.contains("NOT OBSERVED"));
+}
+
+/// Lesson 8 ends in an exercise: as shipped, its last check (the gradient agrees with AD) is not
+/// observed and the run fails; handed a mended copy of the file with `--constraint-file`, it
+/// passes. A file of another name joins the lesson's families instead.
+#[test]
+fn the_gradient_exercise_fails_until_the_student_mends_the_file() {
+    let output = tetlab(&["lesson", "8"]);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(
+        text.contains("observed: gradient_error.height-wrong-sign > 0.1"),
+        "{text}"
+    );
+    assert!(
+        text.contains("NOT OBSERVED: gradient_error.height-wrong-sign < 1e-6"),
+        "{text}"
+    );
+    let unobserved: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("NOT OBSERVED"))
+        .collect();
+    assert_eq!(unobserved.len(), 2, "the exercise's two checks: {text}");
+    assert!(
+        unobserved[1].starts_with("NOT OBSERVED: max_edge_strain < 1e-6"),
+        "{text}"
+    );
+
+    let dir = scratch("exercise");
+    let wrong = std::fs::read_to_string(asset("constraints/height-wrong-sign.toml")).unwrap();
+    let fix = dir.join("my-fix.toml");
+    std::fs::write(&fix, wrong.replace("g3 = (cross", "g3 = -(cross")).unwrap();
+    let output = tetlab(&["lesson", "8", "--constraint-file", fix.to_str().unwrap()]);
+    let text = stdout(&output);
+    assert!(output.status.success(), "{text}{}", stderr(&output));
+    assert!(
+        text.contains("observed: gradient_error.height-wrong-sign < 1e-6"),
+        "{text}"
+    );
+
+    let broken = dir.join("broken.toml");
+    std::fs::write(&broken, wrong.replace("g3 = (cross", "g3 = (crosss")).unwrap();
+    let output = tetlab(&["lesson", "8", "--constraint-file", broken.to_str().unwrap()]);
+    let line = assert_usage_error(&output, "broken.toml:");
+    assert!(line.contains("unknown function `crosss`"), "{line}");
 }
 
 #[test]
@@ -64,7 +109,7 @@ fn mistakes_in_a_lesson_file_name_the_file_and_line() {
     .unwrap();
     let line = assert_usage_error(&tetlab(&["lesson", path.to_str().unwrap()]), "typo.toml:5:");
     assert!(line.contains("'mirorr' is not an action"), "{line}");
-    assert_usage_error(&tetlab(&["lesson", "8"]), "no such lesson");
+    assert_usage_error(&tetlab(&["lesson", "99"]), "no such lesson");
     assert_usage_error(
         &tetlab(&["lesson", "/nonexistent.toml"]),
         "/nonexistent.toml",

@@ -7,7 +7,7 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use support::{assert_usage_error, stderr, stdout, tetlab};
+use support::{assert_usage_error, asset, stderr, stdout, tetlab};
 
 fn scratch(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tetlab-record-{}-{test}", std::process::id()));
@@ -174,6 +174,44 @@ fn arrows_none_logs_no_gradients_and_all_logs_every_tet() {
         inspect(&all)["entities"]["world/gradients/volume"]["frame_rows"],
         3
     );
+}
+
+/// A constraint file's family is recorded like the built-in ones: its arrows every frame, the
+/// file's text once, and, for a file that gives its own gradient (here wrong, and in use), the
+/// other one where they differ.
+#[test]
+fn a_constraint_files_family_is_recorded_with_its_text_and_both_gradients() {
+    let dir = scratch("constraint-file");
+    let path = dir.join("file.rrd");
+    let output = tetlab(&[
+        "record",
+        "--scene",
+        "tet",
+        "--perturb",
+        "invert",
+        "--constraints",
+        "edges",
+        "--constraint-file",
+        &asset("constraints/height-wrong-sign.toml"),
+        "--frames",
+        "3",
+        "--quiet",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let entities = &inspect(&path)["entities"];
+    assert_eq!(
+        entities["world/gradients/height-wrong-sign"]["frame_rows"],
+        4
+    );
+    assert_eq!(
+        entities["world/gradients/height-wrong-sign-ad"]["frame_rows"],
+        4
+    );
+    assert_eq!(entities["constraints/height-wrong-sign"]["static_rows"], 1);
+    let run = tetlab(&["inspect", path.to_str().unwrap()]);
+    assert!(stdout(&run).contains("constraints/height-wrong-sign"));
 }
 
 /// Ctrl-C stops after the current frame and leaves a complete recording of every finished frame.

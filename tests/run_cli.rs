@@ -4,7 +4,7 @@
 mod support;
 
 use serde_json::Value;
-use support::{assert_usage_error, stderr, stdout, tetlab};
+use support::{assert_usage_error, asset, stderr, stdout, tetlab};
 use tetlab_core::shared_meshes;
 
 fn json_lines(args: &[&str]) -> Vec<Value> {
@@ -146,6 +146,14 @@ fn bad_options_are_one_line_naming_the_option_with_status_2() {
         (&["--compliance", "edges=-1"], "--compliance"),
         (&["--stiffness", "volume=2"], "--stiffness"),
         (&["--damping", "-1"], "--damping"),
+        (
+            &["--compliance", "my-height=1e-6"],
+            "--compliance my-height=0.000001",
+        ),
+        (
+            &["--constraint-file", "/nonexistent.toml"],
+            "--constraint-file /nonexistent.toml",
+        ),
     ];
     for (args, option) in cases {
         let mut full = vec!["run"];
@@ -367,4 +375,105 @@ fn max_displacement_is_a_cantilevers_tip_deflection() {
     let (soft, stiff) = (tip("E=2.5e6,nu=0.3"), tip("E=1e7,nu=0.3"));
     assert!(stiff > 0.0 && soft < 0.5, "{soft} {stiff}");
     assert!((3.0..5.0).contains(&(soft / stiff)), "{soft} / {stiff}");
+}
+
+/// A constraint file's family runs like a built-in one: named on the command line and in the
+/// JSON, its compliance set by its name, the source note's height recovering a mirrored cube
+/// with the edges as the built-in heights do.
+#[test]
+fn a_constraint_files_family_runs_like_a_built_in_one() {
+    let height = &asset("constraints/height.toml");
+    let base = [
+        "run",
+        "--scene",
+        "cube",
+        "--resolution",
+        "2",
+        "--perturb",
+        "mirror",
+        "--gravity",
+        "0",
+        "--frames",
+        "60",
+        "--json",
+    ];
+    let mut args = base.to_vec();
+    args.extend(["--constraints", "edges", "--constraint-file", height]);
+    let file = json_lines(&args);
+    let mut args = base.to_vec();
+    args.extend(["--constraints", "edges,height"]);
+    let builtin = json_lines(&args);
+    assert_eq!(file[0]["inverted_tets"], 48);
+    let (last, reference) = (&file[60], &builtin[60]);
+    assert_eq!(last["inverted_tets"], 0, "recovered");
+    assert_eq!(reference["inverted_tets"], 0);
+    let residual = last["residual_my-height"]
+        .as_f64()
+        .expect("the file's family in the JSON");
+    assert!(residual < 1e-3, "{residual}");
+
+    // Named before the file that defines it, with a compliance; the summary names the file.
+    let output = tetlab(&[
+        "run",
+        "--scene",
+        "tet",
+        "--frames",
+        "1",
+        "--constraints",
+        "my-height,volume",
+        "--compliance",
+        "my-height=1e-4",
+        "--constraint-file",
+        height,
+    ]);
+    let text = stdout(&output);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(text.contains("volume+my-height"), "{text}");
+    assert!(text.contains("compliance my-height=0.0001"), "{text}");
+    assert!(
+        text.contains("my-height from ") && text.contains("height.toml with the AD gradient"),
+        "{text}"
+    );
+}
+
+/// A constraint file with a mistake, or a name already taken, stops the run before it starts:
+/// one line naming the file, its line and column, exit status 2.
+#[test]
+fn a_bad_constraint_file_is_named_at_its_line_and_column() {
+    let dir = std::env::temp_dir().join(format!("tetlab-run-file-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        "name = \"bad\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p3) - rest\"\n",
+    )
+    .unwrap();
+    let output = tetlab(&["run", "--constraint-file", bad.to_str().unwrap()]);
+    let line = assert_usage_error(&output, "bad.toml:3:");
+    assert!(line.contains("`p3`") && line.contains("p0…p1"), "{line}");
+
+    let twin = dir.join("twin.toml");
+    let text = std::fs::read_to_string(asset("constraints/volume.toml")).unwrap();
+    std::fs::write(&twin, text.replace("det(", "0.5 * det(")).unwrap();
+    let output = tetlab(&[
+        "run",
+        "--constraint-file",
+        &asset("constraints/volume.toml"),
+        "--constraint-file",
+        twin.to_str().unwrap(),
+    ]);
+    let line = assert_usage_error(&output, "twin.toml");
+    assert!(line.contains("already the name of"), "{line}");
+
+    let builtin = dir.join("builtin.toml");
+    std::fs::write(
+        &builtin,
+        "name = \"volume\"\napplies_to = \"tets\"\nvalue = \"1\"\n",
+    )
+    .unwrap();
+    let line = assert_usage_error(
+        &tetlab(&["run", "--constraint-file", builtin.to_str().unwrap()]),
+        "builtin.toml",
+    );
+    assert!(line.contains("built-in"), "{line}");
 }

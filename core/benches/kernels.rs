@@ -95,13 +95,10 @@ fn kernels(c: &mut Criterion) {
     group.finish();
 }
 
-/// One frame of the fast solver (edges + volume, 10 substeps) on the bunny of ../shared/meshes, or
-/// on a cube of about the same size when the shared meshes are not there: Gauss–Seidel and
-/// Jacobi. The same work as `tetlab bench`, here so that builds for other CPUs are quick to
-/// compare (`RUSTFLAGS="-C target-cpu=x86-64" cargo bench -p tetlab-core -- frame`).
 /// C and ∇C of the height: the built-in formula, and the same constraint compiled from
-/// assets/constraints/height.toml, with ∇C by forward-mode AD (12 passes of the program) and with
-/// the file's own gradient (`use_gradient`, one pass).
+/// assets/constraints/height.toml, with ∇C by reverse-mode AD (what a simulation uses: one pass
+/// forward, one back), by forward-mode AD (what `check-gradients` compares with: 12 passes) and
+/// with the file's own gradient (`use_gradient`, one pass).
 fn constraint_file(c: &mut Criterion) {
     let tet = [
         DVec3::new(0.0, 0.0, 0.0),
@@ -119,6 +116,9 @@ fn constraint_file(c: &mut Criterion) {
     group.bench_function("file, AD", |b| {
         b.iter(|| file.evaluate_vectors(black_box(&tet), 0.7))
     });
+    group.bench_function("file, forward-mode AD", |b| {
+        b.iter(|| file.evaluate(black_box(&tet), 0.7))
+    });
     file.use_gradient = true;
     group.bench_function("file, its own gradient", |b| {
         b.iter(|| file.evaluate_vectors(black_box(&tet), 0.7))
@@ -126,6 +126,10 @@ fn constraint_file(c: &mut Criterion) {
     group.finish();
 }
 
+/// One frame of the fast solver (edges + volume, 10 substeps) on the bunny of ../shared/meshes, or
+/// on a cube of about the same size when the shared meshes are not there: Gauss–Seidel and
+/// Jacobi. The same work as `tetlab bench`, here so that builds for other CPUs are quick to
+/// compare (`RUSTFLAGS="-C target-cpu=x86-64" cargo bench -p tetlab-core -- frame`).
 fn frame(c: &mut Criterion) {
     let bunny = tetlab_core::shared_meshes::folder().join("bunny.node");
     let (name, scene) = match Scene::load(&bunny) {

@@ -1,5 +1,6 @@
 //! What the inspector shows about a constraint: its numbers as the solver sees them
-//! ([`Projection`]) and its analytic gradient checked against central differences, live.
+//! ([`Projection`]) and its analytic gradient checked against central differences, live; for a
+//! constraint file's family, ∇C by automatic differentiation beside the file's own.
 
 use crate::constraints::Family;
 use crate::solver::{Projection, Simulation};
@@ -15,6 +16,18 @@ pub struct Inspection {
     pub numeric_gradients: [DVec3; 4],
     /// maxᵢ |∇ₚᵢC − ∇ₚᵢC_fd|∞ / maxᵢ |∇ₚᵢC| (see [`relative_error`]).
     pub relative_error: f64,
+    /// For a family read from a constraint file: ∇C by AD and the file's own, side by side.
+    pub file_gradients: Option<FileGradients>,
+}
+
+/// The two gradients of a constraint file's constraint, per particle (the first
+/// `projection.len`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FileGradients {
+    /// ∇ₚC by automatic differentiation (zero where it is undefined).
+    pub automatic: [DVec3; 4],
+    /// The file's own ∇ₚC, for each particle it gives one for.
+    pub yours: [Option<DVec3>; 4],
 }
 
 impl Inspection {
@@ -49,10 +62,27 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
     let (analytic, numeric) = analytic_and_numeric(family, &points, projection.rest, &rest_shape);
     let mut numeric_gradients = [DVec3::ZERO; 4];
     numeric_gradients[..numeric.len()].copy_from_slice(&numeric);
+    let file_gradients = family.file().map(|file| {
+        let mut automatic = [DVec3::ZERO; 4];
+        let mut at = [DVec3::ZERO; 4];
+        at[..points.len()].copy_from_slice(&points);
+        match points.len() {
+            2 => {
+                let e = file.evaluate_by(&[at[0], at[1]], projection.rest, false);
+                automatic[..2].copy_from_slice(&e.gradients);
+            }
+            _ => automatic = file.evaluate_by(&at, projection.rest, false).gradients,
+        }
+        FileGradients {
+            automatic,
+            yours: file.yours(&points, projection.rest),
+        }
+    });
     Inspection {
         projection,
         numeric_gradients,
         relative_error: relative_error(&analytic, &numeric),
+        file_gradients,
     }
 }
 

@@ -20,6 +20,11 @@
 //! expect = ["inverted_tets == 1", "max_edge_strain < 1e-6"]
 //! ```
 //!
+//! A lesson may bring constraint files (`constraint_files = ["../constraints/height.toml"]`,
+//! relative to the lesson): their families join the table when it is read, and its settings and
+//! steps name them like the built-in ones; `gradient_error.NAME` measures how far such a file's
+//! gradient is from automatic differentiation ([`GRADIENT_ERROR`]).
+//!
 //! Actions: `reset`, `invert` (the lesson's tet, through its first corner), `invert:K`, `mirror`,
 //! `flatten`, `scramble:SEED`, `select:K`, `constraints:LIST`, `solver:xpbd|pbd`,
 //! `compliance:FAMILY=α`, `stiffness:FAMILY=k`, `substeps:N`, `iterations:N`, `gravity:G`,
@@ -28,6 +33,7 @@
 //! [`Metrics::headline`] (`compare.METRIC` for the comparison's) and OP one of `==`, `!=`, `<`,
 //! `<=`, `>`, `>=`.
 
+use crate::constraint_file::ConstraintFile;
 use crate::constraints::{Family, PerFamily};
 use crate::divergence::Divergence;
 use crate::limits::{self, Bounds};
@@ -52,6 +58,9 @@ pub struct Lesson {
     pub scene: String,
     /// The resolution of a built-in scene.
     pub resolution: u32,
+    /// The families of the constraint files the lesson names (`constraint_files`), defined in
+    /// the table when the lesson was read ([`Family::define`]).
+    pub families: Vec<Family>,
     /// The tet whose arrows are shown at the start.
     pub tet: usize,
     /// The solver settings at the start.
@@ -107,8 +116,10 @@ pub enum Action {
 pub struct Expectation {
     /// Whether the metric is the comparison simulation's (written `compare.METRIC`).
     pub of_comparison: bool,
-    /// The metric's name, one of [`Metrics::headline`].
+    /// The metric's name, one of [`Metrics::headline`], or [`GRADIENT_ERROR`].
     pub metric: String,
+    /// For [`GRADIENT_ERROR`]: the family (of a constraint file) whose gradient it is about.
+    pub gradient_of: Option<Family>,
     /// The comparison.
     pub op: Op,
     /// The number compared with.
@@ -163,10 +174,20 @@ impl Op {
     }
 }
 
+/// The measure of how far a constraint file's gradient is from automatic differentiation, as a
+/// lesson expects it: `gradient_error.NAME < 1e-6`, NAME a family read from a constraint file
+/// ([`crate::constraint_file::check::gradient_error`]: the largest relative error over random
+/// configurations; infinite when the file gives no gradient).
+pub const GRADIENT_ERROR: &str = "gradient_error";
+
 impl Expectation {
     /// The metric's current value, and whether the expectation holds for it (never for a value
     /// that is not finite); `None` when it is about the comparison and there is none.
     pub fn check(&self, metrics: &Metrics, comparison: Option<&Metrics>) -> Option<(f64, bool)> {
+        if let Some(family) = self.gradient_of {
+            let value = gradient_error(family);
+            return Some((value, value.is_finite() && self.op.holds(value, self.value)));
+        }
         let metrics = if self.of_comparison {
             comparison?
         } else {
@@ -187,38 +208,83 @@ impl Expectation {
             .find_map(|&(symbol, op)| text.find(symbol).map(|at| (symbol, op, at)))
             .ok_or_else(|| format!("'{text}' is not METRIC OP NUMBER (e.g. inverted_tets == 0)"))?;
         let metric = text[..at].trim();
+        let number = text[at + symbol.len()..].trim();
+        let value = finite(number)?;
+        if let Some(name) = metric
+            .strip_prefix(GRADIENT_ERROR)
+            .and_then(|m| m.strip_prefix('.'))
+        {
+            let family = Family::parse(name)?;
+            if family.file().is_none() {
+                return Err(format!(
+                    "{GRADIENT_ERROR}.{name}: {name} is a built-in family; {GRADIENT_ERROR} is about \
+                     the gradient a constraint file gives (name one in constraint_files)"
+                ));
+            }
+            return Ok(Expectation {
+                of_comparison: false,
+                metric: GRADIENT_ERROR.to_owned(),
+                gradient_of: Some(family),
+                op,
+                value,
+            });
+        }
         let (of_comparison, metric) = match metric.strip_prefix("compare.") {
             Some(metric) => (true, metric),
             None => (false, metric),
         };
-        let number = text[at + symbol.len()..].trim();
         let names = Metrics::default().headline().map(|(name, _)| name);
         if !names.contains(&metric) {
             return Err(format!(
-                "'{metric}' is not a metric: expected one of {}",
+                "'{metric}' is not a metric: expected one of {}, or {GRADIENT_ERROR}.FAMILY",
                 names.join(", ")
             ));
         }
-        let value = finite(number)?;
         Ok(Expectation {
             of_comparison,
             metric: metric.to_owned(),
+            gradient_of: None,
             op,
             value,
         })
     }
 }
 
+/// [`crate::constraint_file::check::gradient_error`] of `family`'s file, measured once per
+/// definition of the family (a lesson's checks are shown every frame).
+fn gradient_error(family: Family) -> f64 {
+    use std::sync::Mutex;
+    static MEASURED: Mutex<Vec<(Family, u64, f64)>> = Mutex::new(Vec::new());
+    let generation = family.generation();
+    let mut measured = MEASURED.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(&(_, _, error)) = measured
+        .iter()
+        .find(|(f, g, _)| *f == family && *g == generation)
+    {
+        return error;
+    }
+    let error = family.file().map_or(f64::INFINITY, |file| {
+        crate::constraint_file::check::gradient_error(&file)
+    });
+    measured.retain(|(f, _, _)| *f != family);
+    measured.push((family, generation, error));
+    error
+}
+
 impl fmt::Display for Expectation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let prefix = if self.of_comparison { "compare." } else { "" };
+        let prefix = match self.gradient_of {
+            Some(family) => format!("{GRADIENT_ERROR}.{}", family.name()),
+            None if self.of_comparison => format!("compare.{}", self.metric),
+            None => self.metric.clone(),
+        };
         let v = self.value;
         let number = if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
             format!("{v:e}")
         } else {
             v.to_string()
         };
-        write!(f, "{prefix}{} {} {number}", self.metric, self.op.symbol())
+        write!(f, "{prefix} {} {number}", self.op.symbol())
     }
 }
 
@@ -361,6 +427,8 @@ struct RawLesson {
     scene: Spanned<String>,
     resolution: Option<Spanned<u32>>,
     tet: Option<Spanned<usize>>,
+    #[serde(default)]
+    constraint_files: Vec<Spanned<String>>,
     #[serde(default)]
     settings: RawSettings,
     #[serde(default)]
@@ -516,6 +584,16 @@ impl Lesson {
             toml::from_str(text).map_err(|e| error(e.span(), e.message().trim().to_owned()))?;
         let at = |span: std::ops::Range<usize>| move |message: String| error(Some(span), message);
 
+        // The constraint files first: the settings and steps may name their families.
+        let mut families = Vec::new();
+        for file in &raw.constraint_files {
+            let resolved = resolve_path(path, file.get_ref());
+            let family = ConstraintFile::load(Path::new(&resolved))
+                .map_err(|e| e.to_string())
+                .and_then(Family::define)
+                .map_err(|e| error(Some(file.span()), format!("constraint file: {e}")))?;
+            families.push(family);
+        }
         let mut settings = Settings::default();
         let s = &raw.settings;
         if let Some(list) = &s.constraints {
@@ -659,6 +737,7 @@ impl Lesson {
             source: path.to_owned(),
             scene,
             resolution,
+            families,
             tet,
             settings,
             steps,
@@ -673,14 +752,22 @@ impl Lesson {
 
 /// A built-in name as it is; a mesh path relative to the lesson's folder.
 fn resolve_scene(lesson: &Path, scene: &str) -> String {
-    if crate::scene::Builtin::from_name(scene).is_some() || Path::new(scene).is_absolute() {
+    if crate::scene::Builtin::from_name(scene).is_some() {
         return scene.to_owned();
+    }
+    resolve_path(lesson, scene)
+}
+
+/// A path a lesson names, relative to the lesson's folder unless it is absolute.
+fn resolve_path(lesson: &Path, path: &str) -> String {
+    if Path::new(path).is_absolute() {
+        return path.to_owned();
     }
     match lesson.parent() {
         Some(folder) if !folder.as_os_str().is_empty() => {
-            folder.join(scene).to_string_lossy().into_owned()
+            folder.join(path).to_string_lossy().into_owned()
         }
-        _ => scene.to_owned(),
+        _ => path.to_owned(),
     }
 }
 
@@ -720,6 +807,17 @@ pub struct StepOutcome {
     pub checks: Vec<(Expectation, Option<f64>, bool)>,
 }
 
+impl Step {
+    /// The families whose gradient this step expects to agree with automatic differentiation
+    /// (`gradient_error.NAME < …`): the step is an exercise about their files.
+    pub fn exercises(&self) -> impl Iterator<Item = Family> + '_ {
+        self.expect.iter().filter_map(|e| {
+            e.gradient_of
+                .filter(|_| matches!(e.op, Op::Less | Op::LessOrEqual))
+        })
+    }
+}
+
 /// A lesson running headless: the simulation, the selected tet, and the comparison simulation
 /// when a step asked for one.
 pub struct LessonRun {
@@ -732,6 +830,8 @@ pub struct LessonRun {
     scene: Scene,
     /// The metrics of both simulations, as last measured by [`LessonRun::measure`].
     metrics: (Metrics, Option<Metrics>),
+    /// Answers handed in ([`LessonRun::hand_in`]) not yet taken up.
+    answers: Vec<ConstraintFile>,
 }
 
 impl LessonRun {
@@ -745,7 +845,31 @@ impl LessonRun {
             comparison: None,
             tet: lesson.tet,
             scene,
+            answers: Vec::new(),
         }
+    }
+
+    /// A student's answer to an exercise of the lesson: a constraint file with the name of one
+    /// the lesson brings. It replaces that file's family from the first step that expects its
+    /// gradient to agree ([`Step::exercises`]), as the student's edits in the workbench would:
+    /// the steps before it still show the lesson's own file.
+    ///
+    /// An error when no step of `lesson` is an exercise about a family of that name.
+    pub fn hand_in(&mut self, lesson: &Lesson, answer: ConstraintFile) -> Result<(), String> {
+        let asked = lesson
+            .steps
+            .iter()
+            .flat_map(Step::exercises)
+            .any(|family| family.name() == answer.name);
+        if !asked {
+            return Err(format!(
+                "{} defines {}, and no step of this lesson is an exercise about {0}",
+                answer.path.display(),
+                answer.name
+            ));
+        }
+        self.answers.push(answer);
+        Ok(())
     }
 
     /// Applies one action to the simulation and to the comparison.
@@ -811,6 +935,20 @@ impl LessonRun {
         step: &Step,
         mut on_frame: impl FnMut(&LessonRun) -> ControlFlow<()>,
     ) -> Result<Option<StepOutcome>, Divergence> {
+        let exercises: Vec<Family> = step.exercises().collect();
+        let (taken, kept): (Vec<_>, Vec<_>) = std::mem::take(&mut self.answers)
+            .into_iter()
+            .partition(|a| exercises.iter().any(|f| f.name() == a.name));
+        self.answers = kept;
+        for answer in taken {
+            // Its name is a family's already (hand_in checked): it is redefined in place, which
+            // cannot fail.
+            let _ = Family::define(answer);
+            self.simulation.refresh_families();
+            if let Some(comparison) = &mut self.comparison {
+                comparison.refresh_families();
+            }
+        }
         for &action in &step.actions {
             self.apply(action);
         }

@@ -160,19 +160,111 @@ pub const CORRECTION: Rgba = [200, 50, 200, 255];
 /// What an arrow shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Quantity {
-    /// ∇ₚC of one constraint of a family.
+    /// ∇ₚC of one constraint of a family, as the solver projects it.
     Gradient(Family),
+    /// For a family read from a constraint file that gives its own gradient: the gradient the
+    /// solver does not use (yours, or AD's when the file asks for its own to be used), drawn only
+    /// at particles where it differs from the one in use.
+    Disagreeing(Family),
     /// Δp, the correction the last substep's projections made (see
     /// [`Simulation::corrections`]).
     Correction,
 }
 
 impl Quantity {
-    /// The arrow colour: [`family_colour`] for gradients, [`CORRECTION`] for corrections.
+    /// The arrow colour: [`family_colour`] for gradients, the same lightened halfway to white
+    /// for the disagreeing one, [`CORRECTION`] for corrections.
     pub fn colour(self) -> Rgba {
         match self {
             Quantity::Gradient(family) => family_colour(family),
+            Quantity::Disagreeing(family) => {
+                let [r, g, b, a] = family_colour(family);
+                let light = |c: u8| c + (255 - c) / 2;
+                [light(r), light(g), light(b), a]
+            }
             Quantity::Correction => CORRECTION,
+        }
+    }
+
+    /// What it is, for legends: "grad C: heights", "grad C: my-height, yours, where it differs",
+    /// "dp".
+    pub fn label(self) -> String {
+        match self {
+            Quantity::Gradient(family) => match family.file() {
+                Some(file) if file.use_gradient => format!("grad C: {} (yours)", family.name()),
+                Some(_) => format!("grad C: {} (AD)", family.name()),
+                None => format!("grad C: {}", family.row().label),
+            },
+            Quantity::Disagreeing(family) => {
+                let other = Quantity::disagreeing_name(family);
+                format!("grad C: {}, {other}, where it differs", family.name())
+            }
+            Quantity::Correction => "dp".to_owned(),
+        }
+    }
+}
+
+impl Quantity {
+    /// Which gradient the [`Quantity::Disagreeing`] arrows of `family` show: "yours", or "AD"
+    /// when the file asks the solver to use its own (`use_gradient`).
+    pub fn disagreeing_name(family: Family) -> &'static str {
+        match family.file() {
+            Some(file) if file.use_gradient => "AD",
+            _ => "yours",
+        }
+    }
+
+    /// The gradient quantities a family's arrows can show: its ∇C, and for a constraint file
+    /// that gives its own gradient, the one not in use ([`Quantity::Disagreeing`]).
+    pub fn of_family(family: Family) -> impl Iterator<Item = Quantity> {
+        let gives = family
+            .file()
+            .is_some_and(|file| (0..file.arity()).any(|k| file.gives_gradient(k)));
+        [Quantity::Gradient(family)]
+            .into_iter()
+            .chain(gives.then_some(Quantity::Disagreeing(family)))
+    }
+}
+
+/// The relative difference (to the largest gradient of the constraint) from which a
+/// [`Quantity::Disagreeing`] arrow is drawn.
+pub const DISAGREEMENT: f64 = 1e-6;
+
+/// The [`Quantity::Disagreeing`] arrows of one projection of a file family: at each particle the
+/// file gives a gradient for, the gradient the solver does not use, where it differs from the
+/// one it uses by more than [`DISAGREEMENT`]. Appends to `out`, unscaled.
+fn disagreeing_arrows(positions: &[DVec3], projection: &Projection, out: &mut Vec<Arrow>) {
+    let Some(file) = projection.family.file() else {
+        return;
+    };
+    if projection.degenerate || !(0..projection.len).any(|k| file.gives_gradient(k)) {
+        return;
+    }
+    let points: [DVec3; 4] = std::array::from_fn(|k| {
+        positions[projection.particles[k.min(projection.len - 1)] as usize]
+    });
+    let other = match projection.len {
+        2 => {
+            let e = file.evaluate_by(&[points[0], points[1]], projection.rest, !file.use_gradient);
+            [e.gradients[0], e.gradients[1], DVec3::ZERO, DVec3::ZERO]
+        }
+        _ => {
+            file.evaluate_by(&points, projection.rest, !file.use_gradient)
+                .gradients
+        }
+    };
+    let used = &projection.gradients[..projection.len];
+    let scale = used.iter().map(|g| g.length()).fold(0.0, f64::max);
+    for (k, (&particle, &gradient)) in projection.particles().iter().zip(&other).enumerate() {
+        let differs = (gradient - used[k]).length() > DISAGREEMENT * scale;
+        if file.gives_gradient(k) && differs {
+            out.push(Arrow {
+                quantity: Quantity::Disagreeing(projection.family),
+                particle,
+                origin: positions[particle as usize],
+                value: gradient,
+                vector: DVec3::ZERO,
+            });
         }
     }
 }
@@ -198,7 +290,8 @@ pub const GRADIENT_ARROW_LENGTH: f64 = 0.4;
 
 /// The gradient arrows of `family` on tet `tet`: ∇ₚC at each particle p of each of the family's
 /// constraints on that tet — 6 edges × 2 particles, 4 heights × 4 particles, or 1 volume × 4
-/// particles. Degenerate constraints have no arrows. Gradients of different families have
+/// particles — and, for a constraint file that gives its own gradient, the one not in use where
+/// it differs ([`Quantity::Disagreeing`]). Degenerate constraints have no arrows. Gradients of different families have
 /// different units (1, 1 and m²), so each family is scaled on its own: its longest arrow on the tet
 /// is drawn `gain` × [`GRADIENT_ARROW_LENGTH`] × the tet's size long. Appends to `out`.
 pub fn tet_gradient_arrows(
@@ -224,6 +317,7 @@ pub fn tet_gradient_arrows(
                 vector: DVec3::ZERO,
             });
         }
+        disagreeing_arrows(positions, &projection, out);
     }
     let length = gain * GRADIENT_ARROW_LENGTH * tet_size(positions, &simulation.tets()[tet]);
     scale_to_longest(&mut out[first..], length);
@@ -270,6 +364,7 @@ pub fn projection_arrows(
                 vector: DVec3::ZERO,
             });
         }
+        disagreeing_arrows(positions, projection, out);
     }
     scale_to_longest(&mut out[first..], gain * GRADIENT_ARROW_LENGTH * size);
     for (&particle, &delta) in particles.iter().zip(&projection.delta_x) {

@@ -250,11 +250,17 @@ fn a_simulation_gets_a_zero_gradient_where_it_is_undefined_and_yours_when_asked(
     assert!(e.degenerate);
     assert_eq!(e.gradients, [DVec3::ZERO; 2]);
     assert_eq!(e.value, -0.5);
-    // The wrong height, simulated with its own gradient (a top-level key, before [gradient]).
-    let text = std::fs::read_to_string(asset("height-wrong-sign.toml")).unwrap();
-    let text = text.replacen("[gradient]", "use_gradient = true\n\n[gradient]", 1);
-    let wrong = ConstraintFile::parse(Path::new("wrong.toml"), &text).unwrap();
+    // The wrong height is simulated with its own gradient (use_gradient = true); without the
+    // key, with AD's.
+    let wrong = load("height-wrong-sign.toml");
     assert!(wrong.use_gradient);
+    let text = std::fs::read_to_string(asset("height-wrong-sign.toml")).unwrap();
+    let by_ad = text.replace("use_gradient = true", "");
+    assert!(
+        !ConstraintFile::parse(Path::new("ad.toml"), &by_ad)
+            .unwrap()
+            .use_gradient
+    );
     let points = &configurations(4, 1, 12)[0];
     let p: [DVec3; 4] = std::array::from_fn(|k| points[k]);
     let used = wrong.evaluate_vectors(&p, 0.0);
@@ -265,5 +271,40 @@ fn a_simulation_gets_a_zero_gradient_where_it_is_undefined_and_yours_when_asked(
             checked.yours[k].unwrap(),
             "the file's own, wrong as it is"
         );
+    }
+}
+
+/// The gradient a simulation uses (reverse mode over the compiled tape, one pass back) is the
+/// one `check-gradients` compares yours with (forward mode, one pass per coordinate): on every
+/// example, on random configurations, they agree to rounding.
+#[test]
+fn reverse_and_forward_mode_agree_on_every_example() {
+    use glam::DVec3;
+    use tetlab_core::constraint_file::EXAMPLES;
+    for example in EXAMPLES {
+        let file = ConstraintFile::parse(Path::new(example.path), example.text).unwrap();
+        let mut worst: f64 = 0.0;
+        for (k, points) in configurations(file.arity(), 300, 21).iter().enumerate() {
+            let rest = 0.1 * k as f64 / 300.0;
+            let forward = file
+                .evaluate(points, rest)
+                .automatic
+                .expect("well conditioned");
+            let reverse: Vec<DVec3> = match file.arity() {
+                2 => file
+                    .evaluate_by(&[points[0], points[1]], rest, false)
+                    .gradients
+                    .to_vec(),
+                _ => {
+                    let p: [DVec3; 4] = std::array::from_fn(|i| points[i]);
+                    file.evaluate_by(&p, rest, false).gradients.to_vec()
+                }
+            };
+            let scale = forward.iter().map(|g| g.length()).fold(0.0, f64::max);
+            for (f, r) in forward.iter().zip(&reverse) {
+                worst = worst.max((*f - *r).length() / scale);
+            }
+        }
+        assert!(worst < 1e-12, "{}: {worst:e}", example.file);
     }
 }

@@ -38,3 +38,8 @@ pub fn assert_usage_error(output: &Output, names: &str) -> String {
     assert!(err.contains(names), "stderr should name {names}: {err}");
     err
 }
+
+/// The path of `relative` under the repository's `assets/` folder (the tests run in `app/`).
+pub fn asset(relative: &str) -> String {
+    format!("{}/../assets/{relative}", env!("CARGO_MANIFEST_DIR"))
+}

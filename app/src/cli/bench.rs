@@ -112,7 +112,7 @@ fn active_only<S: serde::Serializer>(
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let scene = Scene::from_spec(&args.scene, args.resolution)
         .map_err(|e| UsageError(format!("--scene: {e}")))?;
-    let settings = args.solver.settings();
+    let settings = args.solver.settings()?;
     let mut simulation = Simulation::new(&scene, settings);
     super::simulation_args::warn_if_unstable(&simulation);
     let report = if args.reference {
@@ -134,6 +134,7 @@ fn time_reference(
     Ok(report(
         args,
         scene,
+        simulation.settings().active,
         "reference (f64)",
         1,
         projections,
@@ -178,6 +179,7 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
     let mut report = report(
         args,
         scene,
+        active,
         solver,
         fast.threads(),
         fast.projections_per_frame(),
@@ -221,6 +223,7 @@ fn time<S>(args: &Args, solver: &mut S, step: fn(&mut S), warmed: fn(&mut S)) ->
 fn report(
     args: &Args,
     scene: &Scene,
+    active: PerFamily<bool>,
     solver: &'static str,
     threads: usize,
     projections_per_frame: u64,
@@ -239,8 +242,8 @@ fn report(
         particles: scene.mesh.positions.len(),
         tets,
         edges: scene.mesh.edges().len(),
-        constraints: args.solver.constraints.describe(),
-        active: args.solver.constraints,
+        constraints: active.describe(),
+        active,
         substeps: args.solver.substeps,
         iterations: args.solver.iterations,
         frames: args.frames,

@@ -8,6 +8,8 @@ use crate::record::{ArrowsMode, Destination, Ending, Recorder, Session, send_lay
 use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use tetlab_core::constraint_file::ConstraintFile;
+use tetlab_core::constraints::Family;
 use tetlab_core::lesson::{Action, BUILTIN, Lesson, LessonRun};
 
 /// Options of `tetlab lesson`.
@@ -25,6 +27,11 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// A constraint file whose family joins the lesson's active families; a file with the name
+    /// of one the lesson brings is your answer to its exercise, and replaces it from the step
+    /// that checks it; repeatable.
+    #[arg(long = "constraint-file", value_name = "FILE", conflicts_with = "list")]
+    constraint_files: Vec<PathBuf>,
     /// The neo-Hookean material instead of the lesson's: E=PA,nu=N, as for `tetlab run`.
     #[arg(long, value_name = "E=PA,nu=N", value_parser = tetlab_core::material::Material::parse, conflicts_with = "list")]
     material: Option<tetlab_core::material::Material>,
@@ -79,7 +86,25 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     if let Some(material) = args.material {
         lesson.settings.set_material(material);
     }
+    // A file named after one of the lesson's is an answer to its exercise, taken up at the
+    // exercise; any other joins the active families now.
+    let mut answers = Vec::new();
+    for path in &args.constraint_files {
+        let file =
+            ConstraintFile::load(path).map_err(|e| UsageError(format!("--constraint-file {e}")))?;
+        if lesson.families.iter().any(|f| f.name() == file.name) {
+            answers.push(file);
+        } else {
+            let family = Family::register(file)
+                .map_err(|e| UsageError(format!("--constraint-file {}: {e}", path.display())))?;
+            lesson.settings.active.set(family, true);
+        }
+    }
     let mut run = LessonRun::new(&lesson);
+    for answer in answers {
+        run.hand_in(&lesson, answer)
+            .map_err(|e| UsageError(format!("--constraint-file {e}")))?;
+    }
     super::simulation_args::warn_if_unstable(&run.simulation);
     let frames: u64 = lesson.steps.iter().map(|s| s.frames).sum();
     let compares = lesson

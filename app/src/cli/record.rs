@@ -100,7 +100,7 @@ fn describe(rec: &RecordingStream, scene: &Scene, simulation: &Simulation, args:
         simulation.positions().len(),
         simulation.tets().len(),
         simulation.constraint_count(Family::EDGES),
-        args.simulation.describe(),
+        args.simulation.describe(simulation),
         args.arrows,
         args.tet
     );

@@ -89,7 +89,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             out,
             "perturbation {}; {}",
             perturbation.as_deref().unwrap_or("none"),
-            args.simulation.describe()
+            args.simulation.describe(&simulation)
         )
         .map_err(io)?;
         summary_line(out, 0, &initial).map_err(io)?;

@@ -2,6 +2,8 @@
 //! simulation), and how they become a [`Simulation`].
 
 use super::UsageError;
+use std::path::PathBuf;
+use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::Family;
 use tetlab_core::constraints::PerFamily;
 use tetlab_core::limits::{self, Number};
@@ -37,12 +39,18 @@ pub struct SimulationArgs {
 
 /// The solver's options, the same for every subcommand that simulates (`run`, `record`,
 /// `bench`); each range is [`tetlab_core::limits`]'s, and the ground follows gravity
-/// ([`Settings::set_gravity`]).
+/// ([`Settings::set_gravity`]). Family names are read once the constraint files are loaded, so
+/// that `--constraints` and `--compliance` can name a file's family in any order.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SolverArgs {
-    /// Active constraint families, comma-separated: edges, height, volume, neohookean.
-    #[arg(long, default_value = "edges,volume", value_parser = PerFamily::parse_list)]
-    pub constraints: PerFamily<bool>,
+    /// Active constraint families, comma-separated: edges, height, volume, neohookean, the name
+    /// of a --constraint-file's family, or none.
+    #[arg(long, default_value = "edges,volume", value_name = "LIST")]
+    pub constraints: String,
+    /// A constraint file (TOML: C as an expression; assets/constraints/ has examples), whose
+    /// family is added to the active ones; repeatable.
+    #[arg(long = "constraint-file", value_name = "FILE")]
+    pub constraint_files: Vec<PathBuf>,
     /// xpbd or pbd.
     #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
     pub solver: Method,
@@ -60,11 +68,11 @@ pub struct SolverArgs {
     pub gravity: f64,
     /// XPBD compliance of a family, FAMILY=α (0 <= α <= 1e10; 0 is rigid, the default);
     /// repeatable.
-    #[arg(long, value_name = "FAMILY=α", value_parser = |s: &str| limits::family_value(s, &limits::COMPLIANCE), allow_hyphen_values = true)]
-    pub compliance: Vec<(Family, f64)>,
+    #[arg(long, value_name = "FAMILY=α", value_parser = |s: &str| NamedValue::parse(s, &limits::COMPLIANCE), allow_hyphen_values = true)]
+    pub compliance: Vec<NamedValue>,
     /// PBD stiffness of a family, FAMILY=k with 0 <= k <= 1 (default 1); repeatable.
-    #[arg(long, value_name = "FAMILY=k", value_parser = |s: &str| limits::family_value(s, &limits::STIFFNESS))]
-    pub stiffness: Vec<(Family, f64)>,
+    #[arg(long, value_name = "FAMILY=k", value_parser = |s: &str| NamedValue::parse(s, &limits::STIFFNESS))]
+    pub stiffness: Vec<NamedValue>,
     /// Velocity damping per second (0..=1e6).
     #[arg(long, default_value_t = Settings::default().damping, value_parser = |s: &str| limits::DAMPING.parse(s), allow_hyphen_values = true)]
     pub damping: f64,
@@ -75,12 +83,42 @@ pub struct SolverArgs {
     pub material: Option<Material>,
 }
 
+/// `FAMILY=VALUE` as given, its value in range; the family is looked up later
+/// ([`SolverArgs::settings`]), once the constraint files have added theirs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedValue {
+    /// The family's name as written.
+    pub name: String,
+    /// The value.
+    pub value: f64,
+}
+
+impl NamedValue {
+    fn parse(text: &str, bounds: &limits::Bounds<f64>) -> Result<NamedValue, String> {
+        let (name, value) = text
+            .split_once('=')
+            .ok_or_else(|| format!("'{text}' is not FAMILY=VALUE (e.g. edges=1e-6)"))?;
+        Ok(NamedValue {
+            name: name.trim().to_owned(),
+            value: bounds.parse(value)?,
+        })
+    }
+}
+
 impl SolverArgs {
-    /// The solver settings these options ask for.
-    pub fn settings(&self) -> Settings {
+    /// The solver settings these options ask for: the constraint files loaded and their
+    /// families added to the table and to the active ones, then every family name looked up.
+    /// An error names the option, and for a file the line and column of its mistake.
+    pub fn settings(&self) -> Result<Settings, UsageError> {
+        let files = self.load_constraint_files()?;
+        let mut active = PerFamily::parse_list(&self.constraints)
+            .map_err(|e| UsageError(format!("--constraints: {e}")))?;
+        for family in files {
+            active.set(family, true);
+        }
         let mut settings = Settings {
             method: self.solver,
-            active: self.constraints,
+            active,
             substeps: self.substeps,
             iterations: self.iterations,
             dt: self.dt,
@@ -91,19 +129,34 @@ impl SolverArgs {
         if let Some(material) = self.material {
             settings.set_material(material);
         }
-        for &(family, alpha) in &self.compliance {
-            settings.compliance.set(family, alpha);
+        for (option, values) in [
+            ("--compliance", &self.compliance),
+            ("--stiffness", &self.stiffness),
+        ] {
+            for NamedValue { name, value } in values {
+                let family = limits::settable_family(name)
+                    .map_err(|e| UsageError(format!("{option} {name}={value}: {e}")))?;
+                if option == "--compliance" {
+                    settings.compliance.set(family, *value);
+                } else {
+                    settings.stiffness.set(family, *value);
+                }
+            }
         }
-        for &(family, k) in &self.stiffness {
-            settings.stiffness.set(family, k);
-        }
-        settings
+        Ok(settings)
+    }
+
+    /// Loads every `--constraint-file` and adds its family to the table.
+    fn load_constraint_files(&self) -> Result<Vec<Family>, UsageError> {
+        self.constraint_files
+            .iter()
+            .map(|path| load_constraint_file(path, Family::register))
+            .collect()
     }
 
     /// "xpbd, edges+volume, 100 substeps × 1 iteration, dt 0.016667 s, gravity 9.81" and any
-    /// non-default compliance or stiffness.
-    pub fn describe(&self) -> String {
-        let s = self.settings();
+    /// non-default compliance or stiffness, for the settings [`SolverArgs::settings`] gave.
+    pub fn describe(&self, s: &Settings) -> String {
         let mut text = format!(
             "{}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
             s.method.name(),
@@ -114,11 +167,11 @@ impl SolverArgs {
             s.dt,
             s.gravity.show()
         );
-        for (family, alpha) in &self.compliance {
-            text += &format!(", compliance {}={alpha}", family.name());
+        for NamedValue { name, value } in &self.compliance {
+            text += &format!(", compliance {name}={value}");
         }
-        for (family, k) in &self.stiffness {
-            text += &format!(", stiffness {}={k}", family.name());
+        for NamedValue { name, value } in &self.stiffness {
+            text += &format!(", stiffness {name}={value}");
         }
         let uses_material = s
             .active
@@ -127,17 +180,31 @@ impl SolverArgs {
         if uses_material || self.material.is_some() {
             text += &format!(", material {}", s.material.describe());
         }
+        for family in s.active.families() {
+            if let Some(file) = family.file() {
+                let gradient = if file.use_gradient {
+                    "its own gradient"
+                } else {
+                    "the AD gradient"
+                };
+                text += &format!(
+                    ", {} from {} with {gradient}",
+                    family.name(),
+                    file.path.display()
+                );
+            }
+        }
         text
     }
 }
 
 impl SimulationArgs {
-    /// The solver settings these options ask for.
-    pub fn settings(&self) -> Settings {
-        Settings {
+    /// The solver settings these options ask for ([`SolverArgs::settings`]).
+    pub fn settings(&self) -> Result<Settings, UsageError> {
+        Ok(Settings {
             settle_edits: self.settle_edits,
-            ..self.solver.settings()
-        }
+            ..self.solver.settings()?
+        })
     }
 
     /// Advances one frame and measures it; an error when the simulation diverged
@@ -149,9 +216,10 @@ impl SimulationArgs {
 
     /// Loads the scene, builds the simulation and applies the perturbation.
     pub fn build(&self) -> Result<(Scene, Simulation), UsageError> {
+        let settings = self.settings()?;
         let scene = Scene::from_spec(&self.scene, self.resolution)
             .map_err(|e| UsageError(format!("--scene: {e}")))?;
-        let mut simulation = Simulation::new(&scene, self.settings());
+        let mut simulation = Simulation::new(&scene, settings);
         warn_if_unstable(&simulation);
         if let Some(perturbation) = self.perturb {
             simulation.perturb(perturbation);
@@ -159,14 +227,25 @@ impl SimulationArgs {
         Ok((scene, simulation))
     }
 
-    /// What [`SolverArgs::describe`] says, and whether edits settle.
-    pub fn describe(&self) -> String {
-        let mut text = self.solver.describe();
+    /// What [`SolverArgs::describe`] says of `simulation`'s settings, and whether edits settle.
+    pub fn describe(&self, simulation: &Simulation) -> String {
+        let mut text = self.solver.describe(simulation.settings());
         if self.settle_edits {
             text += ", settle edits";
         }
         text
     }
+}
+
+/// Loads the constraint file of `--constraint-file PATH` and adds its family to the table with
+/// `add` ([`Family::register`], or [`Family::define`] to replace a family of the same name).
+pub fn load_constraint_file(
+    path: &std::path::Path,
+    add: fn(ConstraintFile) -> Result<Family, String>,
+) -> Result<Family, UsageError> {
+    let file =
+        ConstraintFile::load(path).map_err(|e| UsageError(format!("--constraint-file {e}")))?;
+    add(file).map_err(|e| UsageError(format!("--constraint-file {}: {e}", path.display())))
 }
 
 /// Prints [`Simulation::stability_warning`] on stderr, if there is one.

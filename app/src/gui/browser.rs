@@ -1,5 +1,5 @@
 //! "Open mesh file…": a file browser inside the workbench (no blocking system dialog, nothing to
-//! install). It lists folders and the files tetlab can open (.node, .ele, .msh, lesson .toml);
+//! install). It lists folders and the files tetlab can open (.node, .ele, .msh, lesson and constraint .toml);
 //! a click on a folder enters it, a click on a file opens it. Desktop only: a browser has no
 //! folders to list.
 

@@ -1,6 +1,8 @@
 //! The seam between the workbench and files, so that the rest of the GUI never touches the file
-//! system (a browser has none). A `.toml` file is a lesson; anything else a mesh.
+//! system (a browser has none). A `.toml` file is a constraint file when it says what it
+//! `applies_to`, and a lesson otherwise; anything else a mesh.
 
+use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::lesson::Lesson;
 use tetlab_core::scene::Scene;
 
@@ -10,6 +12,14 @@ pub enum Opened {
     Scene(Scene),
     /// A lesson.
     Lesson(Box<Lesson>),
+    /// A constraint file, as text: it goes to the editor, which compiles it (and shows its
+    /// mistake, if it has one, where it can be mended).
+    Constraint {
+        /// Where it came from.
+        path: std::path::PathBuf,
+        /// Its text.
+        text: String,
+    },
 }
 
 /// Opens a mesh or lesson file by path. A TetGen mesh is read from its two files (`.node` and
@@ -75,6 +85,10 @@ fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
     })?;
     let extension = name.extension().and_then(|e| e.to_str()).unwrap_or("");
     match extension {
+        "toml" if ConstraintFile::looks_like(text) => Ok(Opened::Constraint {
+            path: name.to_owned(),
+            text: text.to_owned(),
+        }),
         "toml" => Lesson::parse(name, text)
             .map(|lesson| Opened::Lesson(Box::new(lesson)))
             .map_err(|e| e.to_string()),
@@ -92,7 +106,7 @@ fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
             name.display()
         )),
         _ => Err(format!(
-            "{}: not a mesh (.msh) or a lesson (.toml)",
+            "{}: not a mesh (.msh), a lesson or a constraint file (.toml)",
             name.display()
         )),
     }
@@ -107,6 +121,7 @@ mod tests {
         match opened {
             Ok(Opened::Scene(scene)) => format!("scene {}", scene.name),
             Ok(Opened::Lesson(lesson)) => format!("lesson {}", lesson.title),
+            Ok(Opened::Constraint { path, .. }) => format!("constraint {}", path.display()),
             Err(message) => message,
         }
     }
@@ -125,6 +140,17 @@ mod tests {
         assert!(
             opened_name(open_bytes(Path::new(lesson.file), lesson.text.as_bytes()))
                 .starts_with("lesson 1.")
+        );
+        let example = tetlab_core::constraint_file::EXAMPLES[0];
+        assert_eq!(
+            opened_name(open_bytes(Path::new(example.file), example.text.as_bytes())),
+            format!("constraint {}", example.file)
+        );
+        let broken = b"name = \"x\"\napplies_to = \"edges\"\nvalue = \"length(\"\n";
+        assert_eq!(
+            opened_name(open_bytes(Path::new("broken.toml"), broken)),
+            "constraint broken.toml",
+            "a constraint file with a mistake goes to the editor"
         );
         let node = opened_name(open_bytes(Path::new("bunny.node"), b"4 3 0 0\n"));
         assert!(node.contains("two files"), "{node}");

@@ -16,6 +16,7 @@ pub mod workbench;
 use eframe::egui;
 use files::Opened;
 use geometry::{SceneCache, ViewOptions};
+use panels::constraint_editor::ConstraintEditor;
 use panels::controls::{SceneChoice, SceneRequest};
 use panels::lesson::{LessonRequest, LessonState};
 use shortcuts::{Action, SHORTCUTS};
@@ -104,6 +105,8 @@ pub struct TetlabApp {
     pub show_lesson: bool,
     /// The lesson in progress.
     pub lesson: Option<LessonState>,
+    /// The constraint editor.
+    pub editor: ConstraintEditor,
     /// The second simulation shown beside the first, if any.
     pub comparison: Option<Comparison>,
     /// Classroom mode: large, the 3D view and the lesson only.
@@ -169,6 +172,7 @@ impl TetlabApp {
             show_inspector: false,
             show_lesson: false,
             lesson: None,
+            editor: ConstraintEditor::default(),
             comparison: None,
             classroom: false,
             lesson_path: String::new(),
@@ -191,8 +195,15 @@ impl TetlabApp {
         self.error = None;
     }
 
-    /// Opens a lesson at its first step: its scene, settings and tet.
+    /// Opens a lesson at its first step: its scene, settings and tet. A lesson that brings
+    /// constraint files puts the first in the editor, where its exercise is done.
     pub fn open_lesson(&mut self, lesson: Lesson) {
+        if let Some(&family) = lesson.families.first()
+            && let Some(file) = family.file()
+        {
+            self.editor.set_text(&file.path, &file.source);
+            self.editor.family = Some(family);
+        }
         self.load(lesson.scene());
         self.bench.set_settings(lesson.settings);
         self.bench.select_tet(lesson.tet);
@@ -306,8 +317,42 @@ impl TetlabApp {
         match opened {
             Ok(Opened::Scene(scene)) => self.load(scene),
             Ok(Opened::Lesson(lesson)) => self.open_lesson(*lesson),
+            Ok(Opened::Constraint { path, text }) => {
+                self.editor.open = true;
+                self.error = None;
+                match self.editor.set_text(&path, &text) {
+                    Some(file) => self.define_constraint(file),
+                    None => self.error = self.editor.error.clone(),
+                }
+            }
             Err(message) => self.error = Some(message),
         }
+    }
+
+    /// Defines the family of a constraint file the editor compiled (replacing the one of the
+    /// same name), switches it on (and the editor's previous family off, when the name
+    /// changed), and rebuilds its constraints in every simulation shown.
+    pub fn define_constraint(&mut self, file: tetlab_core::constraint_file::ConstraintFile) {
+        let family = match tetlab_core::constraints::Family::define(file) {
+            Ok(family) => family,
+            Err(message) => {
+                self.editor.error = Some(format!("{}: {message}", self.editor.path.display()));
+                return;
+            }
+        };
+        let previous = self.editor.family.replace(family);
+        let mut settings = *self.bench.simulation.settings();
+        if previous != Some(family) {
+            if let Some(previous) = previous {
+                settings.active[previous] = false;
+            }
+            settings.active[family] = true;
+        }
+        self.bench.refresh_families();
+        if let Some(comparison) = &mut self.comparison {
+            comparison.bench.refresh_families();
+        }
+        self.set_settings(settings);
     }
 
     fn lesson_request(&mut self, request: LessonRequest) {
@@ -332,6 +377,21 @@ impl TetlabApp {
             Action::Inspector => self.show_inspector = !self.show_inspector,
             Action::Help => self.show_help = !self.show_help,
             Action::Lesson => self.show_lesson = !self.show_lesson,
+            Action::ConstraintEditor => {
+                self.editor.open = !self.editor.open;
+                if self.editor.open && self.editor.text.is_empty() {
+                    let example = tetlab_core::constraint_file::EXAMPLES
+                        .iter()
+                        .find(|e| e.file == "height.toml")
+                        .unwrap_or(&tetlab_core::constraint_file::EXAMPLES[0]);
+                    if let Some(file) = self
+                        .editor
+                        .set_text(std::path::Path::new(example.path), example.text)
+                    {
+                        self.define_constraint(file);
+                    }
+                }
+            }
             Action::OpenFile => self.open_browser(),
             Action::Classroom => {
                 self.classroom = !self.classroom;
@@ -491,6 +551,7 @@ impl eframe::App for TetlabApp {
         let mut lesson_request = None;
         let mut compare_request = None;
         let mut settings_request = None;
+        let mut compiled = None;
         let metrics = self.bench.metrics;
         let comparison_metrics = self.comparison.as_ref().map(|c| c.bench.metrics);
         if self.classroom {
@@ -539,8 +600,11 @@ impl eframe::App for TetlabApp {
                             &mut actions,
                         );
                         ui.separator();
-                        settings_request =
-                            panels::solver::show(ui, self.bench.simulation.settings());
+                        settings_request = panels::solver::show(
+                            ui,
+                            self.bench.simulation.settings(),
+                            &mut actions,
+                        );
                         ui.separator();
                         panels::tools::show(ui, &self.bench, &mut actions);
                         ui.separator();
@@ -566,6 +630,7 @@ impl eframe::App for TetlabApp {
                         }
                     });
                 });
+            compiled = self.editor.show(ui);
             if self.show_lesson {
                 egui::Panel::bottom("lesson")
                     .resizable(true)
@@ -614,6 +679,9 @@ impl eframe::App for TetlabApp {
         }
         if let Some(families) = compare_request {
             self.compare(families);
+        }
+        if let Some(file) = compiled {
+            self.define_constraint(file);
         }
         self.preferences.settings = *self.bench.simulation.settings();
         self.frames_drawn += 1;

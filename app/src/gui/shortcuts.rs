@@ -37,6 +37,8 @@ pub enum Action {
     Inspector,
     /// Show or hide the lesson window.
     Lesson,
+    /// Show or hide the constraint editor.
+    ConstraintEditor,
     /// Open a mesh or lesson file.
     OpenFile,
     /// Classroom mode on or off.
@@ -52,7 +54,7 @@ pub enum Action {
 }
 
 /// Every shortcut: key, action, what the help says.
-pub const SHORTCUTS: [(Key, Action, &str); 22] = [
+pub const SHORTCUTS: [(Key, Action, &str); 23] = [
     (Key::Space, Action::PlayPause, "play / pause"),
     (Key::N, Action::StepFrame, "step one frame"),
     (Key::U, Action::StepSubstep, "step one substep"),
@@ -85,7 +87,16 @@ pub const SHORTCUTS: [(Key, Action, &str); 22] = [
         "inspector (numbers of the selected tet)",
     ),
     (Key::L, Action::Lesson, "lessons"),
-    (Key::O, Action::OpenFile, "open a mesh or lesson file"),
+    (
+        Key::G,
+        Action::ConstraintEditor,
+        "constraint editor (write C, check your gradient)",
+    ),
+    (
+        Key::O,
+        Action::OpenFile,
+        "open a mesh, lesson or constraint file",
+    ),
     (
         Key::F5,
         Action::Classroom,

@@ -240,10 +240,9 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
     }
     let active = bench.simulation.settings().active;
     for family in Family::all().filter(|&f| options.arrows && active.get(f)) {
-        entry(
-            visual::family_colour(family),
-            format!("grad C: {}", family.row().label),
-        );
+        for quantity in visual::Quantity::of_family(family) {
+            entry(quantity.colour(), quantity.label());
+        }
     }
     if stepping {
         entry(

@@ -314,6 +314,16 @@ impl Workbench {
         self.after_change();
     }
 
+    /// Takes up the families' definitions now in force (a constraint file redefined by the
+    /// editor): step-by-step mode ends where it stands (its next constraint may be gone), and
+    /// the constraints of a redefined family are rebuilt.
+    pub fn refresh_families(&mut self) {
+        self.stepping = None;
+        self.last_advance = None;
+        self.simulation.refresh_families();
+        self.after_change();
+    }
+
     /// Measures the new state. A state that diverged is never drawn or plotted: the body goes
     /// back to rest, paused, and [`Workbench::diverged`] says why.
     fn after_change(&mut self) {

@@ -27,7 +27,10 @@ pub enum ArrowsMode {
 /// coordinates, y up; the viewer draws its grid on y = 0, the ground), `world/particles`,
 /// `world/mesh` and `world/edges` (all faces and edges of a small mesh, the surface of a large
 /// one, as [`visual::display_faces`] and [`visual::display_edges`] choose),
-/// `world/gradients/<family>`, `world/corrections` (Δp of the last substep, at its true length),
+/// `constraints/<family>` (a constraint file's text, for each in use),
+/// `world/gradients/<family>` (and, for a constraint file that gives its own gradient,
+/// `world/gradients/<family>-yours` where it differs from AD's, or `-ad` where the file's is
+/// used), `world/corrections` (Δp of the last substep, at its true length),
 /// `metrics/<name>`.
 pub struct Recorder<'a> {
     rec: &'a RecordingStream,
@@ -74,8 +77,24 @@ impl<'a> Recorder<'a> {
                 .with_colors([rgba(visual::EDGE)])
                 .with_radii([rerun::Radius::new_ui_points(0.75)]),
         );
-        let quantities = Family::all().map(Quantity::Gradient);
-        for quantity in quantities.into_iter().chain([Quantity::Correction]) {
+        // The constraint files of the families in use, as written: what the arrows of
+        // `world/gradients/<name>` are the gradient of.
+        for family in simulation.settings().active.families() {
+            if let Some(file) = family.file() {
+                let text = format!(
+                    "# {}\n\n{}\n\n```toml\n{}\n```",
+                    family.name(),
+                    file.path.display(),
+                    file.source.trim_end()
+                );
+                log(
+                    &format!("constraints/{}", family.name()),
+                    &rerun::TextDocument::from_markdown(text),
+                );
+            }
+        }
+        let quantities = Family::all().flat_map(Quantity::of_family);
+        for quantity in quantities.chain([Quantity::Correction]) {
             log(
                 &arrow_path(quantity),
                 &rerun::Arrows3D::update_fields().with_colors([rgba(quantity.colour())]),
@@ -196,7 +215,7 @@ impl<'a> Recorder<'a> {
         }
         let quantities = Family::all()
             .filter(|&f| active.get(f))
-            .map(Quantity::Gradient)
+            .flat_map(Quantity::of_family)
             .chain([Quantity::Correction]);
         for quantity in quantities {
             let arrows = self.arrow_scratch.iter().filter(|a| a.quantity == quantity);
@@ -216,6 +235,10 @@ impl<'a> Recorder<'a> {
 fn arrow_path(quantity: Quantity) -> String {
     match quantity {
         Quantity::Gradient(family) => format!("world/gradients/{}", family.name()),
+        Quantity::Disagreeing(family) => {
+            let other = Quantity::disagreeing_name(family).to_lowercase();
+            format!("world/gradients/{}-{other}", family.name())
+        }
         Quantity::Correction => "world/corrections".to_owned(),
     }
 }

@@ -98,6 +98,34 @@ impl Report {
     }
 }
 
+/// The configurations [`gradient_error`] compares on.
+pub const GRADIENT_ERROR_CONFIGS: usize = 100;
+
+/// The largest relative error of the file's gradient against AD over
+/// [`GRADIENT_ERROR_CONFIGS`] random configurations (seed 1), over every particle it gives a
+/// gradient for: what a lesson expects of a gradient (`gradient_error.NAME < 1e-6`). Infinite when
+/// the file gives none.
+///
+/// ```
+/// use std::path::Path;
+/// use tetlab_core::constraint_file::{ConstraintFile, check::gradient_error};
+/// let text = "name = \"e\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p1) - rest\"\n";
+/// let file = ConstraintFile::parse(Path::new("e.toml"), text).unwrap();
+/// assert_eq!(gradient_error(&file), f64::INFINITY, "no gradient given");
+/// let right = ConstraintFile::parse(Path::new("e.toml"), &format!("{text}[gradient]\np0 = \"normalize(p0 - p1)\"\n")).unwrap();
+/// assert!(gradient_error(&right) < 1e-12);
+/// ```
+pub fn gradient_error(file: &ConstraintFile) -> f64 {
+    let report = check(file, GRADIENT_ERROR_CONFIGS, 1);
+    report
+        .max_relative_error
+        .iter()
+        .flatten()
+        .copied()
+        .reduce(f64::max)
+        .unwrap_or(f64::INFINITY)
+}
+
 /// Whether `points` are far from degenerate: no two closer than [`CONDITIONING`] times the
 /// largest distance, and no face of three of them with an angle's sine below it.
 pub fn well_conditioned(points: &[DVec3]) -> bool {

@@ -29,8 +29,9 @@ use crate::constraints::Binding;
 use crate::dual::Tangent;
 use crate::text_file;
 use crate::vector::{Real, Vector3};
+use arrayvec::ArrayVec;
 use glam::DVec3;
-use program::{CompileError, Program, Type};
+use program::{CompileError, Program, Tape, Type};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -91,22 +92,17 @@ pub struct ConstraintFile {
     pub binding: Binding,
     /// Whether the simulation uses the file's gradient rather than AD's (`use_gradient`).
     pub use_gradient: bool,
-    program: Program,
-    /// Output 0 is C; then the gradient entries given, by particle.
+    /// The file's text, as read.
+    pub source: String,
+    /// The lines of `define` and `value`, as written (what the workbench shows as its formula).
+    pub formula: Vec<String>,
+    /// C alone: what AD differentiates.
+    value: Tape,
+    /// C, then the gradient entries the file gives.
+    yours: Tape,
+    /// Per particle, the output of `yours` that is the file's gradient for it.
     gradient_outputs: [Option<usize>; 4],
-    rest_program: Option<Program>,
-}
-
-/// C and the gradient a simulation uses (AD's, or the file's with `use_gradient`), in any
-/// precision: [`ConstraintFile::evaluate_vectors`].
-#[derive(Clone, Copy, Debug)]
-pub struct VectorEvaluation<V: Vector3, const N: usize> {
-    /// C.
-    pub value: V::Real,
-    /// ∇C per particle; zero where `degenerate`.
-    pub gradients: [V; N],
-    /// Where C or ∇C is not finite (a normalised zero vector, a division by zero).
-    pub degenerate: <V::Real as Real>::Mask,
+    rest: Option<Tape>,
 }
 
 /// C at a configuration, by AD and as the file derives it.
@@ -120,15 +116,91 @@ pub struct Evaluation {
     pub yours: Vec<Option<DVec3>>,
 }
 
+/// An example constraint file that comes with tetlab: a file of `assets/constraints`, built into
+/// the library.
+#[derive(Clone, Copy, Debug)]
+pub struct Example {
+    /// Its file name, e.g. `height.toml`.
+    pub file: &'static str,
+    /// Where the file was when tetlab was built.
+    pub path: &'static str,
+    /// The file's text.
+    pub text: &'static str,
+}
+
+include!(concat!(env!("OUT_DIR"), "/constraint_examples.rs"));
+
+impl Example {
+    /// The example whose path (as tetlab was built) `path` names, `..` and `.` resolved.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use tetlab_core::constraint_file::{EXAMPLES, Example};
+    /// let height = EXAMPLES.iter().find(|e| e.file == "height.toml").unwrap();
+    /// let lessons = Path::new(height.path).parent().unwrap().with_file_name("lessons");
+    /// let found = Example::at(&lessons.join("../constraints/height.toml")).unwrap();
+    /// assert_eq!(found.file, "height.toml");
+    /// ```
+    pub fn at(path: &Path) -> Option<&'static Example> {
+        let wanted = lexically_normal(path);
+        EXAMPLES
+            .iter()
+            .find(|example| lexically_normal(Path::new(example.path)) == wanted)
+    }
+}
+
+/// `path` with `.` left out and each `..` taking away the name before it.
+fn lexically_normal(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out = PathBuf::new();
+    for component in path.components() {
+        match component {
+            Component::CurDir => {}
+            Component::ParentDir if out.file_name().is_some() => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
 impl ConstraintFile {
-    /// Reads and compiles `path`.
+    /// Reads and compiles `path`. A path to one of the [`EXAMPLES`] that is not on disk (in the
+    /// browser, or a tetlab built elsewhere) reads the copy built into tetlab.
     pub fn load(path: &Path) -> Result<ConstraintFile, ConstraintFileError> {
-        let text = text_file::read(path).map_err(|e| ConstraintFileError {
-            path: path.to_owned(),
-            at: e.line.map(|l| (l, 1)),
-            message: e.message,
-        })?;
+        let text = match text_file::read(path) {
+            Ok(text) => text,
+            Err(e) => match Example::at(path) {
+                Some(example) => example.text.to_owned(),
+                None => {
+                    return Err(ConstraintFileError {
+                        path: path.to_owned(),
+                        at: e.line.map(|l| (l, 1)),
+                        message: e.message,
+                    });
+                }
+            },
+        };
         ConstraintFile::parse(path, &text)
+    }
+
+    /// Whether TOML `text` is meant as a constraint file (it says what it `applies_to`) rather
+    /// than a lesson, even when it has a mistake.
+    ///
+    /// ```
+    /// use tetlab_core::constraint_file::ConstraintFile;
+    /// assert!(ConstraintFile::looks_like("name = \"e\"\napplies_to = \"edges\"\n"));
+    /// assert!(ConstraintFile::looks_like("applies_to = \"edges\"\nvalue = \"1 +\n"));
+    /// assert!(!ConstraintFile::looks_like("title = \"A lesson\"\nscene = \"tet\"\n"));
+    /// ```
+    pub fn looks_like(text: &str) -> bool {
+        match toml::from_str::<toml::Table>(text_file::without_byte_order_mark(text)) {
+            Ok(table) => table.contains_key("applies_to"),
+            Err(_) => text
+                .lines()
+                .any(|line| line.trim_start().starts_with("applies_to")),
+        }
     }
 
     /// Compiles the text of a constraint file (`path` names it in errors).
@@ -225,7 +297,8 @@ impl ConstraintFile {
                 .map_err(|e| compile_error(base, e, spanned.get_ref(), what))
         };
         let mut program = build(true)?;
-        compile(&mut program, &value, Type::Scalar, "value")?;
+        let c = compile(&mut program, &value, Type::Scalar, "value")?;
+        let mut outputs = vec![c];
         let mut gradient_outputs = [None; 4];
         for (key, entry) in &raw.gradient {
             let particle = key
@@ -244,24 +317,41 @@ impl ConstraintFile {
                 ));
             };
             let what = format!("gradient.{}", key.get_ref());
-            gradient_outputs[k] = Some(compile(&mut program, entry, Type::Vector, &what)?);
+            outputs.push(compile(&mut program, entry, Type::Vector, &what)?);
+            gradient_outputs[k] = Some(outputs.len() - 1);
         }
-        let rest_program = match &raw.rest {
+        let rest = match &raw.rest {
             Some(rest) => {
                 let mut program = build(false)?;
-                compile(&mut program, rest, Type::Scalar, "rest")?;
-                Some(program)
+                let r = compile(&mut program, rest, Type::Scalar, "rest")?;
+                Some(program.tape(&[r]))
             }
             None => None,
         };
+        let mut formula: Vec<String> = raw
+            .define
+            .as_ref()
+            .map(|d| {
+                d.get_ref()
+                    .lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .map(str::to_owned)
+                    .collect()
+            })
+            .unwrap_or_default();
+        formula.push(format!("C = {}", value.get_ref().trim()));
         Ok(ConstraintFile {
             path: path.to_owned(),
             name,
             binding,
             use_gradient: raw.use_gradient,
-            program,
+            source: text.to_owned(),
+            formula,
+            value: program.tape(&[c]),
+            yours: program.tape(&outputs),
             gradient_outputs,
-            rest_program,
+            rest,
         })
     }
 
@@ -280,42 +370,40 @@ impl ConstraintFile {
 
     /// C at `points` with rest value `rest` (NaN where it is undefined).
     pub fn value(&self, points: &[DVec3], rest: f64) -> f64 {
-        let points: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
-        let mut registers = vec![[0.0; 3]; self.program.registers()];
-        self.program.run(0, &points, rest, &mut registers);
-        self.program.scalar(0, &registers)
+        let points = self.coordinates(points);
+        self.value.run(&points, rest, |r| r.scalar(0))
     }
 
-    /// C, its gradient by AD and the file's own, at `points` with rest value `rest`.
+    /// C, its gradient by forward-mode AD and the file's own, at `points` with rest value `rest`:
+    /// what `tetlab check-gradients` and `tetlab gradient` compare.
     pub fn evaluate(&self, points: &[DVec3], rest: f64) -> Evaluation {
         let value = self.value(points, rest);
         let automatic = match self.arity() {
-            2 => self.automatic::<2>(points, rest),
-            _ => self.automatic::<4>(points, rest),
+            2 => self.forward_mode::<2>(points, rest),
+            _ => self.forward_mode::<4>(points, rest),
         };
-        let mut registers = vec![[0.0; 3]; self.program.registers()];
-        let flat: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
-        let last = self.gradient_outputs.iter().flatten().max().copied();
-        if let Some(last) = last {
-            self.program.run(last, &flat, rest, &mut registers);
-        }
-        let yours = (0..self.arity())
-            .map(|k| {
-                self.gradient_outputs[k]
-                    .map(|o| DVec3::from_array(self.program.vector(o, &registers)))
-            })
-            .collect();
         Evaluation {
             value,
             automatic: automatic.filter(|_| value.is_finite()),
-            yours,
+            yours: self.yours(points, rest)[..self.arity()].to_vec(),
         }
     }
 
+    /// The file's own gradient for each particle it gives one for, at `points` with rest value
+    /// `rest`.
+    pub fn yours(&self, points: &[DVec3], rest: f64) -> [Option<DVec3>; 4] {
+        let points = self.coordinates(points);
+        self.yours.run(&points, rest, |r| {
+            self.gradient_outputs
+                .map(|o| o.map(|o| DVec3::from_array(r.vector(o))))
+        })
+    }
+
     /// C and ∇C at `p` with rest value `rest`, in the precision of `V` (f64, f32, the fast
-    /// solver's lanes): by forward-mode AD over [`Tangent`] numbers, 3N passes of the compiled
-    /// value, or, with `use_gradient`, the file's own gradient (a particle it gives none for gets
-    /// zero). Allocates nothing: the registers are on the stack
+    /// solver's lanes), as a simulation uses them: ∇C by reverse-mode AD
+    /// ([`program::Tape::gradient`]) or, with `use_gradient`, the file's own (a particle it gives
+    /// none for gets zero). Where C or ∇C is not finite, the evaluation is degenerate: C is 0
+    /// there and ∇C zero. Allocates nothing: the registers are on the stack
     /// ([`program::MAX_REGISTERS`]).
     ///
     /// # Panics
@@ -334,28 +422,25 @@ impl ConstraintFile {
     /// let e = file.evaluate_vectors(&[glam::Vec3::new(3.0, 0.0, 4.0), glam::Vec3::ZERO], 1.0);
     /// assert!((e.gradients[1] + glam::Vec3::new(0.6, 0.0, 0.8)).length() < 1e-6);
     /// ```
+    #[inline]
     pub fn evaluate_vectors<V: Vector3, const N: usize>(
         &self,
         p: &[V; N],
         rest: V::Real,
-    ) -> VectorEvaluation<V, N> {
-        self.evaluate_with(p, rest, self.use_gradient)
+    ) -> crate::constraints::Evaluation<V, N> {
+        self.evaluate_by(p, rest, self.use_gradient)
     }
 
-    /// ∇C by AD in f64, `None` where it is undefined.
-    fn automatic<const N: usize>(&self, points: &[DVec3], rest: f64) -> Option<Vec<DVec3>> {
-        let p: [DVec3; N] = std::array::from_fn(|k| points[k]);
-        let e = self.evaluate_with(&p, rest, false);
-        (!e.degenerate).then(|| e.gradients.to_vec())
-    }
-
-    /// [`ConstraintFile::evaluate_vectors`], with the file's gradient when `own`, AD's otherwise.
-    fn evaluate_with<V: Vector3, const N: usize>(
+    /// [`ConstraintFile::evaluate_vectors`] with the file's own gradient (`own`) or AD's,
+    /// whichever the file asks the simulation to use: what the workbench shows beside the one in
+    /// use.
+    #[inline]
+    pub fn evaluate_by<V: Vector3, const N: usize>(
         &self,
         p: &[V; N],
         rest: V::Real,
         own: bool,
-    ) -> VectorEvaluation<V, N> {
+    ) -> crate::constraints::Evaluation<V, N> {
         assert_eq!(
             N,
             self.arity(),
@@ -364,67 +449,79 @@ impl ConstraintFile {
             self.arity()
         );
         let coordinates: [[V::Real; 3]; N] = std::array::from_fn(|i| p[i].to_array());
-        let mut value = V::Real::ZERO;
-        let mut gradients = [[V::Real::ZERO; 3]; N];
-        if own {
-            let mut registers = [[V::Real::ZERO; 3]; program::MAX_REGISTERS];
-            let registers = &mut registers[..self.program.registers()];
-            let last = self
-                .gradient_outputs
-                .iter()
-                .flatten()
-                .max()
-                .copied()
-                .unwrap_or(0);
-            self.program.run(last, &coordinates, rest, registers);
-            value = self.program.scalar(0, registers);
-            for (k, output) in self.gradient_outputs.iter().take(N).enumerate() {
-                if let Some(o) = output {
-                    gradients[k] = self.program.vector(*o, registers);
-                }
-            }
+        let (value, gradients) = if own {
+            self.yours.run(&coordinates, rest, |r| {
+                let gradients = std::array::from_fn(|k| match self.gradient_outputs[k] {
+                    Some(o) => r.vector(o),
+                    None => [V::Real::ZERO; 3],
+                });
+                (r.scalar(0), gradients)
+            })
         } else {
-            let mut registers = [[Tangent::<V::Real>::ZERO; 3]; program::MAX_REGISTERS];
-            let registers = &mut registers[..self.program.registers()];
-            let constant = |x: V::Real| Tangent::new(x, V::Real::ZERO);
-            let mut points: [[Tangent<V::Real>; 3]; N] = coordinates.map(|c| c.map(constant));
-            for k in 0..N {
-                for axis in 0..3 {
-                    points[k][axis].slope = V::Real::ONE;
-                    self.program.run(0, &points, constant(rest), registers);
-                    points[k][axis].slope = V::Real::ZERO;
-                    let c = self.program.scalar(0, registers);
-                    value = c.value;
-                    gradients[k][axis] = c.slope;
-                }
+            self.value.gradient(&coordinates, rest)
+        };
+        sound(value, gradients)
+    }
+
+    /// ∇C by forward-mode AD in f64 over [`Tangent`] numbers, one pass per coordinate; `None`
+    /// where it is undefined.
+    fn forward_mode<const N: usize>(&self, points: &[DVec3], rest: f64) -> Option<Vec<DVec3>> {
+        let constant = |x: f64| Tangent::new(x, 0.0);
+        let mut p: [[Tangent<f64>; 3]; N] =
+            std::array::from_fn(|k| points[k].to_array().map(constant));
+        let mut value = Tangent::new(0.0, 0.0);
+        let mut gradients = [[0.0; 3]; N];
+        for k in 0..N {
+            for axis in 0..3 {
+                p[k][axis].slope = 1.0;
+                value = self.value.run(&p, constant(rest), |r| r.scalar(0));
+                p[k][axis].slope = 0.0;
+                gradients[k][axis] = value.slope;
             }
         }
-        let mut sound = value.finite();
-        for g in &gradients {
-            for &x in g {
-                sound = sound & x.finite();
-            }
-        }
-        let gradients = gradients.map(|g| V::select(sound, V::from_array(g), V::ZERO));
-        VectorEvaluation {
-            value: V::Real::select(value.finite(), value, V::Real::ZERO),
-            gradients,
-            degenerate: !sound,
-        }
+        let e = sound::<DVec3, N>(value.value, gradients);
+        (!e.degenerate).then(|| e.gradients.to_vec())
     }
 
     /// The rest value for particles at rest at `rest_points`: `rest = "…"` when the file gives
-    /// it, otherwise C there with rest = 0.
+    /// it, otherwise C there with rest = 0; 0 where that is not finite (a rest shape on which C
+    /// is undefined, such as a flat tet's height).
     pub fn rest_value(&self, rest_points: &[DVec3]) -> f64 {
-        match &self.rest_program {
-            Some(program) => {
-                let points: Vec<[f64; 3]> = rest_points.iter().map(|p| p.to_array()).collect();
-                let mut registers = vec![[0.0; 3]; program.registers()];
-                program.run(0, &points, 0.0, &mut registers);
-                program.scalar(0, &registers)
-            }
+        let rest = match &self.rest {
+            Some(tape) => tape.run(&self.coordinates(rest_points), 0.0, |r| r.scalar(0)),
             None => self.value(rest_points, 0.0),
+        };
+        if rest.is_finite() { rest } else { 0.0 }
+    }
+
+    /// The instructions of C's tape and of the tape with the file's gradients, for the record
+    /// of what an evaluation costs.
+    pub fn tape_lengths(&self) -> (usize, usize) {
+        (self.value.len(), self.yours.len())
+    }
+
+    fn coordinates(&self, points: &[DVec3]) -> ArrayVec<[f64; 3], 4> {
+        points.iter().take(4).map(|p| p.to_array()).collect()
+    }
+}
+
+/// C and ∇C as a simulation takes them: where either is not finite, degenerate, with C = 0 and
+/// ∇C = 0.
+#[inline]
+fn sound<V: Vector3, const N: usize>(
+    value: V::Real,
+    gradients: [[V::Real; 3]; N],
+) -> crate::constraints::Evaluation<V, N> {
+    let mut sound = value.finite();
+    for g in &gradients {
+        for &x in g {
+            sound = sound & x.finite();
         }
+    }
+    crate::constraints::Evaluation {
+        value: V::Real::select(value.finite(), value, V::Real::ZERO),
+        gradients: gradients.map(|g| V::select(sound, V::from_array(g), V::ZERO)),
+        degenerate: !sound,
     }
 }
 

@@ -7,6 +7,7 @@
 //!
 //! Per-family data has one shape, [`PerFamily`], indexed by [`Family`].
 
+use super::file::FileConstraint;
 use super::neohookean::{Deviatoric, Hydrostatic};
 use super::{Constraint, Evaluation, distance::Distance, height::Height, volume::Volume};
 use crate::material::Material;
@@ -15,8 +16,9 @@ use glam::DVec3;
 use std::fmt;
 use std::ops::{Index, IndexMut};
 
-/// How many families the table can hold.
-pub const MAX_FAMILIES: usize = 8;
+/// How many families the table can hold: the built-in ones and those read from constraint files
+/// ([`super::file`]).
+pub const MAX_FAMILIES: usize = 16;
 
 /// A constraint family: a row of [`TABLE`].
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -70,17 +72,19 @@ pub struct Row {
     /// same binding, so constraint c of each has the same particles), when both are active:
     /// [`crate::projection::pair_correction_lanes`]. The first of the two in the table leads.
     pub projected_with: Option<Family>,
-    kind: Kind,
+    pub(super) kind: Kind,
 }
 
 /// Which [`Constraint`] type evaluates a family: the one `match` over families.
 #[derive(Clone, Copy)]
-enum Kind {
+pub(super) enum Kind {
     Distance,
     Height,
     Volume,
     Deviatoric,
     Hydrostatic,
+    /// A constraint file's compiled program ([`super::file::FileConstraint`]).
+    File,
 }
 
 /// The families, in projection order (edges, heights, volumes, then the neo-Hookean pair).
@@ -205,9 +209,16 @@ impl Family {
     /// The hydrostatic half of a neo-Hookean tet ([`super::neohookean`]).
     pub const NEOHOOKEAN_HYDROSTATIC: Family = Family(4);
 
-    /// Every family of the table, in projection order.
+    /// Every family of the table, in projection order: the built-in ones, then those read from
+    /// constraint files ([`Family::register`]).
     pub fn all() -> impl DoubleEndedIterator<Item = Family> + Clone {
-        (0..TABLE.len() as u8).map(Family)
+        (0..super::file::count() as u8).map(Family)
+    }
+
+    /// The family in place `index` of the table.
+    pub(super) fn from_index(index: usize) -> Family {
+        debug_assert!(index < MAX_FAMILIES);
+        Family(index as u8)
     }
 
     /// The family's place in the table: what [`PerFamily`] is indexed by.
@@ -217,7 +228,25 @@ impl Family {
 
     /// Its row of the table.
     pub fn row(self) -> &'static Row {
-        &TABLE[self.index()]
+        match TABLE.get(self.index()) {
+            Some(row) => row,
+            None => super::file::row(self.index() - TABLE.len()),
+        }
+    }
+
+    /// The constraint file it was read from, for a family that was.
+    pub fn file(self) -> Option<std::sync::Arc<crate::constraint_file::ConstraintFile>> {
+        (self.index() >= TABLE.len()).then(|| super::file::file(self.index() - TABLE.len()))
+    }
+
+    /// Which definition of the family is in force: 0 for a built-in family, a number that
+    /// changes whenever a file's family is (re)defined ([`Family::define`]), so that constraints
+    /// built from an older definition are rebuilt.
+    pub fn generation(self) -> u64 {
+        match self.index().checked_sub(TABLE.len()) {
+            Some(slot) => super::file::generation(slot),
+            None => 0,
+        }
     }
 
     /// Its name ([`Row::name`]).
@@ -272,6 +301,13 @@ impl Family {
             Kind::Volume => visitor.visit(self, &Volume),
             Kind::Deviatoric => visitor.visit(self, &Deviatoric),
             Kind::Hydrostatic => visitor.visit(self, &Hydrostatic),
+            Kind::File => {
+                let file = self.file().expect("a family of kind File has a file");
+                match file.arity() {
+                    2 => visitor.visit(self, &FileConstraint::<2>(&file)),
+                    _ => visitor.visit(self, &FileConstraint::<4>(&file)),
+                }
+            }
         }
     }
 
@@ -533,7 +569,7 @@ impl<T> PerFamily<T> {
         T: Default,
     {
         PerFamily(std::array::from_fn(|i| {
-            if i < TABLE.len() {
+            if i < super::file::count() {
                 f(Family(i as u8))
             } else {
                 T::default()
@@ -627,16 +663,20 @@ impl PerFamily<bool> {
     /// assert_eq!(active.describe(), "edges+height");
     /// ```
     ///
-    /// A group's name stands for all its families ([`Family::groups`]):
+    /// A group's name stands for all its families ([`Family::groups`]), and `none` for none:
     ///
     /// ```
     /// use tetlab_core::constraints::{Family, PerFamily};
     /// let active = PerFamily::parse_list("edges,neohookean").unwrap();
     /// assert!(active[Family::NEOHOOKEAN_DEVIATORIC] && active[Family::NEOHOOKEAN_HYDROSTATIC]);
     /// assert_eq!(active.describe(), "edges+neohookean");
+    /// assert_eq!(PerFamily::parse_list("none").unwrap().describe(), "none");
     /// ```
     pub fn parse_list(text: &str) -> Result<PerFamily<bool>, String> {
         let mut active = PerFamily::splat(false);
+        if text.trim() == "none" {
+            return Ok(active);
+        }
         for name in text.split(',') {
             for family in PerFamily::parse_group(name)?.families() {
                 active.set(family, true);
@@ -699,7 +739,7 @@ impl PerFamily<bool> {
 impl<T: serde::Serialize + Copy> serde::Serialize for PerFamily<T> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
-        let mut map = serializer.serialize_map(Some(TABLE.len()))?;
+        let mut map = serializer.serialize_map(Some(super::file::count()))?;
         for (family, value) in self.iter() {
             map.serialize_entry(family.name(), &value)?;
         }

@@ -14,13 +14,14 @@
 //! | [`neohookean`] hydrostatic | p0, p1, p2, p3 | √V₀ (det F − γ), γ = 1 + μ/λ |
 //!
 //! Each is a [`Constraint`] type; [`family`] holds the table of families that everything else
-//! reads.
+//! reads, and [`file`] adds the families of constraint files to it at run time.
 //!
 //! When a gradient is undefined (coincident points, a face of zero area) the evaluation is
 //! flagged ([`Evaluation::degenerate`]), its gradients are zero and its value stays finite.
 
 pub mod distance;
 pub mod family;
+pub mod file;
 pub mod height;
 pub mod neohookean;
 pub mod volume;

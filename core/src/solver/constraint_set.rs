@@ -10,6 +10,9 @@ use glam::DVec3;
 /// One family's constraints.
 #[derive(Clone, Debug, Default)]
 pub struct ConstraintSet {
+    /// The family's definition it was built from ([`Family::generation`]); `None` before it is
+    /// built.
+    generation: Option<u64>,
     arity: usize,
     particles: Vec<u32>,
     rest: Vec<f64>,
@@ -22,6 +25,7 @@ impl ConstraintSet {
     pub(crate) fn new(family: Family, mesh: &TetMesh, material: &Material) -> ConstraintSet {
         let particles = family.row().binding.particles(mesh);
         let mut set = ConstraintSet {
+            generation: Some(family.generation()),
             arity: family.arity(),
             lambda: vec![0.0; particles.len() / family.arity()],
             particles,
@@ -52,6 +56,17 @@ impl ConstraintSet {
             }
         }
         self.rest = family.visit(RestValues(&self.particles, rest_positions, material));
+    }
+
+    /// Whether it was built from the definition of `family` now in force.
+    pub(crate) fn is_current(&self, family: Family) -> bool {
+        self.generation == Some(family.generation())
+    }
+
+    /// Whether it was built at all (the sets of families that joined the table after the
+    /// simulation was made are built when they are switched on).
+    pub(crate) fn is_built(&self) -> bool {
+        self.generation.is_some()
     }
 
     /// The number of constraints.

@@ -99,6 +99,8 @@ pub struct Simulation {
     settling: Option<u32>,
     frame: u64,
     time: f64,
+    /// [`crate::constraints::file::definitions`] when the sets were last brought up to date.
+    definitions: u64,
 }
 
 impl Simulation {
@@ -138,6 +140,7 @@ impl Simulation {
             settling: None,
             frame: 0,
             time: 0.0,
+            definitions: crate::constraints::file::definitions(),
         };
         simulation.update_inverse_masses();
         simulation
@@ -148,7 +151,38 @@ impl Simulation {
         &self.settings
     }
 
-    /// Changes the settings; they apply from the next substep.
+    /// Brings the constraints up to date with the table when a family was defined since the
+    /// last look ([`Family::define`]: the workbench's editor redefines a constraint file's
+    /// family as you type): those of a redefined family are rebuilt. Nothing to do, and nothing
+    /// allocated, when no family was defined; every substep calls it.
+    pub fn refresh_families(&mut self) {
+        if crate::constraints::file::definitions() != self.definitions {
+            self.rebuild_stale_sets();
+        }
+    }
+
+    /// Rebuilds the constraints of each family that were built from an older definition, and
+    /// builds those of an active family registered since the simulation was made. Allocates
+    /// only what it builds.
+    fn rebuild_stale_sets(&mut self) {
+        self.definitions = crate::constraints::file::definitions();
+        let mut mesh = None;
+        for family in Family::all() {
+            let set = &self.sets[family];
+            if set.is_current(family) || !(set.is_built() || self.settings.active[family]) {
+                continue;
+            }
+            let mesh = mesh.get_or_insert_with(|| TetMesh {
+                positions: self.rest_positions.clone(),
+                tets: self.tets.clone(),
+            });
+            self.sets[family] = ConstraintSet::new(family, mesh, &self.settings.material);
+        }
+    }
+
+    /// Changes the settings; they apply from the next substep. The constraints of a family
+    /// they switch on that the simulation has not built yet (one a file added to the table
+    /// since) are built.
     pub fn set_settings(&mut self, settings: Settings) {
         if settings.material != self.settings.material {
             for family in Family::all().filter(|f| f.rest_uses_material()) {
@@ -156,6 +190,7 @@ impl Simulation {
             }
         }
         self.settings = settings;
+        self.rebuild_stale_sets();
     }
 
     /// Current particle positions.
@@ -418,6 +453,7 @@ impl Simulation {
 
     /// The first part of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
     pub fn begin_substep(&mut self) {
+        self.refresh_families();
         let h = self.substep_length();
         self.predict(h);
         for family in Family::all() {

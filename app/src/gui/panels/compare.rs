@@ -12,7 +12,7 @@ pub fn show(
     comparing: bool,
 ) -> Option<Option<PerFamily<bool>>> {
     ui.heading("Compare");
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         for (group, members) in Family::groups() {
             let mut on = members.families().all(|f| families[f]);
             if ui

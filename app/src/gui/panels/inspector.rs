@@ -108,27 +108,63 @@ fn constraint(
     egui::Grid::new(("inspection", id))
         .striped(true)
         .show(ui, |ui| {
-            for header in [
-                "",
-                "particle",
-                "w",
-                "∇C",
-                "∇C by finite differences",
-                "Δx if projected now",
-            ] {
-                ui.label(egui::RichText::new(header).strong());
+            let file = inspection.file_gradients;
+            let gradient_headers: &[&str] = match file {
+                Some(_) => &["∇C by AD", "∇C yours"],
+                None => &["∇C"],
+            };
+            let headers = ["", "particle", "w"]
+                .iter()
+                .chain(gradient_headers)
+                .chain(&["∇C by finite differences", "Δx if projected now"]);
+            for header in headers {
+                ui.label(egui::RichText::new(*header).strong());
             }
             ui.end_row();
             for k in 0..p.len {
                 ui.monospace(format!("p{}", subscript(k)));
                 ui.monospace(p.particles[k].to_string());
                 ui.monospace(format!("{:.3e}", p.inverse_masses[k]));
-                ui.monospace(vector(p.gradients[k]));
+                match file {
+                    Some(file) => {
+                        ui.monospace(vector(file.automatic[k]));
+                        match file.yours[k] {
+                            Some(yours) => {
+                                let scale = file.automatic[..p.len]
+                                    .iter()
+                                    .map(|g| g.length())
+                                    .fold(0.0, f64::max);
+                                let differs = (yours - file.automatic[k]).length()
+                                    > tetlab_core::visual::DISAGREEMENT * scale;
+                                let text = egui::RichText::new(vector(yours)).monospace();
+                                ui.label(if differs {
+                                    text.color(egui::Color32::from_rgb(220, 60, 60))
+                                } else {
+                                    text
+                                });
+                            }
+                            None => {
+                                ui.monospace("not given");
+                            }
+                        }
+                    }
+                    None => {
+                        ui.monospace(vector(p.gradients[k]));
+                    }
+                }
                 ui.monospace(vector(inspection.numeric_gradients[k]));
                 ui.monospace(vector(p.delta_x[k]));
                 ui.end_row();
             }
         });
+    if let Some(file) = p.family.file() {
+        let used = if file.use_gradient {
+            "the solver projects with your gradient (use_gradient = true)"
+        } else {
+            "the solver projects with AD's gradient"
+        };
+        ui.label(format!("{used}; yours in red where it differs from AD's"));
+    }
     ui.monospace(format!(
         "Σ|∇C|² = {:.4e}   Σ w|∇C|² = {:.4e}   finite-difference relative error {:.1e}",
         inspection.gradient_norm_squared(),

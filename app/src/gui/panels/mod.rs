@@ -1,6 +1,7 @@
 //! The side panels of the workbench, one file each.
 
 pub mod compare;
+pub mod constraint_editor;
 pub mod controls;
 pub mod display;
 pub mod help;

@@ -1,14 +1,25 @@
 //! The solver settings: method, families with their compliance or stiffness, substeps and the
 //! rest. The panel edits a copy; the app applies a change to every simulation shown.
 
+use crate::gui::shortcuts::Action;
 use eframe::egui;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::material::{MAX_POISSON, YOUNG};
 use tetlab_core::solver::{Method, Settings};
 
-/// Shows `current`; returns the settings the user changed them to, if they did.
-pub fn show(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
-    ui.heading("Solver");
+/// Shows `current`; returns the settings the user changed them to, if they did. "Write a
+/// constraint" asks for the constraint editor, whose family joins the list.
+pub fn show(ui: &mut egui::Ui, current: &Settings, actions: &mut Vec<Action>) -> Option<Settings> {
+    ui.horizontal(|ui| {
+        ui.heading("Solver");
+        if ui
+            .button("Write a constraint (G)")
+            .on_hover_text("The constraint editor: C as an expression, checked and simulated")
+            .clicked()
+        {
+            actions.push(Action::ConstraintEditor);
+        }
+    });
     let mut settings = *current;
     ui.horizontal(|ui| {
         ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");

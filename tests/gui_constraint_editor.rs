@@ -1,0 +1,191 @@
+//! The constraint editor in the workbench, screenless (egui_kittest on wgpu, like tests/gui.rs):
+//! a constraint typed in the editor is simulated, drawn in its own colour and inspected; a
+//! mistake is shown at its line and column while the last good definition stays; a wrong
+//! gradient is named by the check and drawn pale beside AD's; a dropped file opens in the editor.
+//!
+//! A test binary of its own: these tests add families to the table, which is the process's, and
+//! the snapshots of tests/gui.rs would otherwise show them.
+
+#[path = "support/gui.rs"]
+mod gui_support;
+
+use eframe::egui;
+use egui_kittest::kittest::Queryable;
+use gui_support::{pixels_like, workbench};
+use std::path::Path;
+use tetlab_core::constraint_file::ConstraintFile;
+use tetlab_core::constraints::Family;
+use tetlab_core::visual::{self, Quantity};
+
+/// The example families these tests use, registered once, in this order, before any test draws:
+/// the solver panel lists every family of the table, so that the snapshots do not depend on which
+/// test ran first.
+fn register_examples() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        for name in ["height.toml", "height-wrong-sign.toml", "volume.toml"] {
+            let example = tetlab_core::constraint_file::EXAMPLES
+                .iter()
+                .find(|e| e.file == name)
+                .unwrap();
+            let file = ConstraintFile::parse(Path::new(example.path), example.text).unwrap();
+            Family::register(file).unwrap();
+        }
+    });
+}
+
+/// G opens the editor on the source note's height; it is defined, switched on, drawn in its own
+/// colour on an inverted tet, inspected beside AD, and recovers the tet when played. A mistake
+/// typed in the editor is reported at its line and column, and the family stays as it was.
+#[test]
+fn a_constraint_typed_in_the_editor_is_simulated_and_its_mistakes_are_shown() {
+    register_examples();
+    let mut harness = workbench("tet", 1);
+    harness.key_press(egui::Key::G);
+    harness.run_steps(2);
+    let family = harness.state().editor.family.expect("the example compiles");
+    assert_eq!(family.name(), "my-height");
+    let settings = *harness.state().bench.simulation.settings();
+    assert!(settings.active[family], "switched on");
+    assert_eq!(settings.active.describe(), "edges+volume+my-height");
+    harness.get_by_label_contains("family my-height: on in the solver panel");
+
+    harness.key_press(egui::Key::I);
+    harness.run_steps(2);
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 1);
+    harness.snapshot("constraint_editor");
+    let colour = Quantity::Gradient(family).colour();
+    assert!(
+        pixels_like(&mut harness, colour) > 50,
+        "the file's arrows, in its own colour"
+    );
+
+    // The inspector shows AD's gradient and yours (the note's) side by side.
+    harness.key_press(egui::Key::E);
+    harness.run_steps(2);
+    harness.get_by_label_contains("my-height (").click();
+    harness.run_steps(2);
+    harness.get_all_by_label("∇C yours").next().unwrap();
+    harness.get_all_by_label("∇C by AD").next().unwrap();
+    harness.key_press(egui::Key::E);
+
+    // A mistake at the end, in the [gradient] table: a particle a tet-vertex binding does not
+    // have, on line 22 (the file's 20 lines, then a blank one).
+    let typed = "\np4 = \"n\"";
+    let editor = harness.get_by_label("Constraint file");
+    editor.focus();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::End);
+    harness.get_by_label("Constraint file").type_text(typed);
+    harness.run_steps(2);
+    let error = harness
+        .state()
+        .editor
+        .error
+        .clone()
+        .expect("the mistake is shown");
+    assert!(error.contains("height.toml:22:1:"), "{error}");
+    assert!(
+        error.contains("`p4`: this binding has particles p0…p3 only"),
+        "{error}"
+    );
+    harness.get_by_label_contains("`p4`: this binding has particles p0…p3 only");
+    harness.snapshot("constraint_editor_mistake");
+    assert_eq!(
+        harness.state().editor.family,
+        Some(family),
+        "the last good one stays"
+    );
+    for _ in 0..typed.len() {
+        harness.key_press(egui::Key::Backspace);
+    }
+    harness.run_steps(2);
+    assert_eq!(harness.state().editor.error, None, "mended");
+
+    // Keys go to the editor while it has the focus; the Play button plays.
+    harness.get_by_label("Play").click();
+    harness.run_steps(60);
+    assert_eq!(harness.state().editor.error, None, "nothing was typed");
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 0, "recovered");
+}
+
+/// The wrong height (one sign lost in g3), picked in the editor: the check names p3, its arrows
+/// are drawn pale beside AD's, and the inspector marks yours.
+#[test]
+fn a_wrong_gradient_is_named_by_the_check_and_drawn_beside_ads() {
+    register_examples();
+    let mut harness = workbench("tet", 1);
+    harness.key_press(egui::Key::G);
+    harness.run_steps(2);
+    // The editor's example button (the solver panel has a checkbox of the same name).
+    harness
+        .get_by_role_and_label(egui::accesskit::Role::Button, "height-wrong-sign")
+        .click();
+    harness.run_steps(2);
+    let family = harness.state().editor.family.unwrap();
+    assert_eq!(family.name(), "height-wrong-sign");
+    let active = harness.state().bench.simulation.settings().active;
+    assert!(active[family] && !active[Family::parse("my-height").unwrap()]);
+    harness.get_by_label("Check my gradient").click();
+    harness.run_steps(2);
+    harness.get_by_label("your gradient does NOT agree with AD");
+    harness.get_by_label_contains("worst at p3");
+    harness.key_press(egui::Key::I);
+    harness.run_steps(2);
+    // It is simulated with its own gradient (use_gradient): AD's is the one drawn pale (the
+    // legend says "grad C: height-wrong-sign, AD, where it differs").
+    let pale = Quantity::Disagreeing(family).colour();
+    assert!(pixels_like(&mut harness, pale) > 30, "the other gradient");
+    harness.snapshot("constraint_editor_wrong_gradient");
+}
+
+/// A constraint file dropped on the window opens in the editor; one with a mistake opens too,
+/// with the mistake shown where it can be mended.
+#[test]
+fn a_dropped_constraint_file_opens_in_the_editor() {
+    #[derive(Debug)]
+    struct Dropped(std::path::PathBuf);
+    impl egui::DroppedFile for Dropped {
+        fn path(&self) -> &Path {
+            &self.0
+        }
+        fn bytes(&self) -> Result<Vec<u8>, String> {
+            std::fs::read(&self.0).map_err(|e| e.to_string())
+        }
+    }
+    register_examples();
+    let mut harness = workbench("cube", 2);
+    let volume = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints/volume.toml");
+    harness
+        .input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(volume)));
+    harness.run_steps(3);
+    let family = harness.state().editor.family.expect("dropped and defined");
+    assert_eq!(family.name(), "my-volume");
+    assert!(harness.state().editor.open);
+    assert!(harness.state().bench.simulation.settings().active[family]);
+
+    let dir = std::env::temp_dir().join(format!("tetlab-editor-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let broken = dir.join("broken.toml");
+    std::fs::write(
+        &broken,
+        "name = \"broken\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p2) - rest\"\n",
+    )
+    .unwrap();
+    harness
+        .input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(broken)));
+    harness.run_steps(3);
+    let error = harness.state().editor.error.clone().expect("the mistake");
+    assert!(
+        error.contains("broken.toml:3:") && error.contains("p2"),
+        "{error}"
+    );
+    assert!(
+        harness.state().editor.text.contains("p0 - p2"),
+        "the text to mend"
+    );
+    assert!(visual::family_colour(family) != visual::family_colour(Family::VOLUME));
+}
