@@ -212,3 +212,23 @@ fn bad_options_are_usage_errors() {
         );
     }
 }
+
+/// `--engine reference` times the f64 solver; `--reference` says the same. Jacobi order is the
+/// fast engine's only.
+#[test]
+fn the_reference_engine_is_timed_by_either_name() {
+    for flag in [&["--reference"][..], &["--engine", "reference"][..]] {
+        let mut args = vec!["--scene", "tet", "--frames", "2"];
+        args.extend_from_slice(flag);
+        let report = bench_json(&args);
+        assert_eq!(report["solver"], "reference (f64)", "{flag:?}");
+    }
+    assert_eq!(
+        bench_json(&["--scene", "tet", "--frames", "2"])["solver"],
+        "fast (f32)"
+    );
+    assert_usage_error(
+        &tetlab(&["bench", "--engine", "reference", "--jacobi"]),
+        "--jacobi",
+    );
+}

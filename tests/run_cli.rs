@@ -477,3 +477,69 @@ fn a_bad_constraint_file_is_named_at_its_line_and_column() {
     );
     assert!(line.contains("built-in"), "{line}");
 }
+
+/// The engine in use is chosen (`--engine`, `auto` by default: the reference one below 1000
+/// tets, the fast one from there), named in frame 0 of the JSON and in the summary, and both
+/// engines give the source note's result.
+#[test]
+fn the_engine_is_chosen_and_always_named() {
+    let mirrored = |engine: &str| {
+        json_lines(&[
+            "run",
+            "--scene",
+            "cube",
+            "--resolution",
+            "3",
+            "--perturb",
+            "mirror",
+            "--gravity",
+            "0",
+            "--constraints",
+            "edges,height,volume",
+            "--frames",
+            "120",
+            "--substeps",
+            "10",
+            "--engine",
+            engine,
+            "--json",
+        ])
+    };
+    for engine in ["reference", "fast"] {
+        let frames = mirrored(engine);
+        assert_eq!(frames[0]["engine"], engine);
+        assert_eq!(frames[0]["inverted_tets"], 162);
+        assert_eq!(frames[120]["inverted_tets"], 0, "{engine}");
+        assert!(frames[1].get("engine").is_none(), "frame 0 only");
+    }
+    let auto = |resolution: &str| {
+        json_lines(&[
+            "run",
+            "--scene",
+            "cube",
+            "--resolution",
+            resolution,
+            "--frames",
+            "0",
+            "--json",
+        ])[0]["engine"]
+            .clone()
+    };
+    assert_eq!(auto("3"), "reference", "162 tets");
+    assert_eq!(auto("6"), "fast", "1296 tets");
+    let output = tetlab(&[
+        "run",
+        "--scene",
+        "tet",
+        "--frames",
+        "1",
+        "--engine",
+        "fast",
+        "--threads",
+        "2",
+    ]);
+    let text = stdout(&output);
+    assert!(text.contains("engine fast (f32, 2 threads)"), "{text}");
+    assert_usage_error(&tetlab(&["run", "--engine", "gpu"]), "--engine");
+    assert_usage_error(&tetlab(&["run", "--threads", "0"]), "--threads");
+}

@@ -10,7 +10,7 @@
 //! tet = 0                    # optional: the tet whose arrows are shown
 //!
 //! [settings]                 # optional; the names of the command line
-//! constraints = "edges"
+//! constraints = "edges"      # engine = "reference" if the lesson needs the f64 solver
 //! gravity = 0
 //!
 //! [[step]]
@@ -40,7 +40,7 @@ use crate::limits::{self, Bounds};
 use crate::material::Material;
 use crate::metrics::Metrics;
 use crate::scene::{Perturbation, Scene, SceneError, reflect_through_opposite_face};
-use crate::solver::{Method, Settings, Simulation};
+use crate::solver::{Engine, Method, Settings, Simulation};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::ops::ControlFlow;
@@ -440,6 +440,7 @@ struct RawLesson {
 struct RawSettings {
     constraints: Option<Spanned<String>>,
     solver: Option<Spanned<String>>,
+    engine: Option<Spanned<String>>,
     substeps: Option<Spanned<u32>>,
     iterations: Option<Spanned<u32>>,
     dt: Option<Spanned<f64>>,
@@ -601,6 +602,9 @@ impl Lesson {
         }
         if let Some(solver) = &s.solver {
             settings.method = Method::parse(solver.get_ref()).map_err(at(solver.span()))?;
+        }
+        if let Some(engine) = &s.engine {
+            settings.engine = Engine::parse(engine.get_ref()).map_err(at(engine.span()))?;
         }
         // Each setting checked against its range; a failure names the file and line of the value.
         fn checked<T: limits::Number>(

@@ -5,6 +5,7 @@ use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::lesson::{BUILTIN, Expectation, Lesson, LessonRun};
 use tetlab_core::shared_meshes;
+use tetlab_core::solver::Engine;
 
 #[test]
 fn there_are_at_least_six_lessons_in_order() {
@@ -24,6 +25,9 @@ fn there_are_at_least_six_lessons_in_order() {
 /// as shipped, its exercise's checks (and only those) are not observed; with the sign put back,
 /// handed in as a student would (`tetlab lesson 8 --constraint-file my-fix.toml`), everything is.
 /// One test does both, in order, since the answer redefines the lesson's family for the process.
+///
+/// On both engines: a lesson that does not name one (`engine` in its settings) is run on the
+/// reference engine and on the fast one, and observes the same on each.
 #[test]
 fn every_lesson_observes_what_it_says() {
     for (number, builtin) in (1..).zip(BUILTIN) {
@@ -34,24 +38,32 @@ fn every_lesson_observes_what_it_says() {
                 continue;
             }
         }
-        let lesson = Lesson::builtin(number).unwrap_or_else(|e| panic!("{e}"));
-        let pending = unobserved(number, &lesson, None);
-        // What an exercise expects holds once it is done: only the checks of a step whose
-        // gradient check is pending may be.
-        let exercise = |step: usize| {
-            pending
-                .iter()
-                .any(|(s, e)| *s == step && e.gradient_of.is_some())
+        let mut lesson = Lesson::builtin(number).unwrap_or_else(|e| panic!("{e}"));
+        let engines = match lesson.settings.engine {
+            Engine::Auto => vec![Engine::Reference, Engine::Fast],
+            named => vec![named],
         };
-        for (step, expectation) in &pending {
-            assert!(
-                exercise(*step),
-                "lesson {number} ({}), step {step}: expected {expectation}",
-                lesson.title
-            );
-        }
-        if number == 8 {
-            assert!(exercise(4), "the exercise is pending: {pending:?}");
+        for engine in engines {
+            lesson.settings.engine = engine;
+            let pending = unobserved(number, &lesson, None);
+            // What an exercise expects holds once it is done: only the checks of a step whose
+            // gradient check is pending may be.
+            let exercise = |step: usize| {
+                pending
+                    .iter()
+                    .any(|(s, e)| *s == step && e.gradient_of.is_some())
+            };
+            for (step, expectation) in &pending {
+                assert!(
+                    exercise(*step),
+                    "lesson {number} ({}) on the {engine:?} engine, step {step}: expected \
+                 {expectation}",
+                    lesson.title
+                );
+            }
+            if number == 8 {
+                assert!(exercise(4), "the exercise is pending: {pending:?}");
+            }
         }
     }
     // Lesson 8, with the student's answer: g3 gets its minus back.

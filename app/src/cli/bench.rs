@@ -8,12 +8,12 @@ use serde::Serialize;
 use std::io::Write;
 use std::time::{Duration, Instant};
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::fast::{FastSimulation, Order};
+use tetlab_core::fast::Order;
 use tetlab_core::lanes::{LANES, REGISTERS};
 use tetlab_core::limits;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::Simulation;
+use tetlab_core::solver::{Engine, Simulation};
 
 /// Options of `tetlab bench`.
 #[derive(Debug, clap::Args)]
@@ -34,11 +34,8 @@ pub struct Args {
     /// Frames run before timing (0..=100000).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(0..=100_000))]
     warmup: u64,
-    /// Threads for the fast solver (1..=256).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=256))]
-    threads: u64,
-    /// Time the reference f64 solver (the workbench's and `tetlab run`'s) instead of the fast one.
-    #[arg(long, conflicts_with_all = ["threads", "jacobi"])]
+    /// The same as --engine reference: time the f64 solver instead of the fast one.
+    #[arg(long, conflicts_with_all = ["engine", "threads", "jacobi"])]
     reference: bool,
     /// Fast solver in Jacobi order: each family projected from the same positions, each particle
     /// then moved by ω × the mean of its corrections (instead of Gauss–Seidel).
@@ -108,17 +105,28 @@ fn active_only<S: serde::Serializer>(
     map.end()
 }
 
-/// Runs the benchmark and prints the report.
+/// Runs the benchmark and prints the report. Both engines are timed through the one
+/// [`Simulation`] every front end drives, its fast engine's writing back included.
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let scene = Scene::from_spec(&args.scene, args.resolution)
         .map_err(|e| UsageError(format!("--scene: {e}")))?;
-    let settings = args.solver.settings()?;
+    let mut settings = args.solver.settings()?;
+    settings.engine = match (args.reference, args.solver.engine) {
+        (true, _) => Engine::Reference,
+        (false, Some(engine)) => engine.resolve(scene.mesh.tets.len()),
+        (false, None) => Engine::Fast,
+    };
+    if args.jacobi && settings.engine != Engine::Fast {
+        return Err(UsageError(
+            "--jacobi: only the fast engine projects in Jacobi order".into(),
+        ));
+    }
     let mut simulation = Simulation::new(&scene, settings);
+    simulation.set_threads(args.solver.threads.unwrap_or(1) as usize);
     super::simulation_args::warn_if_unstable(&simulation);
-    let report = if args.reference {
-        time_reference(args, &scene, &mut simulation)?
-    } else {
-        time_fast(args, &scene, &simulation)?
+    let report = match settings.engine {
+        Engine::Fast => time_fast(args, &scene, &mut simulation)?,
+        _ => time_reference(args, &scene, &mut simulation)?,
     };
     write_report(&report, args.json, out).map_err(UsageError::stdout)
 }
@@ -145,19 +153,23 @@ fn time_reference(
     ))
 }
 
-fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Report, UsageError> {
-    let mut fast = FastSimulation::new(simulation, args.threads as usize);
+fn time_fast(
+    args: &Args,
+    scene: &Scene,
+    simulation: &mut Simulation,
+) -> Result<Report, UsageError> {
     if args.jacobi {
-        fast.set_order(Order::Jacobi {
+        simulation.fast_solver().set_order(Order::Jacobi {
             relaxation: args.relaxation,
         });
     }
-    let elapsed = time(
-        args,
-        &mut fast,
-        FastSimulation::step,
-        FastSimulation::reset_timings,
-    );
+    let elapsed = time(args, simulation, Simulation::step, |s| {
+        s.fast_solver().reset_timings();
+    });
+    Metrics::measure_sound(simulation).map_err(|d| UsageError(d.to_string()))?;
+    let fast = simulation.fast_solver();
+    // The fast solver's own arrays (the simulation it steps keeps its f64 state beside them).
+    let heap_bytes = fast.heap_bytes();
     fast.check().map_err(|d| UsageError(d.to_string()))?;
     let timings = fast.timings();
     let active = fast.settings().active;
@@ -185,7 +197,7 @@ fn time_fast(args: &Args, scene: &Scene, simulation: &Simulation) -> Result<Repo
         fast.projections_per_frame(),
         elapsed,
         Some(by_family),
-        fast.heap_bytes(),
+        heap_bytes,
         Some(colours),
     );
     report.lanes = Some(format!("{LANES} f32 per batch, in {REGISTERS}"));

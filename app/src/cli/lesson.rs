@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::Family;
 use tetlab_core::lesson::{Action, BUILTIN, Lesson, LessonRun};
+use tetlab_core::solver::Engine;
 
 /// Options of `tetlab lesson`.
 #[derive(Debug, clap::Args)]
@@ -32,6 +33,12 @@ pub struct Args {
     /// that checks it; repeatable.
     #[arg(long = "constraint-file", value_name = "FILE", conflicts_with = "list")]
     constraint_files: Vec<PathBuf>,
+    /// The engine instead of the lesson's: auto, reference or fast, as for `tetlab run`.
+    #[arg(long, value_parser = Engine::parse, conflicts_with = "list")]
+    engine: Option<Engine>,
+    /// Threads for the fast engine (1..=256) [default: every core].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256), conflicts_with = "list")]
+    threads: Option<u64>,
     /// The neo-Hookean material instead of the lesson's: E=PA,nu=N, as for `tetlab run`.
     #[arg(long, value_name = "E=PA,nu=N", value_parser = tetlab_core::material::Material::parse, conflicts_with = "list")]
     material: Option<tetlab_core::material::Material>,
@@ -100,7 +107,14 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
             lesson.settings.active.set(family, true);
         }
     }
+    if let Some(engine) = args.engine {
+        lesson.settings.engine = engine;
+    }
     let mut run = LessonRun::new(&lesson);
+    run.simulation.set_threads(args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |t| t as usize,
+    ));
     for answer in answers {
         run.hand_in(&lesson, answer)
             .map_err(|e| UsageError(format!("--constraint-file {e}")))?;
@@ -146,6 +160,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     }
 
     writeln!(out, "# {}", lesson.title).map_err(UsageError::stdout)?;
+    writeln!(out, "\nengine {}", run.simulation.describe_engine()).map_err(UsageError::stdout)?;
     let mut all_observed = true;
     for (k, step) in lesson.steps.iter().enumerate() {
         writeln!(
@@ -160,8 +175,9 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
             rec.set_time_sequence("frame", clock.frame as i64);
             rec.set_duration_secs("sim_time", clock.time);
             let text = format!(
-                "# {}\n\n## step {} of {}\n\n{}",
+                "# {}\n\nengine {}\n\n## step {} of {}\n\n{}",
                 lesson.title,
+                run.simulation.describe_engine(),
                 k + 1,
                 lesson.steps.len(),
                 step.text

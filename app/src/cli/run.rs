@@ -38,6 +38,12 @@ pub struct FrameRecord {
     tets: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
     edges: Option<usize>,
+    /// Which engine steps the run: `reference` or `fast`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    engine: Option<&'static str>,
+    /// Threads of the fast engine.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    threads: Option<usize>,
 }
 
 impl FrameRecord {
@@ -60,6 +66,8 @@ impl FrameRecord {
             particles: first.then(|| simulation.positions().len()),
             tets: first.then(|| simulation.tets().len()),
             edges: first.then(|| simulation.constraint_count(Family::EDGES)),
+            engine: first.then(|| simulation.engine().name()),
+            threads: first.then(|| simulation.threads()),
         }
     }
 }

@@ -10,7 +10,7 @@ use tetlab_core::limits::{self, Number};
 use tetlab_core::material::Material;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
-use tetlab_core::solver::{Method, Settings, Simulation};
+use tetlab_core::solver::{Engine, Method, Settings, Simulation};
 
 /// Scene and solver options.
 #[derive(Debug, Clone, clap::Args)]
@@ -54,6 +54,15 @@ pub struct SolverArgs {
     /// xpbd or pbd.
     #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
     pub solver: Method,
+    /// Which solver steps the simulation: reference (f64, one constraint at a time), fast (f32,
+    /// coloured, in SIMD lanes, on threads) or auto (reference below 1000 tets, fast from there)
+    /// [default: auto; bench: fast].
+    #[arg(long, value_parser = Engine::parse)]
+    pub engine: Option<Engine>,
+    /// Threads for the fast engine (1..=256; the results are the same for any count) [default:
+    /// every core; bench: 1].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
     /// Substeps per frame (1..=1000).
     #[arg(long, default_value_t = Settings::default().substeps, value_parser = |s: &str| limits::SUBSTEPS.parse(s), allow_hyphen_values = true)]
     pub substeps: u32,
@@ -118,6 +127,7 @@ impl SolverArgs {
         }
         let mut settings = Settings {
             method: self.solver,
+            engine: self.engine.unwrap_or_default(),
             active,
             substeps: self.substeps,
             iterations: self.iterations,
@@ -154,11 +164,22 @@ impl SolverArgs {
             .collect()
     }
 
-    /// "xpbd, edges+volume, 100 substeps × 1 iteration, dt 0.016667 s, gravity 9.81" and any
-    /// non-default compliance or stiffness, for the settings [`SolverArgs::settings`] gave.
-    pub fn describe(&self, s: &Settings) -> String {
+    /// The threads the fast engine runs on: `--threads`, or every core the machine has.
+    pub fn threads(&self) -> usize {
+        self.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |t| t as usize,
+        )
+    }
+
+    /// "fast (f32, 2 threads), xpbd, edges+volume, 100 substeps × 1 iteration, dt 0.016667 s,
+    /// gravity 9.81" and any non-default compliance or stiffness, for `simulation`, built from
+    /// the settings [`SolverArgs::settings`] gave.
+    pub fn describe(&self, simulation: &Simulation) -> String {
+        let s = simulation.settings();
         let mut text = format!(
-            "{}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
+            "engine {}, {}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
+            simulation.describe_engine(),
             s.method.name(),
             s.active.describe(),
             s.substeps,
@@ -220,6 +241,7 @@ impl SimulationArgs {
         let scene = Scene::from_spec(&self.scene, self.resolution)
             .map_err(|e| UsageError(format!("--scene: {e}")))?;
         let mut simulation = Simulation::new(&scene, settings);
+        simulation.set_threads(self.solver.threads());
         warn_if_unstable(&simulation);
         if let Some(perturbation) = self.perturb {
             simulation.perturb(perturbation);
@@ -229,7 +251,7 @@ impl SimulationArgs {
 
     /// What [`SolverArgs::describe`] says of `simulation`'s settings, and whether edits settle.
     pub fn describe(&self, simulation: &Simulation) -> String {
-        let mut text = self.solver.describe(simulation.settings());
+        let mut text = self.solver.describe(simulation);
         if self.settle_edits {
             text += ", settle edits";
         }

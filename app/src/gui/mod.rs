@@ -98,6 +98,10 @@ pub struct TetlabApp {
     /// The last error to show (a mesh that did not load, …).
     pub error: Option<String>,
     step_time: Duration,
+    /// The time between the last two frames drawn, smoothed.
+    frame_time: Duration,
+    /// When the last frame was drawn.
+    last_frame: Option<Instant>,
     show_help: bool,
     /// Whether the inspector window is open.
     pub show_inspector: bool,
@@ -168,6 +172,8 @@ impl TetlabApp {
                 format!("the remembered solver settings were refused ({why}); using the defaults")
             }),
             step_time: Duration::ZERO,
+            frame_time: Duration::ZERO,
+            last_frame: None,
             show_help: false,
             show_inspector: false,
             show_lesson: false,
@@ -539,6 +545,13 @@ fn act_on(bench: &mut Workbench, action: Action) {
 impl eframe::App for TetlabApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        let now = Instant::now();
+        if let Some(last) = self.last_frame {
+            // A running mean over about ten frames, so that the number can be read.
+            let elapsed = now - last;
+            self.frame_time = (self.frame_time * 9 + elapsed) / 10;
+        }
+        self.last_frame = Some(now);
         self.handle_input(&ctx);
         let zoom = if self.classroom { CLASSROOM_ZOOM } else { 1.0 };
         if ctx.zoom_factor() != zoom {
@@ -619,7 +632,7 @@ impl eframe::App for TetlabApp {
                 .default_size(300.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| {
-                        panels::readouts::show(ui, &self.bench, self.step_time);
+                        panels::readouts::show(ui, &self.bench, self.step_time, self.frame_time);
                         ui.separator();
                         if let Some(action) = panels::display::show(
                             ui,

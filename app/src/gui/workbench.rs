@@ -11,6 +11,15 @@ use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_
 use tetlab_core::solver::{Settings, Simulation};
 use tetlab_core::stepper::{Advanced, StepByStep};
 
+/// The threads the fast engine runs on: every core (one in a browser).
+pub fn threads() -> usize {
+    if cfg!(target_arch = "wasm32") {
+        1
+    } else {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    }
+}
+
 /// How many frames of metrics the plots keep.
 pub const HISTORY: usize = 600;
 
@@ -57,7 +66,8 @@ pub struct Workbench {
 impl Workbench {
     /// A workbench on `scene`, paused at rest, with tet 0 and its first corner selected.
     pub fn new(scene: Scene, settings: Settings) -> Self {
-        let simulation = Simulation::new(&scene, settings);
+        let mut simulation = Simulation::new(&scene, settings);
+        simulation.set_threads(threads());
         let mut workbench = Workbench {
             stability_warning: simulation.stability_warning(),
             scene,

@@ -134,6 +134,25 @@ impl Batches {
         }
     }
 
+    /// Writes each particle's inverse mass into every lane that holds it (padding lanes keep
+    /// 0): after a pin, a grab or a release. Allocates nothing.
+    pub(crate) fn set_weights(&mut self, inverse_masses: &[f32]) {
+        let arity = self.arity;
+        for colour in &self.colours {
+            for (k, b) in colour.batches.clone().enumerate() {
+                let real = colour.constraints.saturating_sub(k * LANES).min(LANES);
+                for i in 0..arity {
+                    let row = self.particles[b * arity + i];
+                    let mut lanes = [0.0f32; LANES];
+                    for (lane, weight) in lanes.iter_mut().enumerate().take(real) {
+                        *weight = inverse_masses[row[lane] as usize];
+                    }
+                    self.weights[b * arity + i] = F32x8::new(lanes);
+                }
+            }
+        }
+    }
+
     /// λ = 0 for every constraint (a new substep).
     pub(crate) fn reset_lambda(&mut self) {
         self.lambda.fill(F32x8::ZERO);

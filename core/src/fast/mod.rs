@@ -63,6 +63,8 @@ pub struct FastSimulation {
     inverse_masses: Vec<f32>,
     /// The scene's number of each particle, by new number.
     original: Vec<u32>,
+    /// The new number of each particle, by the scene's number.
+    renumber: Vec<u32>,
     /// The constraints of each active family (the others are left empty).
     sets: PerFamily<Batches>,
     tets: usize,
@@ -71,6 +73,32 @@ pub struct FastSimulation {
     pool: Option<rayon::ThreadPool>,
     timings: Timings,
     frame: u64,
+    /// Δp of the last substep and its sum over the frame, when a frame asks for them
+    /// ([`FrameInputs`]); the predicted positions they are measured from. Empty until then.
+    corrections: Corrections,
+}
+
+/// What a frame of the fast solver is asked to do beyond the settings: hold a grabbed particle,
+/// settle an edit, keep Δp. The reference solver ([`Simulation`]) passes them when it steps
+/// on the fast engine.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameInputs {
+    /// A particle held by the user: its number in the scene, where it is held, and the grab's
+    /// compliance (0: it follows the target exactly, and its inverse mass must be 0).
+    pub grab: Option<(usize, DVec3, f64)>,
+    /// Whether an edit settles: corrections may move particles but not speed them up, and Δp is
+    /// summed over the frame.
+    pub settling: bool,
+    /// Whether to keep Δp of the frame's last substep ([`FastSimulation::store`]).
+    pub corrections: bool,
+}
+
+/// Δp per particle (new numbering), kept on request.
+#[derive(Clone, Debug, Default)]
+struct Corrections {
+    predicted: Vec<Vec3A>,
+    last: Vec<Vec3A>,
+    frame: Vec<Vec3A>,
 }
 
 /// How a sweep applies the corrections of a family's constraints.
@@ -158,6 +186,7 @@ impl FastSimulation {
             rest_positions: take(simulation.rest_positions()),
             inverse_masses,
             original,
+            renumber,
             sets,
             tets: simulation.tets().len(),
             jacobi: None,
@@ -172,7 +201,60 @@ impl FastSimulation {
                 .flatten(),
             timings: Timings::default(),
             frame: 0,
+            corrections: Corrections::default(),
         }
+    }
+
+    /// Takes up a state given in the scene's numbering: positions, velocities and inverse
+    /// masses (pins and a rigid grab give 0). Allocates nothing; the inverse masses are written
+    /// into every batch lane that holds the particle.
+    ///
+    /// # Panics
+    /// If the slices are not one per particle.
+    pub fn load(&mut self, positions: &[DVec3], velocities: &[DVec3], inverse_masses: &[f64]) {
+        for (new, &old) in self.original.iter().enumerate() {
+            let old = old as usize;
+            self.positions[new] = positions[old].as_vec3a();
+            self.velocities[new] = velocities[old].as_vec3a();
+            self.inverse_masses[new] = inverse_masses[old] as f32;
+        }
+        self.previous.copy_from_slice(&self.positions);
+        for family in self.settings.active.families() {
+            self.sets[family].set_weights(&self.inverse_masses);
+        }
+    }
+
+    /// Writes the state back in the scene's numbering: positions and velocities, and with
+    /// `corrections`, Δp of the last substep and its sum over the frame (zero where the frame
+    /// did not keep them, [`FrameInputs`]). Allocates nothing.
+    ///
+    /// # Panics
+    /// If the slices are not one per particle.
+    pub fn store(
+        &self,
+        positions: &mut [DVec3],
+        velocities: &mut [DVec3],
+        corrections: Option<(&mut [DVec3], &mut [DVec3])>,
+    ) {
+        for (new, &old) in self.original.iter().enumerate() {
+            positions[old as usize] = self.positions[new].as_dvec3();
+            velocities[old as usize] = self.velocities[new].as_dvec3();
+        }
+        if let Some((last, frame)) = corrections {
+            let kept = &self.corrections;
+            for (new, &old) in self.original.iter().enumerate() {
+                let at = |values: &[Vec3A]| values.get(new).map_or(DVec3::ZERO, |v| v.as_dvec3());
+                last[old as usize] = at(&kept.last);
+                frame[old as usize] = at(&kept.frame);
+            }
+        }
+    }
+
+    /// Replaces the settings; the active families and the material must stay as they were (a
+    /// change of either needs a new [`FastSimulation`], whose constraints are built for them).
+    pub fn set_settings(&mut self, settings: Settings) {
+        debug_assert!(settings.active == self.settings.active);
+        self.settings = settings;
     }
 
     /// The threads the projections run on.
@@ -354,22 +436,48 @@ impl FastSimulation {
     /// threads, the whole frame runs inside the thread pool (entering it once per frame, not once
     /// per colour).
     pub fn step(&mut self) {
+        self.step_frame(&FrameInputs::default());
+    }
+
+    /// [`FastSimulation::step`], holding a grabbed particle, settling an edit or keeping Δp as
+    /// `inputs` ask. Allocates nothing once Δp has been kept once.
+    pub fn step_frame(&mut self, inputs: &FrameInputs) {
         #[cfg(feature = "parallel")]
         if let Some(pool) = self.pool.take() {
-            pool.install(|| self.step_on(true));
+            pool.install(|| self.step_on(true, inputs));
             self.pool = Some(pool);
             self.frame += 1;
             return;
         }
-        self.step_on(false);
+        self.step_on(false, inputs);
         self.frame += 1;
     }
 
     /// One frame; `parallel`: large colours are shared by the threads of the current pool.
-    fn step_on(&mut self, parallel: bool) {
+    fn step_on(&mut self, parallel: bool, inputs: &FrameInputs) {
         let settings = self.settings;
         let h = settings.dt / settings.substeps.max(1) as f64;
-        for _ in 0..settings.substeps.max(1) {
+        let substeps = settings.substeps.max(1);
+        let grab = inputs.grab.map(|(particle, target, compliance)| {
+            (
+                self.renumber[particle] as usize,
+                target.as_vec3a(),
+                compliance,
+            )
+        });
+        let keep = inputs.settling || inputs.corrections;
+        if keep && self.corrections.predicted.len() != self.positions.len() {
+            let n = self.positions.len();
+            self.corrections = Corrections {
+                predicted: vec![Vec3A::ZERO; n],
+                last: vec![Vec3A::ZERO; n],
+                frame: vec![Vec3A::ZERO; n],
+            };
+        }
+        if keep {
+            self.corrections.frame.fill(Vec3A::ZERO);
+        }
+        for substep in 0..substeps {
             integrate::predict(
                 &mut self.positions,
                 &mut self.previous,
@@ -379,11 +487,34 @@ impl FastSimulation {
                 h,
                 settings.ground,
             );
+            if let Some((i, target, compliance)) = grab
+                && compliance <= 0.0
+            {
+                self.positions[i] = target;
+            }
+            let track = inputs.settling || (inputs.corrections && substep + 1 == substeps);
+            if track {
+                self.corrections.predicted.copy_from_slice(&self.positions);
+            }
             for family in settings.active.families() {
                 self.sets[family].reset_lambda();
             }
+            let mut grab_lambda = 0.0;
             for _ in 0..settings.iterations.max(1) {
-                self.sweep(h, parallel);
+                self.sweep(h, parallel, grab, &mut grab_lambda);
+            }
+            if track {
+                let c = &mut self.corrections;
+                for (((last, sum), p), predicted) in c
+                    .last
+                    .iter_mut()
+                    .zip(&mut c.frame)
+                    .zip(&self.positions)
+                    .zip(&c.predicted)
+                {
+                    *last = *p - *predicted;
+                    *sum += *last;
+                }
             }
             integrate::update_velocities(
                 &self.positions,
@@ -391,7 +522,7 @@ impl FastSimulation {
                 &mut self.velocities,
                 h,
                 settings.damping,
-                false,
+                inputs.settling,
             );
         }
     }
@@ -409,7 +540,15 @@ impl FastSimulation {
         }
     }
 
-    fn sweep(&mut self, h: f64, parallel: bool) {
+    /// One sweep over the active families, then the grab (when it is compliant: a rigid one
+    /// holds its particle at the target with inverse mass 0), then the ground.
+    fn sweep(
+        &mut self,
+        h: f64,
+        parallel: bool,
+        grab: Option<(usize, Vec3A, f64)>,
+        grab_lambda: &mut f32,
+    ) {
         let active = self.settings.active;
         for family in active.families() {
             if family.projected_by_partner(&active) {
@@ -506,6 +645,21 @@ impl FastSimulation {
             self.apply_jacobi(family);
             self.timings.time[family] += started.elapsed();
             self.timings.projections[family] += count as u64;
+        }
+        if let Some((i, target, compliance)) = grab
+            && compliance > 0.0
+        {
+            let evaluation =
+                crate::constraints::distance::evaluate(&[self.positions[i], target], 0.0);
+            let rule = Rule::Xpbd {
+                alpha_tilde: (compliance / (h * h)) as f32,
+            };
+            let weights = [self.inverse_masses[i], 0.0];
+            if let Some(c) = crate::projection::correction(evaluation, weights, *grab_lambda, rule)
+            {
+                *grab_lambda += c.delta_lambda;
+                self.positions[i] += c.delta_x[0];
+            }
         }
         if self.settings.ground {
             integrate::project_ground(&mut self.positions, &self.inverse_masses);

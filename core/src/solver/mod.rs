@@ -26,11 +26,13 @@
 //! [`crate::constraints::volume::evaluate`] → `correction` ([`crate::projection`]).
 
 mod constraint_set;
+mod engine;
 mod masses;
 mod pair;
 mod settings;
 
 pub use constraint_set::ConstraintSet;
+pub use engine::{Engine, FAST_FROM_TETS};
 pub use masses::DENSITY;
 pub use settings::{DEFAULT_SUBSTEPS, Method, Settings};
 
@@ -101,6 +103,10 @@ pub struct Simulation {
     time: f64,
     /// [`crate::constraints::file::definitions`] when the sets were last brought up to date.
     definitions: u64,
+    /// The fast engine, when [`Simulation::engine`] is [`Engine::Fast`] ([`engine`]).
+    fast: engine::FastEngine,
+    /// Threads for the fast engine.
+    threads: usize,
 }
 
 impl Simulation {
@@ -141,6 +147,8 @@ impl Simulation {
             frame: 0,
             time: 0.0,
             definitions: crate::constraints::file::definitions(),
+            fast: engine::FastEngine::default(),
+            threads: 1,
         };
         simulation.update_inverse_masses();
         simulation
@@ -177,6 +185,8 @@ impl Simulation {
                 tets: self.tets.clone(),
             });
             self.sets[family] = ConstraintSet::new(family, mesh, &self.settings.material);
+            // The fast engine's constraints were built from the old ones.
+            self.fast.solver = None;
         }
     }
 
@@ -189,6 +199,7 @@ impl Simulation {
                 self.sets[family].measure_rest(family, &self.rest_positions, &settings.material);
             }
         }
+        self.fast.set_settings(&self.settings, &settings);
         self.settings = settings;
         self.rebuild_stale_sets();
     }
@@ -264,9 +275,14 @@ impl Simulation {
     /// size; otherwise the first that is not. Within the input [`crate::limits`] only an
     /// instability leaves that range; front ends check after every frame and stop.
     pub fn check(&self) -> Result<(), Divergence> {
+        // The f32 engine holds coordinates up to its own limit.
+        let positions = match self.engine() {
+            Engine::Fast => crate::fast::POSITION_LIMIT,
+            _ => SOUND_LIMIT,
+        };
         Divergence::find(
             self.frame,
-            (SOUND_LIMIT, SOUND_LIMIT),
+            (positions, SOUND_LIMIT),
             self.positions.iter().map(|p| p.to_array()),
             self.velocities.iter().map(|v| v.to_array()),
             |i| i,
@@ -298,6 +314,7 @@ impl Simulation {
                 .iter_ref()
                 .map(|(_, set)| set.heap_bytes())
                 .sum::<usize>()
+            + self.fast.solver.as_ref().map_or(0, |f| f.heap_bytes())
     }
 
     /// Whether particle `i` is pinned.
@@ -309,6 +326,7 @@ impl Simulation {
     pub fn set_pinned(&mut self, i: usize, pinned: bool) {
         self.pinned[i] = pinned;
         self.update_inverse_masses();
+        self.fast.edited();
     }
 
     /// Applies a perturbation to the current positions and stops all motion.
@@ -330,6 +348,7 @@ impl Simulation {
 
     /// Puts particle `i` at `position` at rest (a kinematic move, e.g. a drag while paused).
     pub fn place(&mut self, i: usize, position: DVec3) {
+        self.fast.edited();
         self.positions[i] = position;
         self.previous[i] = position;
         self.velocities[i] = DVec3::ZERO;
@@ -349,6 +368,7 @@ impl Simulation {
 
     /// Zeroes every velocity and multiplier.
     fn stop(&mut self) {
+        self.fast.edited();
         self.previous.copy_from_slice(&self.positions);
         self.velocities.fill(DVec3::ZERO);
         self.corrections.fill(DVec3::ZERO);
@@ -371,6 +391,7 @@ impl Simulation {
             lambda: 0.0,
         });
         self.update_inverse_masses();
+        self.fast.edited();
     }
 
     /// Moves the held target.
@@ -391,6 +412,7 @@ impl Simulation {
         if let Some(grab) = self.grab.take() {
             self.velocities[grab.particle] = grab.target_velocity;
             self.update_inverse_masses();
+            self.fast.edited();
         }
     }
 
@@ -411,12 +433,18 @@ impl Simulation {
         }
     }
 
-    /// Advances one frame: `substeps` substeps of Δt / substeps.
+    /// Advances one frame: `substeps` substeps of Δt / substeps, on the engine of
+    /// [`Simulation::engine`].
     pub fn step(&mut self) {
         self.update_inverse_masses();
         self.frame_corrections.fill(DVec3::ZERO);
-        for _ in 0..self.settings.substeps.max(1) {
-            self.substep();
+        match self.engine() {
+            Engine::Fast => self.step_fast(),
+            _ => {
+                for _ in 0..self.settings.substeps.max(1) {
+                    self.substep();
+                }
+            }
         }
         if let Some(grab) = &mut self.grab {
             grab.target_velocity = (grab.target - grab.target_at_last_step) / self.settings.dt;
@@ -453,6 +481,7 @@ impl Simulation {
 
     /// The first part of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
     pub fn begin_substep(&mut self) {
+        self.fast.edited();
         self.refresh_families();
         let h = self.substep_length();
         self.predict(h);
@@ -466,6 +495,7 @@ impl Simulation {
 
     /// The end of one sweep, after the constraint families: the grab, then the ground y ≥ 0.
     pub fn end_sweep(&mut self) {
+        self.fast.edited();
         let h = self.substep_length();
         self.project_soft_grab(h);
         if self.settings.ground {
@@ -475,6 +505,7 @@ impl Simulation {
 
     /// The last part of a substep: Δp = x − predicted x, then velocities from the positions.
     pub fn end_substep(&mut self) {
+        self.fast.edited();
         let h = self.substep_length();
         for ((correction, sum), p) in self
             .corrections
@@ -591,6 +622,7 @@ impl Simulation {
     /// Projects constraint `c` of `family` once, exactly as a sweep does (with its partner, if
     /// it leads a pair).
     pub fn project(&mut self, family: Family, c: usize) {
+        self.fast.edited();
         self.project_range(family, c..c + 1, self.substep_length());
     }
 

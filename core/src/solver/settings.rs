@@ -3,6 +3,7 @@
 //! [`Settings::set_gravity`]). The command line, lessons, `tetlab bench` and the workbench all
 //! build their settings here.
 
+use super::Engine;
 use crate::constraints::{Family, PerFamily};
 use crate::limits;
 use crate::material::Material;
@@ -69,6 +70,9 @@ pub struct Settings {
     /// move particles but not speed them up, until the edit's violation is undone. Otherwise rigid
     /// constraints undo a large violation within a substep, and v = Δx/h launches the body.
     pub settle_edits: bool,
+    /// Which solver steps the simulation ([`Engine`]).
+    #[serde(default)]
+    pub engine: Engine,
 }
 
 impl Settings {
@@ -163,6 +167,7 @@ impl Default for Settings {
             grab_compliance: 0.0,
             settle_edits: false,
             material: Material::default(),
+            engine: Engine::Auto,
         };
         settings.set_material(Material::default());
         settings

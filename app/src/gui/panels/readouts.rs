@@ -5,8 +5,9 @@ use eframe::egui;
 use egui_plot::{Legend, Line, Plot, PlotPoints};
 use std::time::Duration;
 
-/// Shows the metrics of the current frame and plots of the recent ones.
-pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration) {
+/// Shows the metrics of the current frame and plots of the recent ones; `step_time` is the last
+/// simulation step's, `frame_time` the time between the last two frames drawn.
+pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration, frame_time: Duration) {
     let m = &bench.metrics;
     if let Some(warning) = &bench.stability_warning {
         ui.colored_label(egui::Color32::from_rgb(230, 160, 40), warning);
@@ -36,9 +37,22 @@ pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration) {
                     "no".to_owned()
                 },
             ),
+            ("engine", bench.simulation.describe_engine()),
             (
                 "step time",
                 format!("{:.2} ms", step_time.as_secs_f64() * 1e3),
+            ),
+            (
+                "frame time",
+                if bench.playing {
+                    format!(
+                        "{:.1} ms ({:.0} frames per second)",
+                        frame_time.as_secs_f64() * 1e3,
+                        1.0 / frame_time.as_secs_f64().max(1e-6)
+                    )
+                } else {
+                    "paused".to_owned()
+                },
             ),
         ] {
             ui.label(label);

@@ -5,7 +5,7 @@ use crate::gui::shortcuts::Action;
 use eframe::egui;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::material::{MAX_POISSON, YOUNG};
-use tetlab_core::solver::{Method, Settings};
+use tetlab_core::solver::{Engine, FAST_FROM_TETS, Method, Settings};
 
 /// Shows `current`; returns the settings the user changed them to, if they did. "Write a
 /// constraint" asks for the constraint editor, whose family joins the list.
@@ -24,6 +24,31 @@ pub fn show(ui: &mut egui::Ui, current: &Settings, actions: &mut Vec<Action>) ->
     ui.horizontal(|ui| {
         ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");
         ui.radio_value(&mut settings.method, Method::Pbd, "PBD");
+    });
+    ui.horizontal(|ui| {
+        ui.label("engine");
+        for (engine, label, hover) in [
+            (
+                Engine::Auto,
+                "auto",
+                format!("reference below {FAST_FROM_TETS} tets, fast from there"),
+            ),
+            (
+                Engine::Reference,
+                "reference",
+                "f64, one constraint at a time: exact, and what step by step walks through"
+                    .to_owned(),
+            ),
+            (
+                Engine::Fast,
+                "fast",
+                "f32, coloured, eight constraints at a time in SIMD lanes, on every core"
+                    .to_owned(),
+            ),
+        ] {
+            ui.radio_value(&mut settings.engine, engine, label)
+                .on_hover_text(hover);
+        }
     });
     for (group, members) in Family::groups() {
         let family = members.families().next().expect("a group has a family");
