@@ -397,7 +397,7 @@ fn the_inspector_shows_the_numbers_of_the_selected_tet() {
     harness.key_press(egui::Key::I);
     harness.key_press(egui::Key::E);
     harness.run_steps(2);
-    assert!(harness.state().show_inspector);
+    assert!(harness.state().inspector.open);
     harness.get_by_label_contains("Tet 0: particles");
     harness.get_by_label_contains("Signed volume (1)");
     harness.get_by_label_contains("C = ⅙ e₁ · (e₂ × e₃) − V");
@@ -548,7 +548,7 @@ fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
 #[test]
 fn open_mesh_file_browses_and_loads_a_mesh() {
     let mut harness = workbench("cube", 2);
-    harness.state_mut().preferences.scene.path = "../assets/meshes/bipyramid.node".into();
+    harness.state_mut().controls.scene.path = "../assets/meshes/bipyramid.node".into();
     harness.get_by_label("Open mesh file...").click();
     harness.run_steps(4);
     harness.get_by_label_contains("assets/meshes");
@@ -561,4 +561,86 @@ fn open_mesh_file_browses_and_loads_a_mesh() {
         harness.query_by_label("bipyramid.ele").is_none(),
         "the browser closed"
     );
+}
+
+/// A panel and the requests it made, drawn on its own.
+struct Alone {
+    panel: Box<dyn tetlab::gui::panels::Panel>,
+    bench: tetlab::gui::workbench::Workbench,
+    requests: Vec<tetlab::gui::request::Request>,
+}
+
+/// `panel` on a 2×2×2 cube, drawn on its own in a `width` × `height` harness.
+fn alone(
+    panel: Box<dyn tetlab::gui::panels::Panel>,
+    width: f32,
+    height: f32,
+) -> Harness<'static, Alone> {
+    let settings = tetlab::gui::Preferences::default().settings;
+    let bench =
+        tetlab::gui::workbench::Workbench::builtin(tetlab_core::scene::Builtin::Cube, 2, settings);
+    let mut fonts = false;
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(width, height))
+        .wgpu()
+        .build_ui_state(
+            move |ui, alone: &mut Alone| {
+                if !fonts {
+                    tetlab::gui::install_fonts(ui.ctx());
+                    fonts = true;
+                }
+                let context = tetlab::gui::panels::Context::of(&alone.bench);
+                alone.panel.ui(ui, &context, &mut alone.requests);
+            },
+            Alone {
+                panel,
+                bench,
+                requests: Vec::new(),
+            },
+        );
+    harness.run_steps(3);
+    harness
+}
+
+/// Every side panel has the one signature of `Panel` and can be drawn, and snapshot, on its own:
+/// a change to one panel changes its snapshot only. What a panel asks for comes out as requests.
+#[test]
+fn each_panel_is_drawn_on_its_own_and_asks_through_requests() {
+    use tetlab::gui::panels::{
+        compare::ComparePanel, controls::Controls, display::DisplayPanel, lesson::LessonPanel,
+        readouts::Readouts, solver::SolverPanel, tools::Tools,
+    };
+    use tetlab::gui::request::Request;
+    use tetlab::gui::shortcuts::Action;
+    let panels: [(&str, Box<dyn tetlab::gui::panels::Panel>, f32); 7] = [
+        ("panel_controls", Box::new(Controls::default()), 250.0),
+        ("panel_solver", Box::new(SolverPanel), 300.0),
+        ("panel_tools", Box::new(Tools), 140.0),
+        ("panel_compare", Box::new(ComparePanel::default()), 70.0),
+        ("panel_readouts", Box::new(Readouts), 450.0),
+        ("panel_display", Box::new(DisplayPanel::default()), 240.0),
+        ("panel_lesson", Box::new(LessonPanel::default()), 70.0),
+    ];
+    let mut results = egui_kittest::SnapshotResults::default();
+    for (name, panel, height) in panels {
+        let mut harness = alone(panel, 330.0, height);
+        harness.snapshot(name);
+        results.extend_harness(&mut harness);
+    }
+    results.unwrap();
+    let mut harness = alone(Box::new(Tools), 330.0, 140.0);
+    harness.get_by_label("Mirror all").click();
+    harness.run_steps(1);
+    assert!(matches!(
+        harness.state().requests.as_slice(),
+        [Request::Act(Action::Mirror)]
+    ));
+    let mut harness = alone(Box::new(SolverPanel), 330.0, 300.0);
+    harness.get_by_label("PBD").click();
+    harness.run_steps(1);
+    let asked = harness.state().requests.iter().find_map(|r| match r {
+        Request::Settings(settings) => Some(settings.method),
+        _ => None,
+    });
+    assert_eq!(asked, Some(tetlab_core::solver::Method::Pbd));
 }

@@ -23,7 +23,11 @@ pub fn workbench(scene: &str, resolution: u32) -> Harness<'static, TetlabApp> {
                 tetlab_core::scene::Scene::from_spec(&preferences.scene.builtin, resolution)
                     .unwrap(),
             );
-            app.preferences = preferences.clone();
+            app.controls.scene = preferences.scene.clone();
+            app.freeze_timings(
+                std::time::Duration::from_millis(2),
+                std::time::Duration::from_millis(16),
+            );
             app
         });
     harness.run_steps(3);

@@ -1,6 +1,7 @@
 //! The interactive workbench: an eframe app on wgpu. The 3D view is in [`viewport`] (drawing in
-//! [`render`], what to draw in [`geometry`]), the state in [`workbench`], and each side panel in a
-//! file of its own under [`panels`].
+//! [`render`], what to draw in [`geometry`]), the state in [`workbench`], and each panel in a
+//! file of its own under [`panels`], all with one signature: they draw and add [`Request`]s,
+//! which [`TetlabApp::ui`] carries out in one loop once every panel is drawn.
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod browser;
@@ -9,6 +10,7 @@ pub mod files;
 pub mod geometry;
 pub mod panels;
 pub mod render;
+pub mod request;
 pub mod shortcuts;
 pub mod viewport;
 pub mod workbench;
@@ -16,9 +18,18 @@ pub mod workbench;
 use eframe::egui;
 use files::Opened;
 use geometry::{SceneCache, ViewOptions};
+use panels::compare::ComparePanel;
 use panels::constraint_editor::ConstraintEditor;
-use panels::controls::{SceneChoice, SceneRequest};
-use panels::lesson::{LessonRequest, LessonState};
+use panels::controls::{Controls, SceneChoice, SceneRequest};
+use panels::display::DisplayPanel;
+use panels::help::Help;
+use panels::inspector::Inspector;
+use panels::lesson::{LessonPanel, LessonRequest, LessonState};
+use panels::readouts::Readouts;
+use panels::solver::SolverPanel;
+use panels::tools::Tools;
+use panels::{Context, Panel};
+use request::Request;
 use shortcuts::{Action, SHORTCUTS};
 use std::time::Duration;
 use tetlab_core::constraints::PerFamily;
@@ -93,8 +104,6 @@ pub struct TetlabApp {
     cache: SceneCache,
     /// The 3D view.
     pub viewport: Viewport,
-    /// What is remembered between runs.
-    pub preferences: Preferences,
     /// The last error to show (a mesh that did not load, …).
     pub error: Option<String>,
     step_time: Duration,
@@ -102,21 +111,36 @@ pub struct TetlabApp {
     frame_time: Duration,
     /// When the last frame was drawn.
     last_frame: Option<Instant>,
-    show_help: bool,
-    /// Whether the inspector window is open.
-    pub show_inspector: bool,
+    /// Timings shown instead of the measured ones ([`TetlabApp::freeze_timings`]).
+    frozen_timings: Option<(Duration, Duration)>,
     /// Whether the lesson window is open.
     pub show_lesson: bool,
     /// The lesson in progress.
     pub lesson: Option<LessonState>,
-    /// The constraint editor.
-    pub editor: ConstraintEditor,
     /// The second simulation shown beside the first, if any.
     pub comparison: Option<Comparison>,
     /// Classroom mode: large, the 3D view and the lesson only.
     pub classroom: bool,
-    lesson_path: String,
-    compare_families: PerFamily<bool>,
+    /// Playback, step by step and the scene.
+    pub controls: Controls,
+    /// The solver settings.
+    pub solver: SolverPanel,
+    /// Deformations and the selection.
+    pub tools: Tools,
+    /// Side by side with other families.
+    pub compare: ComparePanel,
+    /// The metrics, engine and timings.
+    pub readouts: Readouts,
+    /// What the views draw.
+    pub display: DisplayPanel,
+    /// The lesson picker and the current step.
+    pub lesson_panel: LessonPanel,
+    /// The constraint editor.
+    pub editor: ConstraintEditor,
+    /// The inspector window.
+    pub inspector: Inspector,
+    /// The help window.
+    pub help: Help,
     /// Frames drawn so far (the first one is announced in a browser).
     frames_drawn: u64,
     /// Dropped files read in the background.
@@ -167,28 +191,52 @@ impl TetlabApp {
             bench,
             cache,
             viewport,
-            preferences,
             error: refused.map(|why| {
                 format!("the remembered solver settings were refused ({why}); using the defaults")
             }),
             step_time: Duration::ZERO,
             frame_time: Duration::ZERO,
             last_frame: None,
-            show_help: false,
-            show_inspector: false,
+            frozen_timings: None,
             show_lesson: false,
             lesson: None,
-            editor: ConstraintEditor::default(),
             comparison: None,
             classroom: false,
-            lesson_path: String::new(),
-            // The geometric families: the material ones are another model, added by choice.
-            compare_families: PerFamily::from_fn(|f| f.row().compliance_from_material.is_none()),
+            controls: Controls {
+                scene: preferences.scene,
+            },
+            solver: SolverPanel,
+            tools: Tools,
+            compare: ComparePanel::default(),
+            readouts: Readouts,
+            display: DisplayPanel {
+                options: preferences.view,
+            },
+            lesson_panel: LessonPanel::default(),
+            editor: ConstraintEditor::default(),
+            inspector: Inspector::default(),
+            help: Help::default(),
             frames_drawn: 0,
             #[cfg(target_arch = "wasm32")]
             inbox: files::Inbox::default(),
             #[cfg(not(target_arch = "wasm32"))]
             browser: None,
+        }
+    }
+
+    /// Shows these step and frame times in the readouts instead of the measured ones: for
+    /// screenless tests, whose snapshots must not depend on how fast the machine is.
+    pub fn freeze_timings(&mut self, step: Duration, frame: Duration) {
+        self.frozen_timings = Some((step, frame));
+    }
+
+    /// What the workbench remembers between runs: the scene section, the solver settings and
+    /// the display options, as they are now.
+    pub fn preferences(&self) -> Preferences {
+        Preferences {
+            scene: self.controls.scene.clone(),
+            settings: *self.bench.simulation.settings(),
+            view: self.display.options,
         }
     }
 
@@ -280,7 +328,7 @@ impl TetlabApp {
     fn open_browser(&mut self) {
         #[cfg(not(target_arch = "wasm32"))]
         {
-            let last = std::path::Path::new(&self.preferences.scene.path);
+            let last = std::path::Path::new(&self.controls.scene.path);
             let folder = last
                 .parent()
                 .filter(|p| p.is_dir())
@@ -374,14 +422,26 @@ impl TetlabApp {
         }
     }
 
+    /// Carries out what a panel asked for.
+    pub fn apply(&mut self, request: Request) {
+        match request {
+            Request::Act(action) => self.act(action),
+            Request::Scene(request) => self.request(request),
+            Request::Lesson(request) => self.lesson_request(request),
+            Request::Compare(families) => self.compare(families),
+            Request::Settings(settings) => self.set_settings(*settings),
+            Request::Constraint(file) => self.define_constraint(*file),
+        }
+    }
+
     /// Does what a key or a button asks; actions on the simulation go to both halves of a
     /// comparison.
     pub fn act(&mut self, action: Action) {
         match action {
             Action::FrameView => self.viewport.frame(),
             Action::ResetCamera => self.viewport.reset_camera(),
-            Action::Inspector => self.show_inspector = !self.show_inspector,
-            Action::Help => self.show_help = !self.show_help,
+            Action::Inspector => self.inspector.open = !self.inspector.open,
+            Action::Help => self.help.open = !self.help.open,
             Action::Lesson => self.show_lesson = !self.show_lesson,
             Action::ConstraintEditor => {
                 self.editor.open = !self.editor.open;
@@ -459,7 +519,7 @@ impl TetlabApp {
             self.browser = None;
         }
         if let Some(path) = chosen {
-            self.preferences.scene.path = path.display().to_string();
+            self.controls.scene.path = path.display().to_string();
             self.opened(files::open_path(&path.to_string_lossy()));
         }
     }
@@ -500,7 +560,7 @@ impl TetlabApp {
 
     /// The 3D view, or two side by side when comparing, each titled with its families.
     fn views(&mut self, ui: &mut egui::Ui) {
-        let view = self.preferences.view;
+        let view = self.display.options;
         let Some(comparison) = &mut self.comparison else {
             self.viewport.show(ui, &mut self.bench, &self.cache, &view);
             return;
@@ -521,6 +581,26 @@ impl TetlabApp {
                 viewport.show(ui, bench, &self.cache, &view);
             }
         });
+    }
+}
+
+/// The top of the left panel: the name, the buttons that open what is not a side panel, and the
+/// last error.
+fn header(ui: &mut egui::Ui, error: Option<&str>, requests: &mut Vec<Request>) {
+    ui.horizontal(|ui| {
+        ui.heading("tetlab");
+        for (label, action) in [
+            ("Help (H)", Action::Help),
+            ("Lessons (L)", Action::Lesson),
+            ("Classroom (F5)", Action::Classroom),
+        ] {
+            if ui.button(label).clicked() {
+                requests.push(Request::Act(action));
+            }
+        }
+    });
+    if let Some(error) = error {
+        ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
     }
 }
 
@@ -559,27 +639,21 @@ impl eframe::App for TetlabApp {
         }
         self.advance(&ctx);
         self.show_divergence();
-        let mut actions = Vec::new();
-        let mut request = None;
-        let mut lesson_request = None;
-        let mut compare_request = None;
-        let mut settings_request = None;
-        let mut compiled = None;
-        let metrics = self.bench.metrics;
-        let comparison_metrics = self.comparison.as_ref().map(|c| c.bench.metrics);
+        let mut requests = Vec::new();
+        let context = Context {
+            bench: &self.bench,
+            comparison: self.comparison.as_ref().map(|c| &c.bench),
+            lesson: self.lesson.as_ref(),
+            step_time: self.frozen_timings.map_or(self.step_time, |t| t.0),
+            frame_time: self.frozen_timings.map_or(self.frame_time, |t| t.1),
+            classroom: self.classroom,
+        };
         if self.classroom {
             egui::Panel::right("classroom lesson")
                 .default_size(ui.available_width() * 0.36)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| {
-                        lesson_request = panels::lesson::show(
-                            ui,
-                            self.lesson.as_ref(),
-                            &mut self.lesson_path,
-                            true,
-                            &metrics,
-                            comparison_metrics.as_ref(),
-                        );
+                        self.lesson_panel.ui(ui, &context, &mut requests);
                         ui.add_space(12.0);
                         ui.label(
                             "Left/Right: steps   Enter: do it   Space: play   F5: leave classroom",
@@ -591,59 +665,31 @@ impl eframe::App for TetlabApp {
                 .default_size(300.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| {
-                        ui.horizontal(|ui| {
-                            ui.heading("tetlab");
-                            for (label, action) in [
-                                ("Help (H)", Action::Help),
-                                ("Lessons (L)", Action::Lesson),
-                                ("Classroom (F5)", Action::Classroom),
-                            ] {
-                                if ui.button(label).clicked() {
-                                    actions.push(action);
-                                }
+                        header(ui, self.error.as_deref(), &mut requests);
+                        let panels: [&mut dyn Panel; 4] = [
+                            &mut self.controls,
+                            &mut self.solver,
+                            &mut self.tools,
+                            &mut self.compare,
+                        ];
+                        for (k, panel) in panels.into_iter().enumerate() {
+                            if k > 0 {
+                                ui.separator();
                             }
-                        });
-                        if let Some(error) = &self.error {
-                            ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
+                            panel.ui(ui, &context, &mut requests);
                         }
-                        request = panels::controls::show(
-                            ui,
-                            &self.bench,
-                            &mut self.preferences.scene,
-                            &mut actions,
-                        );
-                        ui.separator();
-                        settings_request = panels::solver::show(
-                            ui,
-                            self.bench.simulation.settings(),
-                            &mut actions,
-                        );
-                        ui.separator();
-                        panels::tools::show(ui, &self.bench, &mut actions);
-                        ui.separator();
-                        compare_request = panels::compare::show(
-                            ui,
-                            &mut self.compare_families,
-                            self.comparison.is_some(),
-                        );
                     });
                 });
             egui::Panel::right("readouts")
                 .default_size(300.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| {
-                        panels::readouts::show(ui, &self.bench, self.step_time, self.frame_time);
+                        self.readouts.ui(ui, &context, &mut requests);
                         ui.separator();
-                        if let Some(action) = panels::display::show(
-                            ui,
-                            &mut self.preferences.view,
-                            self.bench.simulation.tets().len(),
-                        ) {
-                            actions.push(action);
-                        }
+                        self.display.ui(ui, &context, &mut requests);
                     });
                 });
-            compiled = self.editor.show(ui);
+            self.editor.ui(ui, &context, &mut requests);
             if self.show_lesson {
                 egui::Panel::bottom("lesson")
                     .resizable(true)
@@ -656,47 +702,22 @@ impl eframe::App for TetlabApp {
                                 ui.horizontal(|ui| {
                                     ui.heading("Lesson");
                                     if ui.button("Close (L)").clicked() {
-                                        actions.push(Action::Lesson);
+                                        requests.push(Request::Act(Action::Lesson));
                                     }
                                 });
-                                lesson_request = panels::lesson::show(
-                                    ui,
-                                    self.lesson.as_ref(),
-                                    &mut self.lesson_path,
-                                    false,
-                                    &metrics,
-                                    comparison_metrics.as_ref(),
-                                );
+                                self.lesson_panel.ui(ui, &context, &mut requests);
                             });
                     });
             }
+            self.inspector.ui(ui, &context, &mut requests);
         }
+        self.help.ui(ui, &context, &mut requests);
         egui::CentralPanel::default_margins().show(ui, |ui| self.views(ui));
-        panels::help::show(&ctx, &mut self.show_help);
         #[cfg(not(target_arch = "wasm32"))]
         self.show_browser(&ctx);
-        if !self.classroom {
-            panels::inspector::show(&ctx, &mut self.show_inspector, &self.bench);
+        for request in requests {
+            self.apply(request);
         }
-        for action in actions {
-            self.act(action);
-        }
-        if let Some(request) = request {
-            self.request(request);
-        }
-        if let Some(request) = lesson_request {
-            self.lesson_request(request);
-        }
-        if let Some(settings) = settings_request {
-            self.set_settings(settings);
-        }
-        if let Some(families) = compare_request {
-            self.compare(families);
-        }
-        if let Some(file) = compiled {
-            self.define_constraint(file);
-        }
-        self.preferences.settings = *self.bench.simulation.settings();
         self.frames_drawn += 1;
         // The first frame is painted before the second runs: ask for a second, and announce then.
         #[cfg(target_arch = "wasm32")]
@@ -714,7 +735,7 @@ impl eframe::App for TetlabApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, STORAGE_KEY, &self.preferences);
+        eframe::set_value(storage, STORAGE_KEY, &self.preferences());
     }
 }
 

@@ -1,12 +1,38 @@
 //! Side-by-side comparison: the same scene with a second set of constraint families.
 
+use super::{Context, Panel};
+use crate::gui::request::Request;
 use eframe::egui;
 use tetlab_core::constraints::Family;
 use tetlab_core::constraints::PerFamily;
 
-/// Shows the comparison controls; returns the families to compare with when "Compare" is
-/// pressed, or `Some(None)` when "Stop comparing" is.
-pub fn show(
+/// The comparison panel; it owns the families the second view will run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ComparePanel {
+    /// The families to compare with.
+    pub families: PerFamily<bool>,
+}
+
+impl Default for ComparePanel {
+    /// The geometric families: the material ones are another model, added by choice.
+    fn default() -> Self {
+        ComparePanel {
+            families: PerFamily::from_fn(|f| f.row().compliance_from_material.is_none()),
+        }
+    }
+}
+
+impl Panel for ComparePanel {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        if let Some(request) = show(ui, &mut self.families, context.comparison.is_some()) {
+            requests.push(Request::Compare(request));
+        }
+    }
+}
+
+/// The comparison controls; the families to compare with when "Compare" is pressed, or
+/// `Some(None)` when "Stop comparing" is.
+fn show(
     ui: &mut egui::Ui,
     families: &mut PerFamily<bool>,
     comparing: bool,

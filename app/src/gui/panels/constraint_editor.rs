@@ -4,6 +4,8 @@
 //! not, the mistake is shown at its line and column, and the last good definition stays.
 //! "Check my gradient" runs the check of `tetlab check-gradients --constraint-file` on it.
 
+use super::{Context, Panel};
+use crate::gui::request::Request;
 use eframe::egui;
 use std::path::{Path, PathBuf};
 use tetlab_core::constraint_file::check::{self, Report};
@@ -76,7 +78,7 @@ impl ConstraintEditor {
     /// typing) while it is open: the text on the left, what it defines and the gradient check on
     /// the right. Returns a newly compiled file when the text changed and compiles (the app
     /// defines its family).
-    pub fn show(&mut self, ui: &mut egui::Ui) -> Option<ConstraintFile> {
+    fn show(&mut self, ui: &mut egui::Ui) -> Option<ConstraintFile> {
         if !self.open {
             return None;
         }
@@ -255,6 +257,15 @@ impl ConstraintEditor {
                 egui::Color32::from_rgb(220, 60, 60)
             };
             ui.colored_label(colour, text);
+        }
+    }
+}
+
+impl Panel for ConstraintEditor {
+    /// Below the 3D view while it is open; a text that compiled is asked to be defined.
+    fn ui(&mut self, ui: &mut egui::Ui, _: &Context<'_>, requests: &mut Vec<Request>) {
+        if let Some(file) = self.show(ui) {
+            requests.push(Request::Constraint(Box::new(file)));
         }
     }
 }

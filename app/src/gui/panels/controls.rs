@@ -1,5 +1,7 @@
-//! Playback and the scene.
+//! Playback, step-by-step mode and the scene.
 
+use super::{Context, Panel};
+use crate::gui::request::Request;
 use crate::gui::shortcuts::Action;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
@@ -37,15 +39,22 @@ impl Default for SceneChoice {
     }
 }
 
+/// The playback and scene panel; it owns the scene section's choices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Controls {
+    /// The built-in scene, its resolution and the typed mesh path.
+    pub scene: SceneChoice,
+}
+
 /// The step-by-step buttons and where the substep stands.
-fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>) {
+fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, requests: &mut Vec<Request>) {
     ui.horizontal(|ui| {
         if ui
             .button("Next projection")
             .on_hover_text("J: one constraint at a time")
             .clicked()
         {
-            actions.push(Action::StepProjection);
+            requests.push(Request::Act(Action::StepProjection));
         }
         if ui
             .add_enabled(
@@ -55,7 +64,7 @@ fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>)
             .on_hover_text("K")
             .clicked()
         {
-            actions.push(Action::FinishSubstep);
+            requests.push(Request::Act(Action::FinishSubstep));
         }
     });
     let Some(stepper) = bench.stepping else {
@@ -107,86 +116,84 @@ fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>)
     }
 }
 
-/// Shows playback and solver controls; playback buttons add to `actions`. Returns a scene to
-/// load, if the user asked for one.
-pub fn show(
-    ui: &mut egui::Ui,
-    bench: &Workbench,
-    choice: &mut SceneChoice,
-    actions: &mut Vec<Action>,
-) -> Option<SceneRequest> {
-    ui.heading("Playback");
-    ui.horizontal(|ui| {
-        let label = if bench.playing { "Pause" } else { "Play" };
-        for (label, key, action) in [
-            (label, "Space", Action::PlayPause),
-            ("Step frame", "N", Action::StepFrame),
-            ("Step substep", "U", Action::StepSubstep),
-        ] {
-            if ui.button(label).on_hover_text(key).clicked() {
-                actions.push(action);
-            }
-        }
-    });
-    step_by_step(ui, bench, actions);
-
-    ui.separator();
-    ui.heading("Scene");
-    let mut request = None;
-    ui.horizontal(|ui| {
-        egui::ComboBox::from_label("built-in")
-            .selected_text(choice.builtin.clone())
-            .show_ui(ui, |ui| {
-                for builtin in Builtin::ALL {
-                    ui.selectable_value(
-                        &mut choice.builtin,
-                        builtin.name().to_owned(),
-                        builtin.name(),
-                    );
-                }
-            });
-    });
-    ui.add(egui::Slider::new(&mut choice.resolution, 1..=12).text("resolution"));
-    if ui.button("Load built-in scene").clicked() {
-        let builtin = Builtin::from_name(&choice.builtin).unwrap_or(Builtin::Cube);
-        request = Some(SceneRequest::Builtin(builtin, choice.resolution));
-    }
-    if cfg!(target_arch = "wasm32") {
-        // A page cannot open files by path: meshes and lessons are dropped on it.
-        ui.label("drop a .msh mesh or a lesson .toml on the page to open it");
-    } else {
+impl Panel for Controls {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        let bench = context.bench;
+        let choice = &mut self.scene;
+        ui.heading("Playback");
         ui.horizontal(|ui| {
-            ui.add(
-                egui::TextEdit::singleline(&mut choice.path)
-                    .hint_text(".msh, .node or .ele path")
-                    .desired_width(170.0),
-            )
-            .labelled_by(ui.label("mesh file").id);
-            if ui
-                .add_enabled(!choice.path.trim().is_empty(), egui::Button::new("Open"))
-                .clicked()
-            {
-                request = Some(SceneRequest::File(choice.path.trim().to_owned()));
+            let label = if bench.playing { "Pause" } else { "Play" };
+            for (label, key, action) in [
+                (label, "Space", Action::PlayPause),
+                ("Step frame", "N", Action::StepFrame),
+                ("Step substep", "U", Action::StepSubstep),
+            ] {
+                if ui.button(label).on_hover_text(key).clicked() {
+                    requests.push(Request::Act(action));
+                }
             }
         });
-    }
-    if !cfg!(target_arch = "wasm32")
-        && ui
-            .button("Open mesh file...")
-            .on_hover_text("O: browse for a .node, .ele, .msh or lesson file")
-            .clicked()
-    {
-        actions.push(Action::OpenFile);
-    }
-    ui.label(format!(
-        "{}: {} particles, {} tets",
-        bench.scene.name,
-        bench.simulation.positions().len(),
-        bench.simulation.tets().len()
-    ));
-    for note in &bench.scene.notes {
-        ui.small(note);
-    }
+        step_by_step(ui, bench, requests);
 
-    request
+        ui.separator();
+        ui.heading("Scene");
+        ui.horizontal(|ui| {
+            egui::ComboBox::from_label("built-in")
+                .selected_text(choice.builtin.clone())
+                .show_ui(ui, |ui| {
+                    for builtin in Builtin::ALL {
+                        ui.selectable_value(
+                            &mut choice.builtin,
+                            builtin.name().to_owned(),
+                            builtin.name(),
+                        );
+                    }
+                });
+        });
+        ui.add(egui::Slider::new(&mut choice.resolution, 1..=12).text("resolution"));
+        if ui.button("Load built-in scene").clicked() {
+            let builtin = Builtin::from_name(&choice.builtin).unwrap_or(Builtin::Cube);
+            requests.push(Request::Scene(SceneRequest::Builtin(
+                builtin,
+                choice.resolution,
+            )));
+        }
+        if cfg!(target_arch = "wasm32") {
+            // A page cannot open files by path: meshes and lessons are dropped on it.
+            ui.label("drop a .msh mesh, a lesson or a constraint .toml on the page to open it");
+        } else {
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::TextEdit::singleline(&mut choice.path)
+                        .hint_text(".msh, .node or .ele path")
+                        .desired_width(170.0),
+                )
+                .labelled_by(ui.label("mesh file").id);
+                if ui
+                    .add_enabled(!choice.path.trim().is_empty(), egui::Button::new("Open"))
+                    .clicked()
+                {
+                    let path = choice.path.trim().to_owned();
+                    requests.push(Request::Scene(SceneRequest::File(path)));
+                }
+            });
+        }
+        if !cfg!(target_arch = "wasm32")
+            && ui
+                .button("Open mesh file...")
+                .on_hover_text("O: browse for a .node, .ele, .msh, lesson or constraint file")
+                .clicked()
+        {
+            requests.push(Request::Act(Action::OpenFile));
+        }
+        ui.label(format!(
+            "{}: {} particles, {} tets",
+            bench.scene.name,
+            bench.simulation.positions().len(),
+            bench.simulation.tets().len()
+        ));
+        for note in &bench.scene.notes {
+            ui.small(note);
+        }
+    }
 }

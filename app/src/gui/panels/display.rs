@@ -1,11 +1,29 @@
 //! What the 3D view shows.
 
+use super::{Context, Panel};
 use crate::gui::geometry::{ARROWS_ON_ALL_UP_TO, ViewOptions};
+use crate::gui::request::Request;
 use crate::gui::shortcuts::Action;
 use eframe::egui;
 
-/// Shows the display options; returns the camera action asked for, if any.
-pub fn show(ui: &mut egui::Ui, options: &mut ViewOptions, tets: usize) -> Option<Action> {
+/// The display panel; it owns the options the 3D views draw with.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DisplayPanel {
+    /// What the views draw.
+    pub options: ViewOptions,
+}
+
+impl Panel for DisplayPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        let tets = context.bench.simulation.tets().len();
+        if let Some(action) = show(ui, &mut self.options, tets) {
+            requests.push(Request::Act(action));
+        }
+    }
+}
+
+/// The display options; the camera action asked for, if any.
+fn show(ui: &mut egui::Ui, options: &mut ViewOptions, tets: usize) -> Option<Action> {
     ui.heading("Display");
     ui.checkbox(&mut options.see_through, "See-through (all faces)");
     ui.checkbox(&mut options.colour_by_volume, "Colour by V/V0");

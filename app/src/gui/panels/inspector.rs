@@ -2,6 +2,8 @@
 //! projected) every active constraint's numbers as the solver sees them, its gradient checked
 //! against central differences, and its formula.
 
+use super::{Context, Panel};
+use crate::gui::request::Request;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
 use glam::DVec3;
@@ -9,8 +11,21 @@ use tetlab_core::constraints::Family;
 use tetlab_core::inspector::{Inspection, inspect, inspect_tet, state_lines};
 use tetlab_core::solver::{Method, Simulation};
 
+/// The inspector window.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Inspector {
+    /// Whether it is shown.
+    pub open: bool,
+}
+
+impl Panel for Inspector {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, _: &mut Vec<Request>) {
+        show(ui.ctx(), &mut self.open, context.bench);
+    }
+}
+
 /// Shows the inspector as a window while `open` is true.
-pub fn show(ctx: &egui::Context, open: &mut bool, bench: &Workbench) {
+fn show(ctx: &egui::Context, open: &mut bool, bench: &Workbench) {
     egui::Window::new("Inspector")
         .open(open)
         .default_pos([320.0, 60.0])

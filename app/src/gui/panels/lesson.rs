@@ -2,6 +2,8 @@
 //! metrics) and the buttons to do it and move on. The same contents serve the lesson window and
 //! classroom mode (larger).
 
+use super::{Context, Panel};
+use crate::gui::request::Request;
 use eframe::egui;
 use tetlab_core::lesson::{BUILTIN, Lesson, Step};
 use tetlab_core::metrics::Metrics;
@@ -38,9 +40,32 @@ pub enum LessonRequest {
     Previous,
 }
 
+/// The lesson panel: a picker, and the current step of the lesson in progress. It owns the
+/// typed path of a lesson file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LessonPanel {
+    /// The path typed in the "lesson file" field.
+    pub path: String,
+}
+
+impl Panel for LessonPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        let comparison = context.comparison.map(|c| c.metrics);
+        let request = show(
+            ui,
+            context.lesson,
+            &mut self.path,
+            context.classroom,
+            &context.bench.metrics,
+            comparison.as_ref(),
+        );
+        requests.extend(request.map(Request::Lesson));
+    }
+}
+
 /// Shows the lesson picker and, when a lesson is open, its current step. `large` is classroom
 /// mode. `metrics` and `comparison` are the current metrics of the two simulations.
-pub fn show(
+fn show(
     ui: &mut egui::Ui,
     state: Option<&LessonState>,
     path: &mut String,

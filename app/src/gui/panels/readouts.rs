@@ -1,13 +1,24 @@
 //! Live numbers and their plots over time.
 
-use crate::gui::workbench::{Sample, Workbench};
+use super::{Context, Panel};
+use crate::gui::request::Request;
+use crate::gui::workbench::Sample;
 use eframe::egui;
 use egui_plot::{Legend, Line, Plot, PlotPoints};
-use std::time::Duration;
 
-/// Shows the metrics of the current frame and plots of the recent ones; `step_time` is the last
-/// simulation step's, `frame_time` the time between the last two frames drawn.
-pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration, frame_time: Duration) {
+/// The readouts: the metrics of the current frame, the engine and timings, and plots of the
+/// recent frames.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Readouts;
+
+impl Panel for Readouts {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, _: &mut Vec<Request>) {
+        show(ui, context);
+    }
+}
+
+fn show(ui: &mut egui::Ui, context: &Context<'_>) {
+    let (bench, step_time, frame_time) = (context.bench, context.step_time, context.frame_time);
     let m = &bench.metrics;
     if let Some(warning) = &bench.stability_warning {
         ui.colored_label(egui::Color32::from_rgb(230, 160, 40), warning);
@@ -46,7 +57,7 @@ pub fn show(ui: &mut egui::Ui, bench: &Workbench, step_time: Duration, frame_tim
                 "frame time",
                 if bench.playing {
                     format!(
-                        "{:.1} ms ({:.0} frames per second)",
+                        "{:.1} ms, {:.0} fps",
                         frame_time.as_secs_f64() * 1e3,
                         1.0 / frame_time.as_secs_f64().max(1e-6)
                     )

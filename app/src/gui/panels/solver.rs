@@ -1,25 +1,41 @@
 //! The solver settings: method, families with their compliance or stiffness, substeps and the
 //! rest. The panel edits a copy; the app applies a change to every simulation shown.
 
+use super::{Context, Panel};
+use crate::gui::request::Request;
 use crate::gui::shortcuts::Action;
 use eframe::egui;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::material::{MAX_POISSON, YOUNG};
 use tetlab_core::solver::{Engine, FAST_FROM_TETS, Method, Settings};
 
-/// Shows `current`; returns the settings the user changed them to, if they did. "Write a
-/// constraint" asks for the constraint editor, whose family joins the list.
-pub fn show(ui: &mut egui::Ui, current: &Settings, actions: &mut Vec<Action>) -> Option<Settings> {
-    ui.horizontal(|ui| {
-        ui.heading("Solver");
-        if ui
-            .button("Write a constraint (G)")
-            .on_hover_text("The constraint editor: C as an expression, checked and simulated")
-            .clicked()
-        {
-            actions.push(Action::ConstraintEditor);
+/// The solver panel: it edits a copy of the simulation's settings and asks for the copy when
+/// the user changed it. "Write a constraint" asks for the constraint editor, whose family joins
+/// the list.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolverPanel;
+
+impl Panel for SolverPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        let current = context.bench.simulation.settings();
+        ui.horizontal(|ui| {
+            ui.heading("Solver");
+            if ui
+                .button("Write a constraint (G)")
+                .on_hover_text("The constraint editor: C as an expression, checked and simulated")
+                .clicked()
+            {
+                requests.push(Request::Act(Action::ConstraintEditor));
+            }
+        });
+        if let Some(settings) = edit(ui, current) {
+            requests.push(Request::Settings(Box::new(settings)));
         }
-    });
+    }
+}
+
+/// The settings' widgets, on a copy of `current`; the copy when the user changed it.
+fn edit(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
     let mut settings = *current;
     ui.horizontal(|ui| {
         ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");

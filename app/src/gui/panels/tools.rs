@@ -1,12 +1,26 @@
 //! Tools that deform the body or change the selection. Each adds an [`Action`]; the app does it
 //! (to both simulations when two are compared).
 
+use super::{Context, Panel};
+use crate::gui::request::Request;
 use crate::gui::shortcuts::Action;
-use crate::gui::workbench::Workbench;
 use eframe::egui;
 
-/// Shows the tools.
-pub fn show(ui: &mut egui::Ui, bench: &Workbench, actions: &mut Vec<Action>) {
+/// The tools panel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Tools;
+
+impl Panel for Tools {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        let mut actions = Vec::new();
+        show(ui, context, &mut actions);
+        requests.extend(actions.into_iter().map(Request::Act));
+    }
+}
+
+/// The tools' buttons; what they ask for goes to `actions`.
+fn show(ui: &mut egui::Ui, context: &Context<'_>, actions: &mut Vec<Action>) {
+    let bench = context.bench;
     ui.heading("Tools");
     ui.horizontal_wrapped(|ui| {
         let has_selection = bench.selected_tet.is_some() && bench.selected_particle.is_some();
