@@ -9,7 +9,7 @@ cargo build --release --quiet
 tetlab=target/release/tetlab
 bunny=../shared/meshes/bunny.node
 
-echo "| scene | tets | constraints | solver, threads | projections per frame | ms per frame | frames per second | ns per projection (edges / height / volume) | bytes per tet | error at the end (edges / height / volume) | command |"
+echo "| scene | tets | constraints | engine, threads | projections per frame | ms per frame | frames per second | ns per projection (by family) | bytes per tet | error at the end (by family) | command |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 
 row() {
@@ -20,12 +20,12 @@ args = sys.argv[1]
 runs = [json.loads(line) for line in sys.stdin]
 r = min(runs, key=lambda r: r["ms_per_frame"])
 f = r["ns_per_projection_by_family"]
-families = "—" if f is None else " / ".join(
-    "—" if f[k] == 0 else "%.1f" % f[k] for k in ("edges", "height", "volume"))
+families = "" if f is None else " (" + ", ".join(
+    "%s %.1f" % (k, v) for k, v in f.items() if v > 0) + ")"
 e = r.get("relative_error")
-errors = "—" if e is None else " / ".join(
-    "—" if e[k] is None else "%.1e" % e[k] for k in ("edges", "height", "volume"))
-print("| %s | %d | %s | %s, %d | %d | %.3f | %.1f | %.1f (%s) | %.0f | %s | `tetlab bench %s` |" % (
+errors = "—" if e is None else ", ".join(
+    "%s %.1e" % (k, v) for k, v in e.items() if v is not None)
+print("| %s | %d | %s | %s, %d | %d | %.3f | %.1f | %.1f%s | %.0f | %s | `tetlab bench %s` |" % (
     r["scene"], r["tets"], r["constraints"], r["solver"], r["threads"],
     r["projections_per_frame"], r["ms_per_frame"], r["frames_per_second"],
     r["ns_per_projection"], families, r["bytes_per_tet"], errors, args))
@@ -33,7 +33,7 @@ print("| %s | %d | %s | %s, %d | %d | %.3f | %.1f | %.1f (%s) | %.0f | %s | `tet
 }
 
 row --scene $bunny --frames 1000 --substeps 10
-row --scene $bunny --frames 300 --reference --substeps 10
+row --scene $bunny --frames 300 --engine reference --substeps 10
 row --scene $bunny --frames 300 --constraints edges,height,volume --substeps 10
 row --scene $bunny --frames 1000 --jacobi --substeps 10
 row --scene cube --resolution 6 --frames 500 --substeps 10
@@ -44,3 +44,9 @@ row --scene cube --resolution 26 --frames 10 --constraints edges,height,volume -
 row --scene cube --resolution 26 --frames 40 --jacobi --substeps 10
 row --scene cube --resolution 55 --frames 5 --warmup 1 --substeps 10
 row --scene cube --resolution 55 --frames 5 --warmup 1 --threads 2 --substeps 10
+row --scene cube --resolution 55 --frames 5 --warmup 1 --constraints edges,height,volume --substeps 10
+row --scene $bunny --frames 300 --constraints edges,neohookean --substeps 10
+row --scene $bunny --frames 300 --constraints height --substeps 10
+row --scene $bunny --frames 300 --constraints none --constraint-file assets/constraints/height.toml --substeps 10
+row --scene $bunny --frames 100 --engine reference --constraints height --substeps 10
+row --scene $bunny --frames 100 --engine reference --constraints none --constraint-file assets/constraints/height.toml --substeps 10

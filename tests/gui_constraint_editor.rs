@@ -28,7 +28,7 @@ fn register_examples() {
                 .iter()
                 .find(|e| e.file == name)
                 .unwrap();
-            let file = ConstraintFile::parse(Path::new(example.path), example.text).unwrap();
+            let file = ConstraintFile::parse(&example.shown(), example.text).unwrap();
             Family::register(file).unwrap();
         }
     });

@@ -1,13 +1,14 @@
 //! The projection kernels alone: one constraint evaluated and its correction computed, in f32 (the
 //! fast solver), f64 (the reference) and eight at once in f32 SIMD lanes (the fast solver's main
 //! loop), for each family; a height constraint read from a file (assets/constraints/height.toml)
-//! against the built-in one; and one whole frame of the fast solver. `cargo bench -p tetlab-core`.
+//! against the built-in one; and one whole frame of the fast solver beside the same frame's
+//! arithmetic alone (its kernels on particles already in registers). `cargo bench -p tetlab-core`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3A};
 use std::hint::black_box;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraints::PerFamily;
+use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::constraints::{distance, height, volume};
 use tetlab_core::fast::{FastSimulation, Order};
 use tetlab_core::lanes::{F32x8, LANES, Vec3x8};
@@ -154,6 +155,48 @@ fn frame(c: &mut Criterion) {
         fast.set_order(order);
         group.bench_function(format!("{name}, fast, {label}"), |b| b.iter(|| fast.step()));
     }
+    // The same frame's arithmetic alone: the same kernels, as many times as the Gauss–Seidel
+    // frame runs them (every batch of eight of each family, padding included, every substep),
+    // on particles already in registers. The frame's time over this one is what moving the
+    // particles (gathering, transposing, writing back) and the rest of the frame cost on top.
+    let fast = FastSimulation::new(&simulation, 1);
+    let batches = |family| -> usize {
+        let batches = fast.batches(family);
+        batches.colours().iter().map(|c| c.batches.len()).sum()
+    };
+    let (edge_batches, tet_batches) = (batches(Family::EDGES), batches(Family::VOLUME));
+    let substeps = settings.substeps;
+    let tet = [
+        Vec3A::new(0.0, 0.0, 0.0),
+        Vec3A::new(1.0, 0.1, 0.0),
+        Vec3A::new(0.2, 1.0, 0.1),
+        Vec3A::new(0.1, 0.2, 0.9),
+    ]
+    .map(|p| Vec3x8::gather([p; LANES]));
+    let edge = [tet[0], tet[1]];
+    let w = F32x8::new([0.7; LANES]);
+    group.bench_function(format!("{name}, arithmetic alone"), |b| {
+        b.iter(|| {
+            for _ in 0..substeps {
+                for _ in 0..edge_batches {
+                    black_box(project_kernel(
+                        distance::evaluate::<Vec3x8>,
+                        black_box(&edge),
+                        F32x8::new([0.9; LANES]),
+                        [w; 2],
+                    ));
+                }
+                for _ in 0..tet_batches {
+                    black_box(project_kernel(
+                        volume::evaluate::<Vec3x8>,
+                        black_box(&tet),
+                        F32x8::new([0.2; LANES]),
+                        [w; 4],
+                    ));
+                }
+            }
+        })
+    });
     group.finish();
 }
 

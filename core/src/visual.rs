@@ -406,6 +406,55 @@ pub fn correction_arrows(
     }
 }
 
+/// Whose arrows are shown: no tet's, one tet's (the selected one), or every tet's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArrowSelection {
+    /// No arrows.
+    None,
+    /// The arrows of one tet: ∇C of each active family's constraints on it, Δp at its corners.
+    Tet(usize),
+    /// The arrows of every tet, and Δp at every particle.
+    AllTets,
+}
+
+/// The arrows of `selection`, as the workbench draws them and the recorder logs them: the
+/// gradient arrows of every active family ([`tet_gradient_arrows`], scaled by
+/// `gradient_gain`; none when it is `None`), then Δp of the last substep at the particles
+/// ([`correction_arrows`], `correction_gain` times its length; none when it is `None`).
+/// Appends to `out`.
+pub fn selected_arrows(
+    simulation: &Simulation,
+    selection: ArrowSelection,
+    gradient_gain: Option<f64>,
+    correction_gain: Option<f64>,
+    out: &mut Vec<Arrow>,
+) {
+    let tets = match selection {
+        ArrowSelection::None => return,
+        ArrowSelection::Tet(tet) => tet..tet + 1,
+        ArrowSelection::AllTets => 0..simulation.tets().len(),
+    };
+    if let Some(gain) = gradient_gain {
+        let active = simulation.settings().active;
+        for family in active.families() {
+            for tet in tets.clone() {
+                tet_gradient_arrows(simulation, tet, family, gain, out);
+            }
+        }
+    }
+    if let Some(gain) = correction_gain {
+        match selection {
+            ArrowSelection::Tet(tet) => {
+                correction_arrows(simulation, simulation.tets()[tet], gain, out);
+            }
+            _ => {
+                let particles = 0..simulation.positions().len() as u32;
+                correction_arrows(simulation, particles, gain, out);
+            }
+        }
+    }
+}
+
 /// The box around `positions`: lowest and highest corner.
 pub fn bounds(positions: &[DVec3]) -> (DVec3, DVec3) {
     positions.iter().fold(

@@ -44,6 +44,11 @@ pub struct Args {
     /// ω for --jacobi (0 < ω ≤ 2).
     #[arg(long, default_value_t = 1.0, requires = "jacobi", value_parser = relaxation)]
     relaxation: f32,
+    /// Time a frame of the workbench instead, on the CPU and without a window: the simulation's
+    /// step and metrics, what the 3D view draws, and the upload (rasterising is not counted), on
+    /// the engine and threads the workbench would use (--engine and --threads change them).
+    #[arg(long, conflicts_with_all = ["jacobi", "reference"])]
+    workbench: bool,
     /// End with one JSON object.
     #[arg(long)]
     json: bool,
@@ -111,6 +116,21 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let scene = Scene::from_spec(&args.scene, args.resolution)
         .map_err(|e| UsageError(format!("--scene: {e}")))?;
     let mut settings = args.solver.settings()?;
+    if args.workbench {
+        // The workbench's own settings: edits settle; the engine and threads as it picks them.
+        settings.settle_edits = true;
+        let threads = args
+            .solver
+            .threads
+            .map_or_else(crate::gui::workbench::threads, |t| t as usize);
+        let tets = scene.mesh.tets.len();
+        let name = scene.name.clone();
+        let engine = settings.engine.resolve(tets).name();
+        let cost =
+            super::workbench_frame::measure(scene, settings, threads, args.frames, args.warmup)?;
+        return super::workbench_frame::write(out, &name, tets, engine, &cost, args.json)
+            .map_err(UsageError::stdout);
+    }
     settings.engine = match (args.reference, args.solver.engine) {
         (true, _) => Engine::Reference,
         (false, Some(engine)) => engine.resolve(scene.mesh.tets.len()),
@@ -182,7 +202,7 @@ fn time_fast(
         }
     };
     let by_family = PerFamily::from_fn(|f| if active[f] { per(f) } else { 0.0 });
-    let colours = PerFamily::from_fn(|f| fast.batches(f).colours.len());
+    let colours = PerFamily::from_fn(|f| fast.batches(f).colours().len());
     let solver = if args.jacobi {
         "fast (f32), Jacobi"
     } else {

@@ -15,6 +15,7 @@ mod lesson;
 mod record;
 mod run;
 mod simulation_args;
+mod workbench_frame;
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -96,7 +97,7 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run(&args, &mut stdout),
         Command::Bench(args) => bench::run(&args, &mut stdout),
         #[cfg(not(target_arch = "wasm32"))]
-        Command::Record(args) => record::run(&args, &mut stdout).map(|ending| {
+        Command::Record(args) => record::main(&args, &mut stdout).map(|ending| {
             if let crate::record::Ending::Interrupted = ending {
                 success = ExitCode::from(crate::record::INTERRUPTED);
             }

@@ -1,5 +1,6 @@
 //! `tetlab record`: the run of `tetlab run`, logged to a Rerun recording. This file is set-up
-//! plus [`run`]; what is logged and how the file is written safely are in [`crate::record`].
+//! ([`main`]) plus the run ([`run`], as Rerun's own examples are written); what is logged and how
+//! the file is written safely are in [`crate::record`].
 
 use super::UsageError;
 use super::simulation_args::SimulationArgs;
@@ -47,8 +48,9 @@ pub struct Args {
     quiet: bool,
 }
 
-/// Records the run and writes or streams it. Returns how it ended.
-pub fn run(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
+/// Sets up (the simulation, the recording and its layout), records with [`run`], and writes or
+/// streams the recording. Returns how it ended.
+pub fn main(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
     let (scene, mut simulation) = args.simulation.build()?;
     let tets = simulation.tets().len() as i64;
     if !(0..tets).contains(&args.tet) {
@@ -70,20 +72,34 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
     let rec = session.rec();
     send_layout(rec, &[""]);
     describe(rec, &scene, &simulation, args);
-    let mut recorder = Recorder::new(rec, "", &scene, &simulation, args.arrows, args.tet as usize);
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
-    recorder.log_frame(&simulation, &initial);
+    match run(rec, &session, &scene, &mut simulation, &initial, args) {
+        Ok(()) => session.close(simulation.frame(), out),
+        Err(diverged) => Err(session.close_after(simulation.frame() - 1, diverged)),
+    }
+}
+
+/// The run itself: the simulation logged frame by frame to `rec`, until `--frames` or Ctrl-C;
+/// an error when it diverged (the frames before it are logged).
+fn run(
+    rec: &RecordingStream,
+    session: &Session,
+    scene: &Scene,
+    simulation: &mut Simulation,
+    initial: &Metrics,
+    args: &Args,
+) -> Result<(), UsageError> {
+    let mut recorder = Recorder::new(rec, "", scene, simulation, args.arrows, args.tet as usize);
+    recorder.log_frame(simulation, initial);
     for _ in 0..args.simulation.frames {
         if session.interrupted() {
             break;
         }
-        match SimulationArgs::step(&mut simulation) {
-            Ok(metrics) => recorder.log_frame(&simulation, &metrics),
-            Err(diverged) => return Err(session.close_after(simulation.frame() - 1, diverged)),
-        }
+        let metrics = SimulationArgs::step(simulation)?;
+        recorder.log_frame(simulation, &metrics);
         session.advance();
     }
-    session.close(simulation.frame(), out)
+    Ok(())
 }
 
 /// The static description of a run: scene, sizes, perturbation, settings, arrows.

@@ -1,5 +1,8 @@
-//! What the 3D view draws, as triangles and lines: built each frame from the workbench, with the
-//! colours and arrows of `tetlab_core::visual` (the same the recorder logs).
+//! What the 3D view draws, as triangles and lines, with the colours and arrows of
+//! `tetlab_core::visual` (the same the recorder logs). The view keeps them between frames
+//! ([`ViewGeometry`]) and brings them up to date only when something it shows changed: a frame
+//! played, an edit, the selection, the pointer, the options. A paused view builds and uploads
+//! nothing.
 
 use super::render::{Geometry, Vertex};
 use super::workbench::Workbench;
@@ -49,6 +52,29 @@ impl Default for ViewOptions {
     }
 }
 
+/// Above this many tets a scene is shown as a body: particle handles and arrows start off
+/// (the armadillo's 1180 handles, each an octahedron, hide its surface; the bunny's 333 do not).
+pub const BIG_MESH_TETS: usize = 2000;
+
+impl ViewOptions {
+    /// The default options for a scene of `tets` tets: [`ViewOptions::default`], with particle
+    /// handles and every arrow off above [`BIG_MESH_TETS`].
+    pub fn for_size(tets: usize) -> Self {
+        let mut options = ViewOptions::default();
+        options.fit_size(tets);
+        options
+    }
+
+    /// Turns particle handles and arrows on for a scene of `tets` tets, or off above
+    /// [`BIG_MESH_TETS`]; the other options stay as they are.
+    pub fn fit_size(&mut self, tets: usize) {
+        let small = tets <= BIG_MESH_TETS;
+        self.particles = small;
+        self.arrows = small;
+        self.corrections = small;
+    }
+}
+
 /// Meshes with at most this many tets may show arrows on every tet.
 pub const ARROWS_ON_ALL_UP_TO: usize = 64;
 
@@ -89,19 +115,138 @@ impl SceneCache {
     }
 }
 
-/// Builds everything the view draws this frame.
+/// What the view draws, kept between frames: the vertices, and what they were built from, so
+/// that they are built again (and uploaded again) only when that changes.
+pub struct ViewGeometry {
+    geometry: Geometry,
+    built_from: Option<Key>,
+    /// Which view geometry this is, among all made (the renderer keeps what it uploaded per
+    /// view, and a view may be given another geometry).
+    id: u64,
+    generation: u64,
+    scratch: Scratch,
+}
+
+impl Default for ViewGeometry {
+    fn default() -> Self {
+        static MADE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        ViewGeometry {
+            geometry: Geometry::default(),
+            built_from: None,
+            id: MADE.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            generation: 0,
+            scratch: Scratch::default(),
+        }
+    }
+}
+
+/// Buffers reused from frame to frame.
+#[derive(Default)]
+struct Scratch {
+    inverted: Vec<bool>,
+    colours: Vec<Rgba>,
+    arrows: Vec<Arrow>,
+}
+
+/// Everything the geometry is built from, but the positions (whose change a new revision of the
+/// workbench says).
+#[derive(Clone, Copy, PartialEq)]
+struct Key {
+    revision: u64,
+    selected_tet: Option<usize>,
+    selected_particle: Option<usize>,
+    dragging: Option<usize>,
+    hovered: Option<usize>,
+    options: ViewOptions,
+    stepping: bool,
+}
+
+impl ViewGeometry {
+    /// The vertices.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// This geometry and its version: the version grows by one whenever the vertices are built
+    /// again. What the renderer compares to know whether to upload.
+    pub fn version(&self) -> (u64, u64) {
+        (self.id, self.generation)
+    }
+
+    /// Every vertex buffer, as the bytes uploaded to the GPU.
+    pub fn buffers(&self) -> [&[u8]; 5] {
+        let g = &self.geometry;
+        [
+            &g.triangles,
+            &g.transparent,
+            &g.lines,
+            &g.overlay_triangles,
+            &g.overlay_lines,
+        ]
+        .map(|v| bytemuck::cast_slice(v.as_slice()))
+    }
+
+    /// How many vertices it holds.
+    pub fn vertices(&self) -> usize {
+        let g = &self.geometry;
+        g.triangles.len()
+            + g.transparent.len()
+            + g.lines.len()
+            + g.overlay_triangles.len()
+            + g.overlay_lines.len()
+    }
+}
+
+/// Builds everything the view draws, as a new [`Geometry`] (for tests; the view keeps its own
+/// with [`update`]).
 pub fn build(
     bench: &Workbench,
     cache: &SceneCache,
     options: &ViewOptions,
     hovered: Option<usize>,
 ) -> Geometry {
+    let mut view = ViewGeometry::default();
+    update(&mut view, bench, cache, options, hovered);
+    view.geometry
+}
+
+/// Brings what the view draws up to date, in place: nothing is done when nothing it shows
+/// changed since the last call. Allocates nothing once the buffers have grown to the scene.
+pub fn update(
+    view: &mut ViewGeometry,
+    bench: &Workbench,
+    cache: &SceneCache,
+    options: &ViewOptions,
+    hovered: Option<usize>,
+) {
+    let key = Key {
+        revision: bench.revision(),
+        selected_tet: bench.selected_tet,
+        selected_particle: bench.selected_particle,
+        dragging: bench.dragging,
+        hovered,
+        options: *options,
+        stepping: bench.stepping.is_some(),
+    };
+    if view.built_from == Some(key) {
+        return;
+    }
+    view.built_from = Some(key);
+    view.generation += 1;
+    let geometry = &mut view.geometry;
+    for list in [
+        &mut geometry.triangles,
+        &mut geometry.transparent,
+        &mut geometry.lines,
+        &mut geometry.overlay_triangles,
+        &mut geometry.overlay_lines,
+    ] {
+        list.clear();
+    }
+    let scratch = &mut view.scratch;
     let simulation = &bench.simulation;
     let positions = simulation.positions();
     let tets = simulation.tets();
-    let mut inverted = Vec::new();
-    visual::inverted_tets(positions, tets, &mut inverted);
-    let mut geometry = Geometry::default();
 
     let (faces, alpha) = if options.see_through {
         (&cache.all_faces, 90)
@@ -110,8 +255,9 @@ pub fn build(
     };
     for &(face, tet) in faces {
         let tet = tet as usize;
+        let inverted = signed_volume(&tets[tet].map(|i| positions[i as usize])) < 0.0;
         // Inverted wins over everything, the selection included (its edges are outlined instead).
-        let mut colour = if inverted[tet] {
+        let mut colour = if inverted {
             visual::INVERTED
         } else if bench.selected_tet == Some(tet) {
             SELECTED
@@ -167,8 +313,9 @@ pub fn build(
     }
 
     if options.particles {
-        let mut colours = Vec::new();
-        visual::particle_colours(positions.len(), tets, &inverted, &mut colours);
+        visual::inverted_tets(positions, tets, &mut scratch.inverted);
+        let colours = &mut scratch.colours;
+        visual::particle_colours(positions.len(), tets, &scratch.inverted, colours);
         let radius = (0.012 * cache.size) as f32;
         for (i, p) in positions.iter().enumerate() {
             let colour = if hovered == Some(i) {
@@ -188,7 +335,8 @@ pub fn build(
         ground_grid(&mut geometry.lines, simulation.rest_positions(), cache.size);
     }
 
-    let mut arrows = Vec::new();
+    let arrows = &mut scratch.arrows;
+    arrows.clear();
     let pending = bench.stepping.and_then(|s| s.pending(simulation));
     if let Some(projection) = &pending {
         let particles = projection.particles();
@@ -216,48 +364,35 @@ pub fn build(
             projection,
             options.arrow_scale as f64,
             options.correction_gain as f64,
-            &mut arrows,
+            arrows,
         );
     } else {
-        tet_arrows(bench, options, &mut arrows);
+        tet_arrows(bench, options, arrows);
     }
-    for arrow in &arrows {
-        draw_arrow(&mut geometry, arrow);
+    for arrow in arrows.iter() {
+        draw_arrow(geometry, arrow);
     }
-    geometry
 }
 
 /// The arrows of the selected tet (or of every tet of a small mesh): ∇C per active family, and
-/// Δp of the last substep, as the options ask.
+/// Δp of the last substep, as the options ask ([`visual::selected_arrows`], as recorded).
 fn tet_arrows(bench: &Workbench, options: &ViewOptions, arrows: &mut Vec<Arrow>) {
     let simulation = &bench.simulation;
-    let tets = simulation.tets();
-    let all = options.arrows_on_all_tets && tets.len() <= ARROWS_ON_ALL_UP_TO;
-    let chosen = if all {
-        0..tets.len()
-    } else {
-        match bench.selected_tet {
-            Some(tet) => tet..tet + 1,
-            None => 0..0,
-        }
+    let all = options.arrows_on_all_tets && simulation.tets().len() <= ARROWS_ON_ALL_UP_TO;
+    let selection = match (all, bench.selected_tet) {
+        (true, _) => visual::ArrowSelection::AllTets,
+        (false, Some(tet)) => visual::ArrowSelection::Tet(tet),
+        (false, None) => visual::ArrowSelection::None,
     };
-    if options.arrows {
-        for family in Family::all().filter(|&f| simulation.settings().active.get(f)) {
-            for tet in chosen.clone() {
-                let gain = options.arrow_scale as f64;
-                visual::tet_gradient_arrows(simulation, tet, family, gain, arrows);
-            }
-        }
-    }
-    if options.corrections {
-        let gain = options.correction_gain as f64;
-        if all {
-            let particles = 0..simulation.positions().len() as u32;
-            visual::correction_arrows(simulation, particles, gain, arrows);
-        } else if let Some(tet) = bench.selected_tet {
-            visual::correction_arrows(simulation, tets[tet], gain, arrows);
-        }
-    }
+    visual::selected_arrows(
+        simulation,
+        selection,
+        options.arrows.then_some(options.arrow_scale as f64),
+        options
+            .corrections
+            .then_some(options.correction_gain as f64),
+        arrows,
+    );
 }
 
 fn vertex(position: Vec3, normal: Vec3, color: Rgba) -> Vertex {
@@ -367,6 +502,61 @@ mod tests {
                 .iter()
                 .chain(&geometry.lines)
                 .all(|v| v.position.iter().all(|x| x.is_finite()))
+        );
+    }
+
+    /// The view keeps its vertices while nothing it shows changes (no upload then), and builds
+    /// them again after a step, a selection or an option changes.
+    #[test]
+    fn the_view_is_built_again_only_when_what_it_shows_changes() {
+        let mut bench = Workbench::builtin(Builtin::Cube, 2, Settings::default());
+        let cache = SceneCache::new(&bench.scene.mesh);
+        let mut options = ViewOptions::default();
+        let mut view = ViewGeometry::default();
+        update(&mut view, &bench, &cache, &options, None);
+        let first = view.version();
+        update(&mut view, &bench, &cache, &options, None);
+        assert_eq!(view.version(), first, "nothing changed: kept");
+
+        bench.set_playing(true);
+        bench.step_frame();
+        update(&mut view, &bench, &cache, &options, None);
+        let stepped = view.version();
+        assert_ne!(stepped, first, "the particles moved");
+        update(&mut view, &bench, &cache, &options, None);
+        assert_eq!(view.version(), stepped);
+
+        options.edges = false;
+        update(&mut view, &bench, &cache, &options, None);
+        let edges_off = view.version();
+        assert_ne!(edges_off, stepped, "an option changed");
+        update(&mut view, &bench, &cache, &options, Some(0));
+        assert_ne!(view.version(), edges_off, "the hovered particle changed");
+    }
+
+    /// Above [`BIG_MESH_TETS`] the body is drawn without particle handles and arrows (its
+    /// surface, edges and inverted tets only); at or below it, with them.
+    #[test]
+    fn a_big_mesh_is_drawn_as_a_body() {
+        let small = ViewOptions::for_size(BIG_MESH_TETS);
+        assert!(small.particles && small.arrows && small.corrections);
+        let big = ViewOptions::for_size(BIG_MESH_TETS + 1);
+        assert!(!big.particles && !big.arrows && !big.corrections);
+        assert!(big.edges, "the other options stay");
+
+        let mut bench = Workbench::builtin(Builtin::Cube, 2, Settings::default());
+        bench.invert_selected();
+        let cache = SceneCache::new(&bench.scene.mesh);
+        let with_handles = build(&bench, &cache, &small, None);
+        assert!(!with_handles.overlay_lines.is_empty(), "arrows drawn");
+        let as_a_body = build(&bench, &cache, &big, None);
+        assert!(as_a_body.overlay_lines.is_empty(), "no arrows");
+        assert!(as_a_body.overlay_triangles.is_empty(), "no arrow heads");
+        let handles = bench.simulation.positions().len() * 8 * 3;
+        assert_eq!(
+            with_handles.triangles.len() - as_a_body.triangles.len(),
+            handles,
+            "one octahedron per particle, and only those, left out"
         );
     }
 

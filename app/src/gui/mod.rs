@@ -240,10 +240,14 @@ impl TetlabApp {
         }
     }
 
-    /// Replaces the scene; keeps settings and view; ends a comparison.
+    /// Replaces the scene; keeps settings and view (but particle handles and arrows, which
+    /// [`ViewOptions::fit_size`] sets for the scene's size); ends a comparison.
     pub fn load(&mut self, scene: Scene) {
         self.bench.load(scene);
         self.cache = SceneCache::new(&self.bench.scene.mesh);
+        // A big mesh is shown as a body: its particle handles and arrows start off.
+        let tets = self.bench.simulation.tets().len();
+        self.display.options.fit_size(tets);
         self.viewport.frame();
         self.comparison = None;
         self.error = None;
@@ -450,10 +454,7 @@ impl TetlabApp {
                         .iter()
                         .find(|e| e.file == "height.toml")
                         .unwrap_or(&tetlab_core::constraint_file::EXAMPLES[0]);
-                    if let Some(file) = self
-                        .editor
-                        .set_text(std::path::Path::new(example.path), example.text)
-                    {
+                    if let Some(file) = self.editor.set_text(&example.shown(), example.text) {
                         self.define_constraint(file);
                     }
                 }

@@ -149,6 +149,8 @@ pub struct Renderer {
 
 /// What one view draws with.
 struct ViewResources {
+    /// The version of the geometry last uploaded ([`super::geometry::ViewGeometry::version`]).
+    uploaded: Option<(u64, u64)>,
     uniforms: wgpu::Buffer,
     uniform_group: wgpu::BindGroup,
     target: Option<Target>,
@@ -176,6 +178,7 @@ impl ViewResources {
             }],
         });
         ViewResources {
+            uploaded: None,
             uniforms,
             uniform_group,
             target: None,
@@ -436,8 +439,9 @@ impl Renderer {
 pub struct ViewCallback {
     /// Which view: 0 the main one, 1 the comparison.
     pub view: usize,
-    /// The geometry.
-    pub geometry: Geometry,
+    /// The geometry, kept by the view between frames; uploaded when its version is not the one
+    /// the GPU holds.
+    pub geometry: std::sync::Arc<std::sync::Mutex<super::geometry::ViewGeometry>>,
     /// World to clip space.
     pub view_projection: Mat4,
     /// Direction toward the light, unit length.
@@ -470,19 +474,24 @@ impl egui_wgpu::CallbackTrait for ViewCallback {
         };
         let resources = renderer.view(device, self.view);
         queue.write_buffer(&resources.uniforms, 0, bytemuck::bytes_of(&uniforms));
-        let geometry = &self.geometry;
-        for (buffer, vertices) in [
-            (&mut resources.triangle_buffer, &geometry.triangles),
-            (&mut resources.transparent_buffer, &geometry.transparent),
-            (&mut resources.line_buffer, &geometry.lines),
-            (
-                &mut resources.overlay_triangle_buffer,
-                &geometry.overlay_triangles,
-            ),
-            (&mut resources.overlay_line_buffer, &geometry.overlay_lines),
-        ] {
-            buffer.upload(device, queue, vertices);
+        let view = self.geometry.lock().unwrap_or_else(|e| e.into_inner());
+        if resources.uploaded != Some(view.version()) {
+            let geometry = view.geometry();
+            for (buffer, vertices) in [
+                (&mut resources.triangle_buffer, &geometry.triangles),
+                (&mut resources.transparent_buffer, &geometry.transparent),
+                (&mut resources.line_buffer, &geometry.lines),
+                (
+                    &mut resources.overlay_triangle_buffer,
+                    &geometry.overlay_triangles,
+                ),
+                (&mut resources.overlay_line_buffer, &geometry.overlay_lines),
+            ] {
+                buffer.upload(device, queue, vertices);
+            }
+            resources.uploaded = Some(view.version());
         }
+        drop(view);
         renderer.resize(device, self.view, size);
         let renderer = &*renderer;
         let resources = &renderer.views[self.view];

@@ -6,7 +6,7 @@
 //! selects a particle and its tet.
 
 use super::camera::OrbitCamera;
-use super::geometry::{self, SceneCache, ViewOptions};
+use super::geometry::{self, SceneCache, ViewGeometry, ViewOptions};
 use super::render::ViewCallback;
 use super::workbench::Workbench;
 use eframe::egui::{self, PointerButton, Pos2, Rect, Sense, Vec2};
@@ -30,6 +30,8 @@ pub struct Viewport {
     pub view: usize,
     /// A camera change that waits for the view's size: frame the body, or reset the camera.
     pending: Option<CameraChange>,
+    /// What the view draws, kept between frames (the paint callback reads it).
+    geometry: std::sync::Arc<std::sync::Mutex<ViewGeometry>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,6 +50,7 @@ impl Default for Viewport {
             rect: Rect::NOTHING,
             view: 0,
             pending: Some(CameraChange::Reset),
+            geometry: Default::default(),
         }
     }
 }
@@ -137,7 +140,13 @@ impl Viewport {
             bench.select_particle(particle);
         }
 
-        let geometry = geometry::build(bench, cache, options, self.hovered);
+        geometry::update(
+            &mut self.geometry.lock().unwrap_or_else(|e| e.into_inner()),
+            bench,
+            cache,
+            options,
+            self.hovered,
+        );
         let background = if ui.visuals().dark_mode {
             [0.09, 0.10, 0.12, 1.0]
         } else {
@@ -145,7 +154,7 @@ impl Viewport {
         };
         let callback = ViewCallback {
             view: self.view,
-            geometry,
+            geometry: std::sync::Arc::clone(&self.geometry),
             view_projection: self.camera.view_projection(aspect),
             light: (self.camera.eye() - self.camera.target + Vec3::Y * self.camera.distance)
                 .normalize(),

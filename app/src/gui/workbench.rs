@@ -61,6 +61,9 @@ pub struct Workbench {
     /// Why the settings may blow up ([`Simulation::stability_warning`]), as of the last change
     /// of settings.
     pub stability_warning: Option<String>,
+    /// Grows with every change of the simulation's state: what the view compares to know whether
+    /// to draw again.
+    revision: u64,
 }
 
 impl Workbench {
@@ -82,6 +85,7 @@ impl Workbench {
             stepping: None,
             last_advance: None,
             diverged: None,
+            revision: 0,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -205,6 +209,7 @@ impl Workbench {
         if let Some(i) = self.selected_particle {
             let pinned = self.simulation.is_pinned(i);
             self.simulation.set_pinned(i, !pinned);
+            self.revision += 1;
         }
     }
 
@@ -334,9 +339,15 @@ impl Workbench {
         self.after_change();
     }
 
+    /// Which state of the simulation this is: it grows with every step and edit.
+    pub fn revision(&self) -> u64 {
+        self.revision
+    }
+
     /// Measures the new state. A state that diverged is never drawn or plotted: the body goes
     /// back to rest, paused, and [`Workbench::diverged`] says why.
     fn after_change(&mut self) {
+        self.revision += 1;
         match Metrics::measure_sound(&self.simulation) {
             Ok(metrics) => self.metrics = metrics,
             Err(divergence) => {

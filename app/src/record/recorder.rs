@@ -189,30 +189,23 @@ impl<'a> Recorder<'a> {
     }
 
     /// Logs the gradient arrows of the chosen tets, one entity per active family, and Δp of the
-    /// last substep at their particles, at its true length.
+    /// last substep at their particles, at its true length ([`visual::selected_arrows`], as the
+    /// workbench draws them).
     fn log_arrows(&mut self, simulation: &Simulation) {
-        let tets = match self.arrows {
+        let selection = match self.arrows {
             ArrowsMode::None => return,
-            ArrowsMode::Selected => self.tet..self.tet + 1,
-            ArrowsMode::All => 0..simulation.tets().len(),
+            ArrowsMode::Selected => visual::ArrowSelection::Tet(self.tet),
+            ArrowsMode::All => visual::ArrowSelection::AllTets,
         };
-        let active = simulation.settings().active;
         self.arrow_scratch.clear();
-        for family in Family::all().filter(|&f| active.get(f)) {
-            for tet in tets.clone() {
-                visual::tet_gradient_arrows(simulation, tet, family, 1.0, &mut self.arrow_scratch);
-            }
-        }
-        match self.arrows {
-            ArrowsMode::All => {
-                let particles = 0..simulation.positions().len() as u32;
-                visual::correction_arrows(simulation, particles, 1.0, &mut self.arrow_scratch);
-            }
-            _ => {
-                let corners = simulation.tets()[self.tet];
-                visual::correction_arrows(simulation, corners, 1.0, &mut self.arrow_scratch);
-            }
-        }
+        visual::selected_arrows(
+            simulation,
+            selection,
+            Some(1.0),
+            Some(1.0),
+            &mut self.arrow_scratch,
+        );
+        let active = simulation.settings().active;
         let quantities = Family::all()
             .filter(|&f| active.get(f))
             .flat_map(Quantity::of_family)

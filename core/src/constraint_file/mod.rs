@@ -131,6 +131,17 @@ pub struct Example {
 include!(concat!(env!("OUT_DIR"), "/constraint_examples.rs"));
 
 impl Example {
+    /// Where the file sits in the repository, `assets/constraints/FILE`: the name the workbench
+    /// shows and its errors give, the same wherever tetlab was built.
+    ///
+    /// ```
+    /// use tetlab_core::constraint_file::EXAMPLES;
+    /// assert!(EXAMPLES.iter().all(|e| e.shown().starts_with("assets/constraints")));
+    /// ```
+    pub fn shown(&self) -> PathBuf {
+        Path::new("assets/constraints").join(self.file)
+    }
+
     /// The example whose path (as tetlab was built) `path` names, `..` and `.` resolved.
     ///
     /// ```

@@ -20,7 +20,7 @@ pub const FORMULA: &[&str] = &[
 ];
 
 /// d = |p0 − p1| of a rest configuration.
-#[inline]
+#[inline(always)]
 pub fn rest_value<V: Vector3>(p: &[V; 2]) -> V::Real {
     (p[0] - p[1]).length()
 }
@@ -35,7 +35,7 @@ pub fn rest_value<V: Vector3>(p: &[V; 2]) -> V::Real {
 /// assert_eq!(e.gradients[0], DVec3::new(0.6, 0.8, 0.0));
 /// assert_eq!(e.gradients[0] + e.gradients[1], DVec3::ZERO);
 /// ```
-#[inline]
+#[inline(always)]
 pub fn evaluate<V: Vector3>(p: &[V; 2], rest: V::Real) -> Evaluation<V, 2> {
     let delta = p[0] - p[1];
     let length = delta.length();

@@ -43,7 +43,7 @@ pub const fn tet_vertex_order() -> [[usize; 4]; 4] {
 }
 
 /// e₁·n, the signed height of p1 above the plane of (p0, p2, p3); zero for a degenerate face.
-#[inline]
+#[inline(always)]
 pub fn rest_value<V: Vector3>(p: &[V; 4]) -> V::Real {
     let e = evaluate(p, <V::Real as crate::vector::Real>::ZERO);
     e.value
@@ -62,7 +62,7 @@ pub fn rest_value<V: Vector3>(p: &[V; 4]) -> V::Real {
 /// let swapped = height::evaluate(&[p[0], p[1], p[3], p[2]], 0.0);
 /// assert_eq!(swapped.value, -2.0);
 /// ```
-#[inline]
+#[inline(always)]
 pub fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
     let e1 = p[1] - p[0];
     let e2 = p[2] - p[0];

@@ -32,7 +32,7 @@ pub const FORMULA: &[&str] = &[
 
 /// V = ⅙ (p1 − p0)·((p2 − p0)×(p3 − p0)) of a rest configuration: positive when
 /// (p1 − p0, p2 − p0, p3 − p0) is a right-handed frame.
-#[inline]
+#[inline(always)]
 pub fn rest_value<V: Vector3>(p: &[V; 4]) -> V::Real {
     signed_volume(p)
 }
@@ -47,7 +47,7 @@ pub fn rest_value<V: Vector3>(p: &[V; 4]) -> V::Real {
 /// // Swapping two vertices mirrors the tet: the signed volume flips.
 /// assert_eq!(signed_volume(&[p[1], p[0], p[2], p[3]]), -1.0 / 6.0);
 /// ```
-#[inline]
+#[inline(always)]
 pub fn signed_volume<V: Vector3>(p: &[V; 4]) -> V::Real {
     let e1 = p[1] - p[0];
     let e2 = p[2] - p[0];
@@ -65,7 +65,7 @@ pub fn signed_volume<V: Vector3>(p: &[V; 4]) -> V::Real {
 /// assert_eq!(e.value, 0.0);
 /// assert_eq!(e.gradients[1], DVec3::X / 6.0); // ⅙ area normal of the face opposite p1
 /// ```
-#[inline]
+#[inline(always)]
 pub fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
     let e1 = p[1] - p[0];
     let e2 = p[2] - p[0];
@@ -84,7 +84,7 @@ pub fn evaluate<V: Vector3>(p: &[V; 4], rest: V::Real) -> Evaluation<V, 4> {
     Evaluation::unless_degenerate(degenerate, value, value, gradients)
 }
 
-#[inline]
+#[inline(always)]
 fn sixth<R: Real>() -> R {
     R::ONE / R::from_f64(6.0)
 }

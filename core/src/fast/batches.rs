@@ -1,134 +1,137 @@
-//! One family's constraints as the fast solver keeps them: coloured so that no two of a colour
-//! share a particle, and packed [`LANES`] to a batch, each batch laid out as its lanes. The
-//! particles of batch b are rows b·N..b·N + N of `particles` (row i: particle i of the
-//! constraint in each lane), its inverse masses rows b·N..b·N + N of `weights`, its rest values
-//! and multipliers entry b of `rest` and `lambda`: a batch is loaded with one vector load per
-//! quantity. The same shape for every family, whatever its arity N.
+//! The fast solver's constraints, laid out for eight lanes.
+//!
+//! A [`Layout`] holds the elements constraints bind to, edges or tets: coloured so that no two
+//! elements of a colour share a particle, and packed [`LANES`] to a batch, each batch stored lane
+//! by lane. The particles of batch b are rows b·N..b·N + N of `particles` (row i: particle i of
+//! the element in each lane), their inverse masses the same rows of `weights`: a batch is loaded
+//! with one vector load per row. Every family bound to the same kind of element shares one layout
+//! (the built-in heights and volume, the neo-Hookean pair, a constraint file's tet family all
+//! share the tets'), and keeps only its own rest values and multipliers ([`Batches`]): K per
+//! element, K being its constraints per element (1 per edge or tet, 4 per tet for the heights).
+//! The K constraints of an element are projected one after the other on the element's particles
+//! held in registers, which are then written back once.
 
+use crate::constraints::Binding;
 use crate::lanes::{F32x8, LANES};
 use crate::vector::Real;
 use std::ops::Range;
 
-/// One colour of a family: the batches `batches`, holding `constraints` constraints. The lanes
-/// after them in the last batch are padding: copies of a constraint of the batch with zero
-/// weights, which move nothing.
+/// One colour of a layout: the batches `batches`, holding `elements` elements. The lanes after
+/// them in the last batch are padding: copies of an element of the batch with zero weights,
+/// which move nothing.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Colour {
     /// The batches of this colour.
     pub batches: Range<usize>,
-    /// The constraints in them, padding not counted.
-    pub constraints: usize,
+    /// The elements in them, padding not counted.
+    pub elements: usize,
 }
 
-/// One family's constraints, coloured and in batches.
+/// The edges or the tets of a body, coloured and in batches (see the module).
 #[derive(Clone, Debug, Default)]
-pub struct Batches {
+pub struct Layout {
     arity: usize,
     particles: Vec<[u32; LANES]>,
     weights: Vec<F32x8>,
-    rest: Vec<F32x8>,
-    lambda: Vec<F32x8>,
-    /// Constraints of one colour share no particle; colours are projected in order.
+    /// Per batch, the element (edge or tet number) in each lane.
+    elements: Vec<[u32; LANES]>,
+    /// Elements of one colour share no particle; colours are projected in order.
     pub colours: Vec<Colour>,
     /// Every particle index above is below this.
     particle_count: usize,
 }
 
-/// A family's batches with their arity N known: what the kernels read.
+/// One family's constraints on a [`Layout`]: for each element, its K constraints' rest values
+/// and multipliers, K rows per batch.
+#[derive(Clone, Debug, Default)]
+pub struct Batches {
+    per_element: usize,
+    rest: Vec<F32x8>,
+    lambda: Vec<F32x8>,
+}
+
+/// A layout with its arity N known: what the kernels read.
 pub(crate) struct Typed<'a, const N: usize> {
     pub particles: &'a [[[u32; LANES]; N]],
     pub weights: &'a [[F32x8; N]],
-    pub rest: &'a [F32x8],
-    pub lambda: &'a mut [F32x8],
     pub colours: &'a [Colour],
     pub particle_count: usize,
 }
 
-impl Batches {
-    /// Colours constraints given as (particles, rest) in the new particle numbering: greedy, each
-    /// constraint takes the first colour none of its particles has yet; within a colour, sorted by
-    /// first particle for locality, then packed into batches.
-    pub(crate) fn new<const N: usize>(
-        constraints: Vec<([u32; N], f32)>,
-        inverse_masses: &[f32],
-    ) -> Self {
-        let mut colour_of = vec![usize::MAX; constraints.len()];
-        let mut remaining: Vec<usize> = (0..constraints.len()).collect();
+impl Layout {
+    /// Colours `elements` (each its particles, in the new numbering) greedily: each takes the first
+    /// colour none of its particles has yet; within a colour they are sorted by first particle,
+    /// for locality, and packed into batches.
+    pub(crate) fn new<const N: usize>(elements: &[[u32; N]], inverse_masses: &[f32]) -> Layout {
+        let mut colour_of = vec![usize::MAX; elements.len()];
+        let mut remaining: Vec<usize> = (0..elements.len()).collect();
         let mut base = 0;
-        // 64 colours per pass, one bit each per particle; constraints that find none wait for the
+        // 64 colours per pass, one bit each per particle; elements that find none wait for the
         // next pass.
         while !remaining.is_empty() {
             let mut used = vec![0u64; inverse_masses.len()];
             let mut waiting = Vec::new();
-            for c in remaining {
-                let particles = constraints[c].0;
-                let taken = particles
+            for e in remaining {
+                let taken = elements[e]
                     .iter()
                     .fold(0u64, |mask, &i| mask | used[i as usize]);
                 if taken == u64::MAX {
-                    waiting.push(c);
+                    waiting.push(e);
                     continue;
                 }
                 let colour = taken.trailing_ones() as usize;
-                for &i in &particles {
+                for &i in &elements[e] {
                     used[i as usize] |= 1 << colour;
                 }
-                colour_of[c] = base + colour;
+                colour_of[e] = base + colour;
             }
             remaining = waiting;
             base += 64;
         }
-        let mut order: Vec<usize> = (0..constraints.len()).collect();
-        order.sort_by_key(|&c| (colour_of[c], constraints[c].0.iter().min().copied()));
-        let mut batches = Batches {
+        let mut order: Vec<usize> = (0..elements.len()).collect();
+        order.sort_by_key(|&e| (colour_of[e], elements[e].iter().min().copied()));
+        let mut layout = Layout {
             arity: N,
             particle_count: inverse_masses.len(),
-            ..Batches::default()
+            ..Layout::default()
         };
         for colour in order.chunk_by(|&a, &b| colour_of[a] == colour_of[b]) {
-            let start = batches.rest.len();
+            let start = layout.elements.len();
             for lanes in colour.chunks(LANES) {
-                batches.push::<N>(std::array::from_fn(|k| {
-                    let (particles, rest) = constraints[lanes[k.min(lanes.len() - 1)]];
+                let element = |k: usize| lanes[k.min(lanes.len() - 1)];
+                // Corner i of every lane's element (so not a loop over one element's corners).
+                #[allow(clippy::needless_range_loop)]
+                for i in 0..N {
                     // Indexing checks the invariant the kernels rely on (see `particles`).
-                    let weights = particles.map(|i| inverse_masses[i as usize]);
-                    let padding = k >= lanes.len();
-                    (
-                        particles,
-                        rest,
-                        weights.map(|w| if padding { 0.0 } else { w }),
-                    )
-                }));
+                    let row = std::array::from_fn(|k| elements[element(k)][i]);
+                    let weights = std::array::from_fn(|k| {
+                        let w = inverse_masses[row[k] as usize];
+                        if k < lanes.len() { w } else { 0.0 }
+                    });
+                    layout.particles.push(row);
+                    layout.weights.push(F32x8::new(weights));
+                }
+                layout
+                    .elements
+                    .push(std::array::from_fn(|k| element(k) as u32));
             }
-            batches.colours.push(Colour {
-                batches: start..batches.rest.len(),
-                constraints: colour.len(),
+            layout.colours.push(Colour {
+                batches: start..layout.elements.len(),
+                elements: colour.len(),
             });
         }
-        batches
+        layout
     }
 
-    /// Appends a batch of (particles, rest, weights), one per lane.
-    fn push<const N: usize>(&mut self, lanes: [([u32; N], f32, [f32; N]); LANES]) {
-        for i in 0..N {
-            self.particles.push(lanes.map(|lane| lane.0[i]));
-            self.weights.push(F32x8::new(lanes.map(|lane| lane.2[i])));
-        }
-        self.rest.push(F32x8::new(lanes.map(|lane| lane.1)));
-        self.lambda.push(F32x8::ZERO);
-    }
-
-    /// The batches with their arity `N` known.
+    /// The layout with its arity `N` known.
     ///
     /// # Panics
-    /// If `N` is not their arity.
-    pub(crate) fn typed<const N: usize>(&mut self) -> Typed<'_, N> {
-        assert_eq!(N, self.arity, "batches of another arity");
+    /// If `N` is not its arity.
+    pub(crate) fn typed<const N: usize>(&self) -> Typed<'_, N> {
+        assert_eq!(N, self.arity, "a layout of another arity");
         Typed {
             particles: self.particles.as_chunks::<N>().0,
             weights: self.weights.as_chunks::<N>().0,
-            rest: &self.rest,
-            lambda: &mut self.lambda,
             colours: &self.colours,
             particle_count: self.particle_count,
         }
@@ -140,7 +143,7 @@ impl Batches {
         let arity = self.arity;
         for colour in &self.colours {
             for (k, b) in colour.batches.clone().enumerate() {
-                let real = colour.constraints.saturating_sub(k * LANES).min(LANES);
+                let real = colour.elements.saturating_sub(k * LANES).min(LANES);
                 for i in 0..arity {
                     let row = self.particles[b * arity + i];
                     let mut lanes = [0.0f32; LANES];
@@ -153,83 +156,127 @@ impl Batches {
         }
     }
 
-    /// λ = 0 for every constraint (a new substep).
-    pub(crate) fn reset_lambda(&mut self) {
-        self.lambda.fill(F32x8::ZERO);
-    }
-
-    /// How many particles each constraint touches.
+    /// How many particles an element has: 2 for an edge, 4 for a tet.
     pub fn arity(&self) -> usize {
         self.arity
     }
 
-    /// The number of constraints, padding not counted.
-    pub fn len(&self) -> usize {
-        self.colours.iter().map(|c| c.constraints).sum()
+    /// The number of batches.
+    pub fn batch_count(&self) -> usize {
+        self.elements.len()
     }
 
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The particles (the first `arity` of four) and rest value of each constraint, colour by
-    /// colour, padding left out.
-    pub fn constraints(&self) -> impl Iterator<Item = ([u32; 4], f32)> + '_ {
-        self.colours
-            .iter()
-            .flat_map(|colour| self.constraints_of(colour))
-    }
-
-    /// The particles and rest value of each constraint of `colour`, padding left out.
-    fn constraints_of<'a>(
-        &'a self,
-        colour: &'a Colour,
-    ) -> impl Iterator<Item = ([u32; 4], f32)> + 'a {
-        colour
-            .batches
-            .clone()
-            .flat_map(|b| (0..LANES).map(move |k| (b, k)))
-            .take(colour.constraints)
-            .map(|(b, k)| {
-                let mut particles = [0; 4];
-                for (i, slot) in particles.iter_mut().enumerate().take(self.arity) {
-                    *slot = self.particles[b * self.arity + i][k];
-                }
-                (particles, self.rest[b].to_array()[k])
-            })
-    }
-
-    /// How many constraints each particle is in.
-    pub(crate) fn constraints_per_particle(&self) -> Vec<u32> {
-        let mut count = vec![0; self.particle_count];
-        for (particles, _) in self.constraints() {
-            for &i in &particles[..self.arity] {
-                count[i as usize] += 1;
-            }
-        }
-        count
+    /// The elements, colour by colour, padding left out: each element's number and its
+    /// particles (the first `arity` of four), with where it is (batch, lane).
+    pub fn elements(&self) -> impl Iterator<Item = (u32, [u32; 4], (usize, usize))> + '_ {
+        self.colours.iter().flat_map(|colour| {
+            colour
+                .batches
+                .clone()
+                .flat_map(|b| (0..LANES).map(move |k| (b, k)))
+                .take(colour.elements)
+                .map(|(b, k)| {
+                    let mut particles = [0; 4];
+                    for (i, slot) in particles.iter_mut().enumerate().take(self.arity) {
+                        *slot = self.particles[b * self.arity + i][k];
+                    }
+                    (self.elements[b][k], particles, (b, k))
+                })
+        })
     }
 
     /// Whether every colour really shares no particle (padding, which moves nothing, aside).
     pub fn colouring_is_valid(&self, particle_count: usize) -> bool {
         let mut seen = vec![usize::MAX; particle_count];
-        self.colours.iter().enumerate().all(|(k, colour)| {
-            self.constraints_of(colour).all(|(particles, _)| {
-                particles[..self.arity].iter().all(|&i| {
-                    let fresh = seen[i as usize] != k;
-                    seen[i as usize] = k;
-                    fresh
-                })
+        let mut colour_at = vec![0; self.elements.len()];
+        for (k, colour) in self.colours.iter().enumerate() {
+            for b in colour.batches.clone() {
+                colour_at[b] = k;
+            }
+        }
+        self.elements().all(|(_, particles, (b, _))| {
+            let k = colour_at[b];
+            particles[..self.arity].iter().all(|&i| {
+                let fresh = seen[i as usize] != k;
+                seen[i as usize] = k;
+                fresh
             })
         })
     }
 
     /// The bytes its arrays take (their capacities).
     pub(crate) fn heap_bytes(&self) -> usize {
-        self.particles.capacity() * size_of::<[u32; LANES]>()
-            + (self.weights.capacity() + self.rest.capacity() + self.lambda.capacity())
-                * size_of::<F32x8>()
+        (self.particles.capacity() + self.elements.capacity()) * size_of::<[u32; LANES]>()
+            + self.weights.capacity() * size_of::<F32x8>()
             + self.colours.capacity() * size_of::<Colour>()
+    }
+}
+
+/// The orders of the one constraint per element of an edge or tet binding: the identity.
+pub(crate) fn identity<const N: usize>() -> [[usize; N]; 1] {
+    [std::array::from_fn(|i| i)]
+}
+
+/// The orders of the four constraints per tet of a tet-vertex binding: for constraint k, which
+/// of the tet's corners is its p0, p1, p2, p3 ([`crate::constraints::height::tet_vertex_order`]).
+pub(crate) fn tet_vertex_orders<const N: usize>() -> [[usize; N]; 4] {
+    let orders = crate::constraints::height::tet_vertex_order();
+    std::array::from_fn(|k| std::array::from_fn(|i| orders[k][i.min(3)]))
+}
+
+/// How many constraints per element a binding has: 4 per tet for tet vertices, 1 otherwise.
+pub(crate) fn per_element(binding: Binding) -> usize {
+    match binding {
+        Binding::TetVertices => 4,
+        Binding::Edges | Binding::Tets => 1,
+    }
+}
+
+impl Batches {
+    /// A family's batches on `layout`: constraint k of element e has rest value
+    /// `rest(e, k)`, for k below `per_element`.
+    pub(crate) fn new(
+        layout: &Layout,
+        per_element: usize,
+        rest: impl Fn(u32, usize) -> f32,
+    ) -> Self {
+        let mut batches = Batches {
+            per_element,
+            rest: Vec::with_capacity(layout.batch_count() * per_element),
+            lambda: vec![F32x8::ZERO; layout.batch_count() * per_element],
+        };
+        for lanes in &layout.elements {
+            for k in 0..per_element {
+                batches
+                    .rest
+                    .push(F32x8::new(lanes.map(|element| rest(element, k))));
+            }
+        }
+        batches
+    }
+
+    /// Constraints per element (K).
+    pub fn per_element(&self) -> usize {
+        self.per_element
+    }
+
+    /// The rest values (K rows per batch) and the multipliers, for the kernels.
+    pub(crate) fn rows(&mut self) -> (&[F32x8], &mut [F32x8]) {
+        (&self.rest, &mut self.lambda)
+    }
+
+    /// The rest value of constraint k of the element at (batch, lane).
+    pub(crate) fn rest_at(&self, (batch, lane): (usize, usize), k: usize) -> f32 {
+        self.rest[batch * self.per_element + k].to_array()[lane]
+    }
+
+    /// λ = 0 for every constraint (a new substep).
+    pub(crate) fn reset_lambda(&mut self) {
+        self.lambda.fill(F32x8::ZERO);
+    }
+
+    /// The bytes its arrays take (their capacities).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        (self.rest.capacity() + self.lambda.capacity()) * size_of::<F32x8>()
     }
 }

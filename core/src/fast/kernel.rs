@@ -1,8 +1,13 @@
-//! The fast solver's kernels: a family's batches projected colour by colour, eight constraints
-//! at a time in SIMD lanes, through the generic formula ([`Constraint`]) and projection rule
-//! ([`correction_lanes`]); threads share large colours.
+//! The fast solver's kernels: a family's constraints projected colour by colour, eight elements
+//! (edges or tets) at a time in SIMD lanes, through the generic formula ([`Constraint`]) and
+//! projection rule ([`correction_lanes`]); threads share large colours.
+//!
+//! A batch's particles are gathered once into registers; the family's K constraints per element
+//! (four heights per tet, one volume) are projected one after the other on those registers; the
+//! new positions are then written back from them, once (Gauss–Seidel), or the sum of the
+//! corrections is added to the Jacobi sums.
 
-use super::batches::{Batches, Typed};
+use super::batches::{Batches, Layout, Typed};
 use super::particles::Particles;
 use crate::constraints::Constraint;
 use crate::lanes::{F32x8, LANES, Vec3x8};
@@ -10,7 +15,7 @@ use crate::projection::{Rule, correction_lanes, pair_correction_lanes};
 use crate::vector::Vector3;
 use glam::Vec3A;
 
-/// Colours with fewer constraints than this are projected on one thread even when several are
+/// Colours with fewer elements than this are projected on one thread even when several are
 /// available: below it, handing out the work costs more than it saves.
 pub const PARALLEL_MIN: usize = 1024;
 
@@ -53,21 +58,96 @@ fn scatter_add(positions: Particles, indices: [u32; LANES], delta: Vec3x8) {
     }
 }
 
+/// Puts particle `indices[k]` at lane k of `value`, the last lane first: a padding lane repeats
+/// an element of a lower lane with zero weights (its particles unmoved), so the real lane is
+/// written last.
+#[inline(always)]
+fn scatter_set(positions: Particles, indices: [u32; LANES], value: Vec3x8) {
+    let rows = value.rows();
+    for k in (0..LANES).rev() {
+        positions.set(indices[k], rows[k]);
+    }
+}
+
 /// Where the kernels read and write: the positions (or their rest shape, for a family that reads
-/// it), and where corrections go (the same positions for Gauss–Seidel, the sums for Jacobi).
+/// it), and where corrections go: the same positions for Gauss–Seidel, the sums for Jacobi.
 #[derive(Clone, Copy)]
 struct Access<'a> {
     read: Particles<'a>,
     rest_shape: Particles<'a>,
-    write: Particles<'a>,
+    /// The Jacobi sums, when projecting in Jacobi order.
+    sums: Option<Particles<'a>>,
 }
 
-/// Projects batches of constraints that share no particle, [`LANES`] constraints at a time (the
-/// generic formula and projection rule on [`Vec3x8`]): reads the particles from `access.read`
-/// and adds the corrections to `access.write`.
+/// An element order packed into a number, four bits per particle (particle i of the constraint
+/// is the element's particle `(order >> 4i) & 15`), so that it can be a const parameter of the
+/// kernel and the reordering of the registers be resolved when it is compiled.
+const fn pack(order: [usize; 4]) -> u32 {
+    (order[0] | order[1] << 4 | order[2] << 8 | order[3] << 12) as u32
+}
+
+/// The orders of the four constraints per tet of a tet-vertex binding
+/// ([`crate::constraints::height::tet_vertex_order`]).
+const TET_VERTEX: [u32; 4] = {
+    let orders = crate::constraints::height::tet_vertex_order();
+    [
+        pack(orders[0]),
+        pack(orders[1]),
+        pack(orders[2]),
+        pack(orders[3]),
+    ]
+};
+
+/// Particle i of a constraint in element order `ORDER`.
+#[inline(always)]
+const fn at<const ORDER: u32>(i: usize) -> usize {
+    ((ORDER >> (4 * i)) & 15) as usize
+}
+
+/// Projects one constraint of each element of a batch, whose particles are the element's in
+/// order `ORDER`, on the registers `p` (and, in Jacobi order, from `original`, adding the
+/// corrections to `sum`).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn project_in_order<const N: usize, C: Constraint<N>, const ORDER: u32, const JACOBI: bool>(
+    constraint: &C,
+    p: &mut [Vec3x8; N],
+    original: &[Vec3x8; N],
+    sum: &mut [Vec3x8; N],
+    shape: &[Vec3x8; N],
+    weights: &[F32x8; N],
+    rest: F32x8,
+    lambda: &mut F32x8,
+    rule: Rule<F32x8>,
+) {
+    let from = if JACOBI { original } else { &*p };
+    let points: [Vec3x8; N] = std::array::from_fn(|i| from[at::<ORDER>(i)]);
+    let shape: [Vec3x8; N] = std::array::from_fn(|i| shape[at::<ORDER>(i)]);
+    let weights: [F32x8; N] = std::array::from_fn(|i| weights[at::<ORDER>(i)]);
+    let (_, d) = correction_lanes(
+        constraint.evaluate(&points, rest, &shape),
+        weights,
+        *lambda,
+        rule,
+    );
+    *lambda += d.delta_lambda;
+    for (i, delta) in d.delta_x.into_iter().enumerate() {
+        if JACOBI {
+            sum[at::<ORDER>(i)] += delta;
+        } else {
+            p[at::<ORDER>(i)] += delta;
+        }
+    }
+}
+
+/// Projects batches of elements that share no particle: per batch, the family's constraints on
+/// each element, K of them (one for an edge or a tet, four for a tet's vertices, in the orders
+/// of [`TET_VERTEX`]), one after the other; then the corrections are added to the positions
+/// (Gauss–Seidel) or, with `JACOBI`, to the sums. With K above one the particles stay in
+/// registers between the constraints and are gathered and written once.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn project_batches<const N: usize, C: Constraint<N>>(
+fn project_batches<const N: usize, C: Constraint<N>, const K: usize, const JACOBI: bool>(
     constraint: &C,
     particles: &[[[u32; LANES]; N]],
     weights: &[[F32x8; N]],
@@ -77,46 +157,79 @@ fn project_batches<const N: usize, C: Constraint<N>>(
     rule: Rule<F32x8>,
 ) {
     let read = access.read;
-    // The next batch is gathered before this one is corrected (they share no particle), so that
+    let write = access.sums.unwrap_or(read);
+    // The next batch is gathered before this one is written (they share no particle), so that
     // its loads overlap this one's arithmetic.
     let mut next = particles.first().map(|indices| gather_batch(read, indices));
-    for (b, (((indices, weights), &rest), lambda)) in particles
+    for (b, ((indices, weights), (rest, lambda))) in particles
         .iter()
         .zip(weights)
-        .zip(rest)
-        .zip(lambda)
+        .zip(rest.chunks_exact(K).zip(lambda.chunks_exact_mut(K)))
         .enumerate()
     {
-        let Some(p) = next else { break };
+        let Some(original) = next else { break };
         next = particles
             .get(b + 1)
             .map(|indices| gather_batch(read, indices));
         let shape = if C::USES_REST_SHAPE {
             gather_batch(access.rest_shape, indices)
         } else {
-            p
+            original
         };
-        let (_, d) = correction_lanes(
-            constraint.evaluate(&p, rest, &shape),
-            *weights,
-            *lambda,
-            rule,
-        );
-        *lambda += d.delta_lambda;
-        for (&indices, delta) in indices.iter().zip(d.delta_x) {
-            scatter_add(access.write, indices, delta);
+        if K == 1 {
+            let (_, d) = correction_lanes(
+                constraint.evaluate(&original, rest[0], &shape),
+                *weights,
+                lambda[0],
+                rule,
+            );
+            lambda[0] += d.delta_lambda;
+            for (&indices, delta) in indices.iter().zip(d.delta_x) {
+                scatter_add(write, indices, delta);
+            }
+            continue;
+        }
+        let mut p = original;
+        let mut sum = [Vec3x8::ZERO; N];
+        macro_rules! project {
+            ($k:expr) => {
+                project_in_order::<N, C, { TET_VERTEX[$k] }, JACOBI>(
+                    constraint,
+                    &mut p,
+                    &original,
+                    &mut sum,
+                    &shape,
+                    weights,
+                    rest[$k],
+                    &mut lambda[$k],
+                    rule,
+                )
+            };
+        }
+        project!(0);
+        project!(1);
+        project!(2);
+        project!(3);
+        for (i, &indices) in indices.iter().enumerate() {
+            if JACOBI {
+                scatter_add(write, indices, sum[i]);
+            } else {
+                scatter_set(read, indices, p[i]);
+            }
         }
     }
 }
 
-/// Projects every constraint of `batches`, colour by colour, and adds the corrections to
-/// `positions` (Gauss–Seidel) or, given `sums`, to `sums` (Jacobi: `positions` stay as they are);
-/// with `parallel`, large colours are shared by the threads of the current pool. Returns how many
-/// constraints it projected.
+/// Projects every constraint of a family (`batches`, on `layout`, K per element: 1, or 4 for a
+/// tet-vertex binding), colour by colour, moving `positions` (Gauss–Seidel) or, given `sums`,
+/// adding the corrections to `sums` (Jacobi: `positions` stay as they are); with `parallel`,
+/// large colours are shared by the threads of the current pool. Returns how many constraints it
+/// projected.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
+pub(crate) fn project_family<const N: usize, C: Constraint<N>, const K: usize>(
     constraint: &C,
+    layout: &Layout,
     batches: &mut Batches,
     positions: &mut [Vec3A],
     rest_positions: &mut [Vec3A],
@@ -124,56 +237,79 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
     rule: Rule<f64>,
     parallel: bool,
 ) -> usize {
+    assert!(
+        K == 1 || (K == 4 && N == 4),
+        "one constraint per element, or four per tet"
+    );
+    assert_eq!(batches.per_element(), K, "batches of another binding");
     let rule: Rule<F32x8> = rule.to();
     let Typed {
         particles,
         weights,
-        rest,
-        lambda,
         colours,
         particle_count,
-    } = batches.typed::<N>();
-    let read = Particles::new(positions, particle_count);
+    } = layout.typed::<N>();
+    let (rest, lambda) = batches.rows();
     let access = Access {
-        read,
+        read: Particles::new(positions, particle_count),
         rest_shape: Particles::new(rest_positions, particle_count),
-        write: sums.map_or(read, |sums| Particles::new(sums, particle_count)),
+        sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let mut count = 0;
     for colour in colours.iter() {
         let range = colour.batches.clone();
+        let rows = range.start * K..range.end * K;
         let (particles, weights, rest, lambda) = (
             &particles[range.clone()],
-            &weights[range.clone()],
-            &rest[range.clone()],
-            &mut lambda[range],
+            &weights[range],
+            &rest[rows.clone()],
+            &mut lambda[rows],
         );
-        match parallel && colour.constraints >= PARALLEL_MIN {
+        match parallel && colour.elements >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
             true => {
                 use rayon::prelude::*;
                 lambda
-                    .par_chunks_mut(CHUNK)
+                    .par_chunks_mut(CHUNK * K)
                     .zip(particles.par_chunks(CHUNK))
                     .zip(weights.par_chunks(CHUNK))
-                    .zip(rest.par_chunks(CHUNK))
+                    .zip(rest.par_chunks(CHUNK * K))
                     .for_each(|(((lambda, particles), weights), rest)| {
-                        project_batches::<N, C>(
+                        project::<N, C, K>(
                             constraint, particles, weights, rest, lambda, access, rule,
                         );
                     })
             }
-            _ => {
-                project_batches::<N, C>(constraint, particles, weights, rest, lambda, access, rule)
-            }
+            _ => project::<N, C, K>(constraint, particles, weights, rest, lambda, access, rule),
         }
-        count += colour.constraints;
+        count += colour.elements * K;
     }
     count
 }
 
-/// [`project_batches`] for two families projected together ([`pair_correction_lanes`]): the
-/// batches of both have the same particles, in the same order; each has its own rest values and
+/// [`project_batches`] in the order `access` asks for: Gauss–Seidel, or Jacobi with sums.
+#[inline(always)]
+fn project<const N: usize, C: Constraint<N>, const K: usize>(
+    constraint: &C,
+    particles: &[[[u32; LANES]; N]],
+    weights: &[[F32x8; N]],
+    rest: &[F32x8],
+    lambda: &mut [F32x8],
+    access: Access,
+    rule: Rule<F32x8>,
+) {
+    match access.sums {
+        Some(_) => project_batches::<N, C, K, true>(
+            constraint, particles, weights, rest, lambda, access, rule,
+        ),
+        None => project_batches::<N, C, K, false>(
+            constraint, particles, weights, rest, lambda, access, rule,
+        ),
+    }
+}
+
+/// [`project_batches`] for two families projected together ([`pair_correction_lanes`]): one
+/// constraint of each per element, on the same layout; each has its own rest values and
 /// multipliers.
 #[inline]
 #[allow(clippy::too_many_arguments)]
@@ -212,19 +348,23 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
         );
         lambda_a[b] += d.delta_lambda[0];
         lambda_b[b] += d.delta_lambda[1];
-        for (&indices, delta) in indices.iter().zip(d.delta_x) {
-            scatter_add(access.write, indices, delta);
+        for (i, &indices) in indices.iter().enumerate() {
+            match access.sums {
+                Some(sums) => scatter_add(sums, indices, d.delta_x[i]),
+                None => scatter_set(access.read, indices, p[i] + d.delta_x[i]),
+            }
         }
     }
 }
 
-/// [`project_family`] for two families projected together, constraint by constraint: their
-/// batches (`pair`) were built from the same particles, so they have the same colours and
-/// batches. Returns how many constraints of each it projected.
+/// [`project_family`] for two families projected together, element by element (the neo-Hookean
+/// pair: one constraint of each per tet, on the same layout). Returns how many constraints of
+/// each it projected.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
     constraints: (&A, &B),
+    layout: &Layout,
     (first, second): (&mut Batches, &mut Batches),
     positions: &mut [Vec3A],
     rest_positions: &mut [Vec3A],
@@ -236,27 +376,15 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
     let Typed {
         particles,
         weights,
-        rest: rest_a,
-        lambda: lambda_a,
         colours,
         particle_count,
-    } = first.typed::<N>();
-    let Typed {
-        particles: particles_b,
-        rest: rest_b,
-        lambda: lambda_b,
-        ..
-    } = second.typed::<M>();
-    assert_eq!(
-        particles.len(),
-        particles_b.len(),
-        "a pair has the same batches"
-    );
-    let read = Particles::new(positions, particle_count);
+    } = layout.typed::<N>();
+    let (rest_a, lambda_a) = first.rows();
+    let (rest_b, lambda_b) = second.rows();
     let access = Access {
-        read,
+        read: Particles::new(positions, particle_count),
         rest_shape: Particles::new(rest_positions, particle_count),
-        write: sums.map_or(read, |sums| Particles::new(sums, particle_count)),
+        sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let mut count = 0;
     for colour in colours.iter() {
@@ -264,7 +392,7 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         let (particles, weights) = (&particles[range.clone()], &weights[range.clone()]);
         let rest = (&rest_a[range.clone()], &rest_b[range.clone()]);
         let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
-        match parallel && colour.constraints >= PARALLEL_MIN {
+        match parallel && colour.elements >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
             true => {
                 use rayon::prelude::*;
@@ -296,7 +424,7 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
                 rules,
             ),
         }
-        count += colour.constraints;
+        count += colour.elements;
     }
     count
 }

@@ -27,10 +27,10 @@ mod kernel;
 mod morton;
 mod particles;
 
-pub use batches::{Batches, Colour};
+pub use batches::{Batches, Colour, Layout};
 pub use kernel::PARALLEL_MIN;
 
-use crate::constraints::{Constraint, Family, PerFamily, Visit, VisitPair};
+use crate::constraints::{Binding, Constraint, Family, PerFamily, Visit, VisitPair};
 use crate::divergence::Divergence;
 use crate::integrate;
 use crate::projection::Rule;
@@ -65,7 +65,11 @@ pub struct FastSimulation {
     original: Vec<u32>,
     /// The new number of each particle, by the scene's number.
     renumber: Vec<u32>,
-    /// The constraints of each active family (the others are left empty).
+    /// The edges and the tets of the body, coloured and in batches; every family bound to edges
+    /// shares the first, every family bound to tets the second (each is empty when no active
+    /// family uses it).
+    layouts: Layouts,
+    /// The rest values and multipliers of each active family (the others are left empty).
     sets: PerFamily<Batches>,
     tets: usize,
     jacobi: Option<Jacobi>,
@@ -99,6 +103,89 @@ struct Corrections {
     predicted: Vec<Vec3A>,
     last: Vec<Vec3A>,
     frame: Vec<Vec3A>,
+}
+
+/// The layouts of the elements families bind to.
+#[derive(Default)]
+struct Layouts {
+    edges: Layout,
+    tets: Layout,
+}
+
+impl Layouts {
+    /// The layout a family of `binding` uses.
+    fn of(&self, binding: Binding) -> &Layout {
+        match binding {
+            Binding::Edges => &self.edges,
+            Binding::Tets | Binding::TetVertices => &self.tets,
+        }
+    }
+
+    /// Both, for the families' weights and the memory.
+    fn all_mut(&mut self) -> [&mut Layout; 2] {
+        [&mut self.edges, &mut self.tets]
+    }
+}
+
+/// One family's constraints as the fast solver holds them: on its layout, K per element.
+#[derive(Clone, Copy)]
+pub struct FamilyBatches<'a> {
+    layout: &'a Layout,
+    batches: &'a Batches,
+    binding: Binding,
+}
+
+impl<'a> FamilyBatches<'a> {
+    /// The colours of the family's layout.
+    pub fn colours(&self) -> &'a [Colour] {
+        &self.layout.colours
+    }
+
+    /// The number of constraints, padding not counted.
+    pub fn len(&self) -> usize {
+        self.colours().iter().map(|c| c.elements).sum::<usize>() * self.batches.per_element()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The particles (the first arity of four, in the constraint's order) and rest value of each
+    /// constraint, colour by colour, padding left out.
+    pub fn constraints(&self) -> impl Iterator<Item = ([u32; 4], f32)> + 'a {
+        let orders = match self.binding {
+            Binding::TetVertices => batches::tet_vertex_orders::<4>(),
+            _ => [batches::identity::<4>()[0]; 4],
+        };
+        let (layout, batches) = (self.layout, self.batches);
+        let arity = layout.arity();
+        layout.elements().flat_map(move |(_, particles, at)| {
+            (0..batches.per_element()).map(move |k| {
+                let mut ordered = [0; 4];
+                for (i, slot) in ordered.iter_mut().enumerate().take(arity) {
+                    *slot = particles[orders[k][i]];
+                }
+                (ordered, batches.rest_at(at, k))
+            })
+        })
+    }
+
+    /// Whether every colour of its layout really shares no particle.
+    pub fn colouring_is_valid(&self, particle_count: usize) -> bool {
+        self.layout.colouring_is_valid(particle_count)
+    }
+
+    /// How many of its constraints each particle is in.
+    fn constraints_per_particle(&self, particle_count: usize) -> Vec<u32> {
+        let mut count = vec![0; particle_count];
+        for (particles, _) in self.constraints() {
+            for &i in &particles[..self.layout.arity()] {
+                count[i as usize] += 1;
+            }
+        }
+        count
+    }
 }
 
 /// How a sweep applies the corrections of a family's constraints.
@@ -144,37 +231,42 @@ impl FastSimulation {
             .collect();
         // Only the families in use are built: the settings do not change after this.
         let active = simulation.settings().active;
+        let uses =
+            |binding: &dyn Fn(Binding) -> bool| active.families().any(|f| binding(f.row().binding));
+        let mut layouts = Layouts::default();
+        if uses(&|b| b == Binding::Edges) {
+            // In the order of the edge binding ([`Binding::particles`]), whose rest values they
+            // are: the built-in edge family's, always built.
+            let (pairs, _) = simulation
+                .constraints(Family::EDGES)
+                .all_particles()
+                .as_chunks::<2>();
+            let edges: Vec<[u32; 2]> = pairs
+                .iter()
+                .map(|edge| edge.map(|i| renumber[i as usize]))
+                .collect();
+            layouts.edges = Layout::new(&edges, &inverse_masses);
+        }
+        if uses(&|b| b != Binding::Edges) {
+            let tets: Vec<[u32; 4]> = simulation
+                .tets()
+                .iter()
+                .map(|tet| tet.map(|i| renumber[i as usize]))
+                .collect();
+            layouts.tets = Layout::new(&tets, &inverse_masses);
+        }
         let sets = PerFamily::build(|family| {
             if !active[family] {
                 return Batches::default();
             }
-            struct Build<'a> {
-                simulation: &'a Simulation,
-                renumber: &'a [u32],
-                inverse_masses: &'a [f32],
-            }
-            impl Visit for Build<'_> {
-                type Output = Batches;
-                fn visit<const N: usize, C: Constraint<N>>(self, family: Family, _: &C) -> Batches {
-                    let set = self.simulation.constraints(family);
-                    let constraints = (0..set.len())
-                        .map(|c| {
-                            let particles: [u32; N] = std::array::from_fn(|k| {
-                                self.renumber[set.particles(c)[k] as usize]
-                            });
-                            (particles, set.rest()[c] as f32)
-                        })
-                        .collect();
-                    Batches::new(constraints, self.inverse_masses)
-                }
-            }
-            family.visit(Build {
-                simulation,
-                renumber: &renumber,
-                inverse_masses: &inverse_masses,
+            let binding = family.row().binding;
+            let per_element = batches::per_element(binding);
+            let rest = simulation.constraints(family).rest();
+            Batches::new(layouts.of(binding), per_element, |element, k| {
+                rest[element as usize * per_element + k] as f32
             })
         });
-        debug_assert!(sets.iter_ref().all(|(_, b)| b.colouring_is_valid(n)));
+        debug_assert!(layouts.edges.colouring_is_valid(n) && layouts.tets.colouring_is_valid(n));
         let positions = take(simulation.positions());
         #[cfg(not(feature = "parallel"))]
         let _ = threads;
@@ -187,6 +279,7 @@ impl FastSimulation {
             inverse_masses,
             original,
             renumber,
+            layouts,
             sets,
             tets: simulation.tets().len(),
             jacobi: None,
@@ -219,8 +312,8 @@ impl FastSimulation {
             self.inverse_masses[new] = inverse_masses[old] as f32;
         }
         self.previous.copy_from_slice(&self.positions);
-        for family in self.settings.active.families() {
-            self.sets[family].set_weights(&self.inverse_masses);
+        for layout in self.layouts.all_mut() {
+            layout.set_weights(&self.inverse_masses);
         }
     }
 
@@ -267,8 +360,13 @@ impl FastSimulation {
     }
 
     /// The constraints of `family`, coloured and in batches (empty when it is not active).
-    pub fn batches(&self, family: Family) -> &Batches {
-        &self.sets[family]
+    pub fn batches(&self, family: Family) -> FamilyBatches<'_> {
+        let binding = family.row().binding;
+        FamilyBatches {
+            layout: self.layouts.of(binding),
+            batches: &self.sets[family],
+            binding,
+        }
     }
 
     /// Projects in `order` from now on (Gauss–Seidel unless set).
@@ -286,7 +384,8 @@ impl FastSimulation {
                     relaxation,
                     sums: vec![Vec3A::ZERO; self.positions.len()],
                     factors: PerFamily::build(|family| {
-                        factors(self.sets[family].constraints_per_particle())
+                        let n = self.positions.len();
+                        factors(self.batches(family).constraints_per_particle(n))
                     }),
                 })
             }
@@ -307,7 +406,7 @@ impl FastSimulation {
     /// rest value of zero counts as one).
     pub fn relative_error(&self) -> PerFamily<Option<f64>> {
         struct RelativeError<'a> {
-            batches: &'a Batches,
+            batches: FamilyBatches<'a>,
             positions: &'a [Vec3A],
             rest_positions: &'a [Vec3A],
         }
@@ -332,7 +431,7 @@ impl FastSimulation {
         PerFamily::from_fn(|family| {
             active[family].then(|| {
                 family.visit(RelativeError {
-                    batches: &self.sets[family],
+                    batches: self.batches(family),
                     positions: &self.positions,
                     rest_positions: &self.rest_positions,
                 })
@@ -395,7 +494,7 @@ impl FastSimulation {
     /// Constraint projections one frame makes with the current settings.
     pub fn projections_per_frame(&self) -> u64 {
         self.settings
-            .projections_per_frame(PerFamily::from_fn(|f| self.sets[f].len()))
+            .projections_per_frame(PerFamily::from_fn(|f| self.batches(f).len()))
     }
 
     /// The bytes of memory the solver's arrays take.
@@ -406,12 +505,18 @@ impl FastSimulation {
             + self.rest_positions.capacity())
             * size_of::<Vec3A>()
             + self.inverse_masses.capacity() * size_of::<f32>()
-            + self.original.capacity() * size_of::<u32>()
+            + (self.original.capacity() + self.renumber.capacity()) * size_of::<u32>()
+            + self.layouts.edges.heap_bytes()
+            + self.layouts.tets.heap_bytes()
             + self
                 .sets
                 .iter_ref()
                 .map(|(_, b)| b.heap_bytes())
                 .sum::<usize>()
+            + (self.corrections.predicted.capacity()
+                + self.corrections.last.capacity()
+                + self.corrections.frame.capacity())
+                * size_of::<Vec3A>()
             + self.jacobi.as_ref().map_or(0, |j| {
                 j.sums.capacity() * size_of::<Vec3A>()
                     + j.factors
@@ -559,6 +664,7 @@ impl FastSimulation {
             let sums = self.jacobi.as_mut().map(|j| &mut j.sums[..]);
             if let Some(partner) = family.partner_in(&active) {
                 struct ProjectPair<'a> {
+                    layout: &'a Layout,
                     batches: (&'a mut Batches, &'a mut Batches),
                     positions: &'a mut [Vec3A],
                     rest_positions: &'a mut [Vec3A],
@@ -581,6 +687,7 @@ impl FastSimulation {
                     ) -> usize {
                         kernel::project_pair::<N, A, M, B>(
                             (first, second),
+                            self.layout,
                             self.batches,
                             self.positions,
                             self.rest_positions,
@@ -594,6 +701,7 @@ impl FastSimulation {
                 let count = family.visit_pair(
                     partner,
                     ProjectPair {
+                        layout: self.layouts.of(family.row().binding),
                         batches: self.sets.pair_mut(family, partner),
                         positions: &mut self.positions,
                         rest_positions: &mut self.rest_positions,
@@ -612,6 +720,8 @@ impl FastSimulation {
                 continue;
             }
             struct Project<'a> {
+                layout: &'a Layout,
+                binding: Binding,
                 batches: &'a mut Batches,
                 positions: &'a mut [Vec3A],
                 rest_positions: &'a mut [Vec3A],
@@ -619,12 +729,13 @@ impl FastSimulation {
                 rule: Rule<f64>,
                 parallel: bool,
             }
-            impl Visit for Project<'_> {
-                type Output = usize;
+            impl Project<'_> {
+                /// The kernel for K constraints per element.
                 #[inline]
-                fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> usize {
-                    kernel::project_family::<N, C>(
+                fn with<const N: usize, C: Constraint<N>, const K: usize>(self, c: &C) -> usize {
+                    kernel::project_family::<N, C, K>(
                         c,
+                        self.layout,
                         self.batches,
                         self.positions,
                         self.rest_positions,
@@ -634,7 +745,21 @@ impl FastSimulation {
                     )
                 }
             }
+            impl Visit for Project<'_> {
+                type Output = usize;
+                #[inline]
+                fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> usize {
+                    // Constraints per element, a constant of each instance of the kernel.
+                    match self.binding {
+                        Binding::TetVertices => self.with::<N, C, 4>(c),
+                        _ => self.with::<N, C, 1>(c),
+                    }
+                }
+            }
+            let binding = family.row().binding;
             let count = family.visit(Project {
+                layout: self.layouts.of(binding),
+                binding,
                 batches: &mut self.sets[family],
                 positions: &mut self.positions,
                 rest_positions: &mut self.rest_positions,
@@ -756,9 +881,9 @@ mod tests {
             assert_eq!(two.threads(), 2);
             assert!(
                 two.batches(Family::VOLUME)
-                    .colours
+                    .colours()
                     .iter()
-                    .any(|c| c.constraints >= PARALLEL_MIN),
+                    .any(|c| c.elements >= PARALLEL_MIN),
                 "some colour is large enough to be shared"
             );
             for _ in 0..5 {

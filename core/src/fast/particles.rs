@@ -47,6 +47,14 @@ impl<'a> Particles<'a> {
         padded(unsafe { self.ptr.add(i as usize).read() })
     }
 
+    /// Puts particle `i` at the first three lanes of `position`.
+    #[inline(always)]
+    pub(crate) fn set(self, i: u32, position: f32x4) {
+        debug_assert!((i as usize) < self.len);
+        // SAFETY: as for `get`; and no other thread reads or writes particle i meanwhile.
+        unsafe { self.ptr.add(i as usize).write(unpadded(position)) }
+    }
+
     /// Moves particle `i` by the first three lanes of `delta` (its fourth is zero).
     #[inline(always)]
     pub(crate) fn add(self, i: u32, delta: f32x4) {

@@ -27,12 +27,11 @@ pub enum Engine {
     Fast,
 }
 
-/// The size from which [`Engine::Auto`] picks the fast engine. Below it the reference solver
-/// holds 60 frames a second at the default 100 substeps (a 384-tet cube with edges + volume
-/// takes 5 ms a frame); above it the reference solver does not (the 1351-tet bunny takes 19 ms,
-/// the 3717-tet armadillo with all three families 60 ms; docs/performance.md), while the
-/// built-in teaching scenes and every lesson's scene but the bunny stay below it, on the exact
-/// path.
+/// The size from which [`Engine::Auto`] picks the fast engine. The reference solver's frame
+/// grows with the tets, about 19 µs a tet at the default 100 substeps with edges + volume (the
+/// 384-tet cube: 7.3 ms a frame; the 1351-tet bunny: 24 ms, where the fast engine takes 4.1;
+/// docs/performance.md): from about 900 tets it no longer holds 60 frames a second. The built-in
+/// teaching scenes and every lesson's scene but the bunny stay below it, on the exact path.
 pub const FAST_FROM_TETS: usize = 1000;
 
 impl Engine {

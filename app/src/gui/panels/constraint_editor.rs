@@ -139,10 +139,10 @@ impl ConstraintEditor {
                 let name = example.file.trim_end_matches(".toml");
                 if ui
                     .small_button(name)
-                    .on_hover_text(format!("assets/constraints/{}", example.file))
+                    .on_hover_text(example.shown().display().to_string())
                     .clicked()
                 {
-                    compiled = self.set_text(Path::new(example.path), example.text);
+                    compiled = self.set_text(&example.shown(), example.text);
                 }
             }
         });

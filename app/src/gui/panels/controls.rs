@@ -8,6 +8,9 @@ use eframe::egui;
 use tetlab_core::scene::Builtin;
 use tetlab_core::stepper::{Advanced, Next};
 
+/// The largest resolution the scene panel offers (a cube of 196 608 tets).
+const MAX_RESOLUTION: u32 = 32;
+
 /// A scene the user asked for.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SceneRequest {
@@ -150,7 +153,13 @@ impl Panel for Controls {
                     }
                 });
         });
-        ui.add(egui::Slider::new(&mut choice.resolution, 1..=12).text("resolution"));
+        // Up to a 196 608-tet cube: big meshes are drawn as a body and run on the fast engine.
+        ui.add(
+            egui::Slider::new(&mut choice.resolution, 1..=MAX_RESOLUTION)
+                .logarithmic(true)
+                .text("resolution"),
+        )
+        .on_hover_text("cells along a side: a cube of resolution n has 6n³ tets (15: 20 250)");
         if ui.button("Load built-in scene").clicked() {
             let builtin = Builtin::from_name(&choice.builtin).unwrap_or(Builtin::Cube);
             requests.push(Request::Scene(SceneRequest::Builtin(
