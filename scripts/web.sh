@@ -2,7 +2,8 @@
 # Builds the workbench as a static web page: the folder it writes (site/ by default, or $1) can be
 # served by any static file server, e.g. `python3 -m http.server -d site 8000`.
 # Installs what it needs when missing: the wasm32 target (rustup) and wasm-bindgen-cli of the
-# version in Cargo.lock (cargo install). Prints the size of the .wasm, plain and gzipped.
+# version in Cargo.lock (cargo install). Runs wasm-opt where the machine has it. Prints the size of
+# the .wasm, plain and gzipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-site}"
@@ -24,6 +25,18 @@ wasm-bindgen --target web --no-typescript --out-dir "$out" \
 cp web/index.html "$out/index.html"
 
 wasm="$out/tetlab_bg.wasm"
+# Binaryen's optimiser, where the machine has one that understands wasm-bindgen's externref
+# table (binaryen 116 and later: `cargo install wasm-opt`). Debian 12's binaryen (108) breaks it:
+# the page then fails with "WebAssembly.Table.set(): Argument 1 is invalid".
+opt_version=$(wasm-opt --version 2>/dev/null | grep -o 'version [0-9]*' | grep -o '[0-9]*' || true)
+if [ -n "$opt_version" ] && [ "$opt_version" -ge 116 ]; then
+  echo "== wasm-opt -Oz (binaryen $opt_version)"
+  wasm-opt -Oz --enable-bulk-memory --enable-nontrapping-float-to-int --enable-sign-ext \
+    --enable-mutable-globals --enable-reference-types --enable-multivalue "$wasm" -o "$wasm.opt"
+  mv "$wasm.opt" "$wasm"
+else
+  echo "== no wasm-opt of binaryen 116 or later (found: ${opt_version:-none}): the page is not optimised further"
+fi
 bytes=$(stat -c %s "$wasm")
 gzipped=$(gzip -9 -c "$wasm" | wc -c)
 echo "wrote $out: tetlab_bg.wasm $bytes bytes ($gzipped gzipped); serve it with: python3 -m http.server -d $out 8000"

@@ -9,7 +9,7 @@ use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use gui_support::{click_at, pixels_like, workbench};
-use tetlab::gui::{TetlabApp, viewport};
+use tetlab::gui::{Preferences, TetlabApp, viewport};
 use tetlab_core::visual;
 
 #[test]
@@ -294,6 +294,46 @@ fn a_bad_mesh_file_shows_an_error_and_keeps_the_scene() {
         48,
         "the cube stays"
     );
+}
+
+/// "Copy link" puts a link to the state on the clipboard (and says so): the scene, the edits and
+/// the camera; a second workbench opened on it shows the same body, bit for bit.
+#[test]
+fn copy_link_gives_a_link_that_opens_the_same_state() {
+    let mut harness = workbench("cube", 2);
+    harness.key_press(egui::Key::M);
+    harness.run_steps(1);
+    harness.get_by_label("Copy link").click();
+    harness.run_steps(1);
+    let copied = harness
+        .output()
+        .platform_output
+        .commands
+        .iter()
+        .find_map(|command| match command {
+            egui::OutputCommand::CopyText(text) => Some(text.clone()),
+            _ => None,
+        })
+        .expect("the link is copied");
+    let (page, fragment) = copied.split_once('#').expect("a fragment");
+    assert_eq!(page, tetlab::gui::link::page_url());
+    assert!(
+        fragment.starts_with("scene=cube&resolution=2") && fragment.contains("edits=mirror"),
+        "{fragment}"
+    );
+    harness.run_steps(1);
+    harness.get_by_label_contains("link copied");
+
+    let mut student = TetlabApp::with_preferences(Preferences::default());
+    student.open_fragment(fragment);
+    assert_eq!(student.error, None);
+    let teacher = harness.state();
+    assert_eq!(
+        student.bench.simulation.positions(),
+        teacher.bench.simulation.positions()
+    );
+    assert_eq!(student.viewport.camera, teacher.viewport.camera);
+    assert_eq!(student.bench.metrics.inverted_tets, 48);
 }
 
 /// Writes the screenshot in the README: a corner tet of a 3³ cube inverted by hand, red, with the

@@ -34,6 +34,21 @@ pub fn start() {
     });
 }
 
+/// The page's URL fragment (`#…`, or empty): a link to a state ([`crate::gui::link`]).
+pub fn fragment() -> String {
+    web_sys::window()
+        .and_then(|w| w.location().hash().ok())
+        .unwrap_or_default()
+}
+
+/// The page's address without its fragment: what a link to a state starts with.
+pub fn page_address() -> String {
+    let href = web_sys::window()
+        .and_then(|w| w.location().href().ok())
+        .unwrap_or_default();
+    href.split('#').next().unwrap_or_default().to_owned()
+}
+
 /// Writes a line to the browser console.
 pub fn log(line: &str) {
     web_sys::console::log_1(&line.into());

@@ -19,10 +19,9 @@ pub fn workbench(scene: &str, resolution: u32) -> Harness<'static, TetlabApp> {
         .wgpu()
         .build_eframe(move |cc| {
             let mut app = TetlabApp::new(cc).expect("the wgpu renderer is there");
-            app.load(
-                tetlab_core::scene::Scene::from_spec(&preferences.scene.builtin, resolution)
-                    .unwrap(),
-            );
+            let builtin = tetlab_core::scene::Builtin::from_name(&preferences.scene.builtin)
+                .expect("a built-in scene");
+            app.load_builtin(builtin, resolution).unwrap();
             app.controls.scene = preferences.scene.clone();
             app.freeze_timings(
                 std::time::Duration::from_millis(2),

@@ -71,6 +71,14 @@ impl OrbitCamera {
         projection * view
     }
 
+    /// Brings a camera read from outside (a link) within the ranges the controls keep: the
+    /// pitch short of straight up or down, the distance and target within 10⁶.
+    pub fn keep_in_range(&mut self) {
+        self.pitch = self.pitch.clamp(-1.56, 1.56);
+        self.distance = self.distance.clamp(1e-3, 1e6);
+        self.target = self.target.clamp(Vec3::splat(-1e6), Vec3::splat(1e6));
+    }
+
     /// Turns the camera by a pointer movement of `delta` points.
     pub fn orbit(&mut self, delta: Vec2) {
         self.yaw -= delta.x * 0.008;

@@ -8,6 +8,7 @@ pub mod browser;
 pub mod camera;
 pub mod files;
 pub mod geometry;
+pub mod link;
 pub mod panels;
 pub mod render;
 pub mod request;
@@ -18,6 +19,7 @@ pub mod workbench;
 use eframe::egui;
 use files::Opened;
 use geometry::{SceneCache, ViewOptions};
+use link::Link;
 use panels::compare::ComparePanel;
 use panels::constraint_editor::ConstraintEditor;
 use panels::controls::{Controls, SceneChoice, SceneRequest};
@@ -69,22 +71,39 @@ impl Default for Preferences {
 
 const STORAGE_KEY: &str = "tetlab";
 
-/// Adds DejaVu Sans Mono after egui's own fonts, for the glyphs of the formulas (∇ ₀ ⅙ × λ Δ …)
-/// that egui's fonts lack.
+/// The fonts: on the desktop, egui's own with DejaVu Sans Mono after them, for the glyphs of the
+/// formulas (∇ ₀ ⅙ × λ Δ …) that egui's fonts lack; in a browser, to keep the page small, only
+/// Ubuntu Light and DejaVu Sans Mono cut to the characters tetlab shows (`scripts/web-fonts.sh`).
 pub fn install_fonts(ctx: &egui::Context) {
+    let font = |bytes: &'static [u8]| std::sync::Arc::new(egui::FontData::from_static(bytes));
     let mut fonts = egui::FontDefinitions::default();
-    fonts.font_data.insert(
-        "DejaVuSansMono".into(),
-        std::sync::Arc::new(egui::FontData::from_static(include_bytes!(
-            "../../../assets/fonts/DejaVuSansMono.ttf"
-        ))),
-    );
-    for family in [egui::FontFamily::Proportional, egui::FontFamily::Monospace] {
+    #[cfg(not(target_arch = "wasm32"))]
+    let (proportional, monospace) = {
+        let dejavu = include_bytes!("../../../assets/fonts/DejaVuSansMono.ttf");
         fonts
-            .families
-            .entry(family)
-            .or_default()
-            .push("DejaVuSansMono".into());
+            .font_data
+            .insert("DejaVuSansMono".into(), font(dejavu));
+        (vec!["DejaVuSansMono"], vec!["DejaVuSansMono"])
+    };
+    #[cfg(target_arch = "wasm32")]
+    let (proportional, monospace) = {
+        let dejavu = include_bytes!("../../../assets/fonts/web/DejaVuSansMono-subset.ttf");
+        let ubuntu = include_bytes!("../../../assets/fonts/web/Ubuntu-Light-subset.ttf");
+        fonts
+            .font_data
+            .insert("DejaVuSansMono".into(), font(dejavu));
+        fonts.font_data.insert("Ubuntu-Light".into(), font(ubuntu));
+        (
+            vec!["Ubuntu-Light", "DejaVuSansMono"],
+            vec!["DejaVuSansMono", "Ubuntu-Light"],
+        )
+    };
+    for (family, names) in [
+        (egui::FontFamily::Proportional, proportional),
+        (egui::FontFamily::Monospace, monospace),
+    ] {
+        let list = fonts.families.entry(family).or_default();
+        list.extend(names.into_iter().map(String::from));
     }
     ctx.set_fonts(fonts);
 }
@@ -143,6 +162,15 @@ pub struct TetlabApp {
     pub help: Help,
     /// Frames drawn so far (the first one is announced in a browser).
     frames_drawn: u64,
+    /// The built-in scene shown and its resolution (`None` for a mesh file or a lesson's scene):
+    /// what a link names.
+    builtin_shown: Option<(Builtin, u32)>,
+    /// The built-in lesson open (its number, from 1): what a link names.
+    lesson_number: Option<usize>,
+    /// A link just made, to copy to the clipboard on this frame.
+    link_to_copy: Option<String>,
+    /// The last thing done that is worth a line (a link copied); not an error.
+    pub notice: Option<String>,
     /// Dropped files read in the background.
     #[cfg(target_arch = "wasm32")]
     inbox: files::Inbox,
@@ -172,6 +200,20 @@ impl TetlabApp {
             .storage
             .and_then(|s| eframe::get_value(s, STORAGE_KEY))
             .unwrap_or_default();
+        // A page opened by a link shows the link's state, from the defaults.
+        #[cfg(target_arch = "wasm32")]
+        {
+            let fragment = crate::web::fragment();
+            if !fragment.trim_start_matches('#').is_empty() {
+                let mut app = TetlabApp::with_preferences(Preferences::default());
+                app.open_fragment(&fragment);
+                match &app.error {
+                    Some(error) => crate::web::log(&format!("tetlab: link not opened: {error}")),
+                    None => crate::web::log("tetlab: link opened"),
+                }
+                return Ok(app);
+            }
+        }
         Ok(TetlabApp::with_preferences(preferences))
     }
 
@@ -185,6 +227,7 @@ impl TetlabApp {
         }
         let builtin = Builtin::from_name(&preferences.scene.builtin).unwrap_or(Builtin::Cube);
         let bench = Workbench::builtin(builtin, preferences.scene.resolution, preferences.settings);
+        let shown_resolution = preferences.scene.resolution.clamp(1, 16);
         let cache = SceneCache::new(&bench.scene.mesh);
         let viewport = Viewport::default();
         TetlabApp {
@@ -217,6 +260,10 @@ impl TetlabApp {
             inspector: Inspector::default(),
             help: Help::default(),
             frames_drawn: 0,
+            builtin_shown: Some((builtin, shown_resolution)),
+            lesson_number: None,
+            link_to_copy: None,
+            notice: None,
             #[cfg(target_arch = "wasm32")]
             inbox: files::Inbox::default(),
             #[cfg(not(target_arch = "wasm32"))]
@@ -251,11 +298,13 @@ impl TetlabApp {
         self.viewport.frame();
         self.comparison = None;
         self.error = None;
+        self.builtin_shown = None;
     }
 
     /// Opens a lesson at its first step: its scene, settings and tet. A lesson that brings
     /// constraint files puts the first in the editor, where its exercise is done.
     pub fn open_lesson(&mut self, lesson: Lesson) {
+        self.lesson_number = None;
         if let Some(&family) = lesson.families.first()
             && let Some(file) = family.file()
         {
@@ -362,13 +411,84 @@ impl TetlabApp {
     }
 
     fn request(&mut self, request: SceneRequest) {
-        let opened = match request {
-            SceneRequest::Builtin(builtin, resolution) => Scene::builtin(builtin, resolution)
-                .map(Opened::Scene)
-                .map_err(|e| e.to_string()),
-            SceneRequest::File(path) => files::open_path(&path),
-        };
-        self.opened(opened);
+        match request {
+            SceneRequest::Builtin(builtin, resolution) => {
+                if let Err(why) = self.load_builtin(builtin, resolution) {
+                    self.error = Some(why);
+                }
+            }
+            SceneRequest::File(path) => self.opened(files::open_path(&path)),
+        }
+    }
+
+    /// Loads a built-in scene ([`TetlabApp::load`]), which a link can then name.
+    pub fn load_builtin(&mut self, builtin: Builtin, resolution: u32) -> Result<(), String> {
+        let scene = Scene::builtin(builtin, resolution).map_err(|e| e.to_string())?;
+        self.load(scene);
+        self.builtin_shown = Some((builtin, resolution));
+        Ok(())
+    }
+
+    /// A link to the state shown: the built-in scene, the settings, the lesson and its step, the
+    /// camera, and the edits made since the scene was loaded.
+    pub fn link(&self) -> Link {
+        Link {
+            scene: self.builtin_shown,
+            settings: *self.bench.simulation.settings(),
+            lesson: self
+                .lesson_number
+                .zip(self.lesson.as_ref().map(|state| state.step)),
+            camera: Some(self.viewport.camera),
+            edits: self.bench.edits.clone(),
+        }
+    }
+
+    /// Shows the state a link describes: its lesson at its step (or its scene), its settings,
+    /// its edits made again, its camera. An edit that does not fit is reported and the rest
+    /// left out.
+    pub fn open_link(&mut self, link: Link) {
+        if let Some((number, step)) = link.lesson {
+            self.lesson_request(LessonRequest::Builtin(number));
+            self.show_lesson = true;
+            for _ in 0..step {
+                self.go_to_step(true);
+            }
+        } else if let Some((builtin, resolution)) = link.scene {
+            self.controls.scene.builtin = builtin.name().to_owned();
+            self.controls.scene.resolution = resolution;
+            self.request(SceneRequest::Builtin(builtin, resolution));
+        }
+        self.set_settings(link.settings);
+        for edit in link.edits {
+            if let Err(why) = self.bench.apply_edit(edit) {
+                self.error = Some(format!("the link's edits: {why}; the later ones left out"));
+                break;
+            }
+        }
+        if let Some(camera) = link.camera {
+            self.viewport.camera = camera;
+        }
+    }
+
+    /// Opens the state of a URL fragment; a fragment that cannot be read leaves the workbench
+    /// as it is, and says why.
+    pub fn open_fragment(&mut self, fragment: &str) {
+        match Link::parse(fragment) {
+            Ok(link) => self.open_link(link),
+            Err(error) => {
+                self.error = Some(format!("{error}; the workbench opened with its defaults"))
+            }
+        }
+    }
+
+    /// The whole link to the state shown: the page's address (in a browser, this page's;
+    /// on the desktop, [`link::page_url`]) and the fragment.
+    pub fn link_url(&self) -> String {
+        #[cfg(target_arch = "wasm32")]
+        let page = crate::web::page_address();
+        #[cfg(not(target_arch = "wasm32"))]
+        let page = link::page_url();
+        format!("{page}#{}", self.link().fragment())
     }
 
     fn opened(&mut self, opened: Result<Opened, String>) {
@@ -416,7 +536,10 @@ impl TetlabApp {
     fn lesson_request(&mut self, request: LessonRequest) {
         match request {
             LessonRequest::Builtin(k) => match Lesson::builtin(k) {
-                Ok(lesson) => self.open_lesson(lesson),
+                Ok(lesson) => {
+                    self.open_lesson(lesson);
+                    self.lesson_number = Some(k);
+                }
                 Err(e) => self.error = Some(e.to_string()),
             },
             LessonRequest::File(path) => self.opened(files::open_path(&path)),
@@ -444,6 +567,14 @@ impl TetlabApp {
         match action {
             Action::FrameView => self.viewport.frame(),
             Action::ResetCamera => self.viewport.reset_camera(),
+            Action::CopyLink => {
+                let url = self.link_url();
+                // On the desktop the link is printed too, for a terminal or a script.
+                #[cfg(not(target_arch = "wasm32"))]
+                println!("{url}");
+                self.notice = Some(format!("link copied ({} characters)", url.len()));
+                self.link_to_copy = Some(url);
+            }
             Action::Inspector => self.inspector.open = !self.inspector.open,
             Action::Help => self.help.open = !self.help.open,
             Action::Lesson => self.show_lesson = !self.show_lesson,
@@ -587,7 +718,12 @@ impl TetlabApp {
 
 /// The top of the left panel: the name, the buttons that open what is not a side panel, and the
 /// last error.
-fn header(ui: &mut egui::Ui, error: Option<&str>, requests: &mut Vec<Request>) {
+fn header(
+    ui: &mut egui::Ui,
+    error: Option<&str>,
+    notice: Option<&str>,
+    requests: &mut Vec<Request>,
+) {
     ui.horizontal(|ui| {
         ui.heading("tetlab");
         for (label, action) in [
@@ -602,6 +738,9 @@ fn header(ui: &mut egui::Ui, error: Option<&str>, requests: &mut Vec<Request>) {
     });
     if let Some(error) = error {
         ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
+    }
+    if let Some(notice) = notice {
+        ui.small(notice);
     }
 }
 
@@ -666,7 +805,12 @@ impl eframe::App for TetlabApp {
                 .default_size(300.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| {
-                        header(ui, self.error.as_deref(), &mut requests);
+                        header(
+                            ui,
+                            self.error.as_deref(),
+                            self.notice.as_deref(),
+                            &mut requests,
+                        );
                         let panels: [&mut dyn Panel; 4] = [
                             &mut self.controls,
                             &mut self.solver,
@@ -718,6 +862,9 @@ impl eframe::App for TetlabApp {
         self.show_browser(&ctx);
         for request in requests {
             self.apply(request);
+        }
+        if let Some(url) = self.link_to_copy.take() {
+            ctx.copy_text(url);
         }
         self.frames_drawn += 1;
         // The first frame is painted before the second runs: ask for a second, and announce then.
@@ -789,6 +936,71 @@ mod tests {
         assert_eq!(restored.scene.builtin, "tet");
         assert_eq!(restored.settings, Preferences::default().settings);
         assert!(restored.settings.settle_edits);
+    }
+
+    /// A link made on one workbench shows the same state on another: the scene, the settings,
+    /// the edits (the same positions, bit for bit), the camera; and a lesson at its step.
+    #[test]
+    fn a_link_shows_the_same_state_on_another_workbench() {
+        let mut teacher = TetlabApp::with_preferences(Preferences::default());
+        teacher.request(SceneRequest::Builtin(Builtin::Cube, 2));
+        let mut settings = *teacher.bench.simulation.settings();
+        settings.active[Family::HEIGHT] = true;
+        settings.substeps = 12;
+        teacher.set_settings(settings);
+        teacher.act(Action::Mirror);
+        teacher.bench.select_tet(5);
+        teacher.act(Action::InvertSelected);
+        teacher.viewport.camera.yaw = 2.0;
+        let url = teacher.link_url();
+        let (_, fragment) = url.split_once('#').unwrap();
+
+        let mut student = TetlabApp::with_preferences(Preferences::default());
+        student.open_fragment(fragment);
+        assert_eq!(student.error, None);
+        assert_eq!(student.bench.scene.name, "cube");
+        assert_eq!(student.bench.simulation.tets().len(), 48);
+        assert_eq!(
+            student.bench.simulation.settings(),
+            teacher.bench.simulation.settings()
+        );
+        assert_eq!(
+            student.bench.simulation.positions(),
+            teacher.bench.simulation.positions()
+        );
+        assert_eq!(student.viewport.camera, teacher.viewport.camera);
+        assert_eq!(student.link(), teacher.link());
+
+        teacher.lesson_request(LessonRequest::Builtin(2));
+        teacher.lesson_request(LessonRequest::Next);
+        let mut student = TetlabApp::with_preferences(Preferences::default());
+        student.open_fragment(&teacher.link().fragment());
+        let state = student.lesson.as_ref().expect("the lesson is open");
+        assert_eq!(state.step, 1);
+        assert_eq!(
+            state.lesson.title,
+            teacher.lesson.as_ref().unwrap().lesson.title
+        );
+    }
+
+    /// A fragment that cannot be read leaves the defaults and says which key was wrong.
+    #[test]
+    fn a_malformed_link_falls_back_to_the_defaults_with_a_message() {
+        let mut app = TetlabApp::with_preferences(Preferences::default());
+        let before = *app.bench.simulation.settings();
+        app.open_fragment("#scene=cube&substeps=lots");
+        let error = app.error.as_deref().unwrap();
+        assert!(error.contains("'substeps'"), "{error}");
+        assert!(error.contains("defaults"), "{error}");
+        assert_eq!(*app.bench.simulation.settings(), before);
+
+        let mut app = TetlabApp::with_preferences(Preferences::default());
+        app.open_fragment("#scene=tet&edits=tet:9:0");
+        let error = app.error.as_deref().unwrap();
+        assert!(
+            error.contains("tet 9 is not in a body of 1 tets"),
+            "{error}"
+        );
     }
 
     #[test]

@@ -51,6 +51,8 @@ pub enum Action {
     DoStep,
     /// Show or hide the help.
     Help,
+    /// Copy a link to this state (a button; no key).
+    CopyLink,
 }
 
 /// Every shortcut: key, action, what the help says.

@@ -64,6 +64,23 @@ pub struct Workbench {
     /// Grows with every change of the simulation's state: what the view compares to know whether
     /// to draw again.
     revision: u64,
+    /// The edits made since the scene was loaded or reset, in order (what a link replays;
+    /// particles dragged are not among them).
+    pub edits: Vec<Edit>,
+}
+
+/// An edit of the body, made from the tools or by a lesson, that a link can replay.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Edit {
+    /// A perturbation of the whole body.
+    Perturb(Perturbation),
+    /// `particle` reflected through the opposite face of `tet` ([`Workbench::invert_selected`]).
+    InvertTet {
+        /// The tet.
+        tet: usize,
+        /// Its corner that was reflected.
+        particle: usize,
+    },
 }
 
 impl Workbench {
@@ -86,6 +103,7 @@ impl Workbench {
             last_advance: None,
             diverged: None,
             revision: 0,
+            edits: Vec::new(),
         };
         workbench.select_tet(0);
         workbench.record();
@@ -114,6 +132,7 @@ impl Workbench {
         twin.selected_particle = self.selected_particle;
         twin.selected_tet = self.selected_tet;
         twin.scramble_seed = self.scramble_seed;
+        twin.edits = self.edits.clone();
         twin.after_change();
         twin
     }
@@ -171,6 +190,7 @@ impl Workbench {
         self.last_advance = None;
         self.simulation.reset();
         self.history.clear();
+        self.edits.clear();
         self.after_change();
     }
 
@@ -178,6 +198,7 @@ impl Workbench {
     pub fn perturb(&mut self, perturbation: Perturbation) {
         self.finish_substep();
         self.simulation.perturb(perturbation);
+        self.edits.push(Edit::Perturb(perturbation));
         self.after_change();
     }
 
@@ -185,6 +206,27 @@ impl Workbench {
     pub fn scramble(&mut self) {
         self.perturb(Perturbation::Scramble(self.scramble_seed));
         self.scramble_seed += 1;
+    }
+
+    /// Makes `edit` again (a link's edits, replayed); an edit that does not fit this body (a tet
+    /// it does not have, or a particle not its corner) is refused with a message.
+    pub fn apply_edit(&mut self, edit: Edit) -> Result<(), String> {
+        match edit {
+            Edit::Perturb(perturbation) => self.perturb(perturbation),
+            Edit::InvertTet { tet, particle } => {
+                let tets = self.simulation.tets();
+                let Some(corners) = tets.get(tet) else {
+                    return Err(format!("tet {tet} is not in a body of {} tets", tets.len()));
+                };
+                if !corners.contains(&(particle as u32)) {
+                    return Err(format!("particle {particle} is not a corner of tet {tet}"));
+                }
+                self.selected_tet = Some(tet);
+                self.selected_particle = Some(particle);
+                self.invert_selected();
+            }
+        }
+        Ok(())
     }
 
     /// Reflects the selected particle through the opposite face of the selected tet: that tet
@@ -201,6 +243,7 @@ impl Workbench {
         let mut positions = self.simulation.positions().to_vec();
         reflect_through_opposite_face(&mut positions, &corners, k);
         self.simulation.place(particle, positions[particle]);
+        self.edits.push(Edit::InvertTet { tet, particle });
         self.after_change();
     }
 

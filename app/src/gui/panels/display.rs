@@ -61,5 +61,15 @@ fn show(ui: &mut egui::Ui, options: &mut ViewOptions, tets: usize) -> Option<Act
             action = Some(Action::ResetCamera);
         }
     });
+    // Its own row: the panel does not grow wider for it.
+    if ui
+        .button("Copy link")
+        .on_hover_text(
+            "a link to this state (scene, settings, lesson, camera, edits) for the web page",
+        )
+        .clicked()
+    {
+        action = Some(Action::CopyLink);
+    }
     action
 }
