@@ -3,6 +3,7 @@
 # headless Chromium (installed with apt when missing) and checks that the workbench started and
 # drew the soft body: its "tetlab ready" line in the console, and a screenshot with the body's
 # colour in it. The screenshot is kept at $TETLAB_WEB_SCREENSHOT (default: a temporary folder).
+# Then drives the page through the DevTools protocol (below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v chromium >/dev/null; then
@@ -40,3 +41,16 @@ if [ "$body" -lt 20000 ]; then
   exit 1
 fi
 echo "web page OK"
+
+# Then driven as a user would (tests/web/drive.mjs: puppeteer-core from the npm registry, against
+# Debian's chromium; no browser is downloaded): a tet dragged inside out, Space, M, a lesson and a
+# Gmsh mesh dropped, a broken file dropped; the page's state read after each step, one screenshot
+# per step kept in $TETLAB_WEB_SHOTS (default: a temporary folder).
+if ! command -v npm >/dev/null; then
+  echo "== installing Node.js and npm (for the driven test)"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq nodejs npm >/dev/null
+fi
+echo "== driving the page (tests/web/drive.mjs)"
+npm ci --prefix tests/web --no-audit --no-fund --silent
+node tests/web/drive.mjs "http://127.0.0.1:$port/" "${TETLAB_WEB_SHOTS:-$work/shots}" .

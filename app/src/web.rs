@@ -49,6 +49,24 @@ pub fn page_address() -> String {
     href.split('#').next().unwrap_or_default().to_owned()
 }
 
+thread_local! {
+    /// The workbench's state after its last frame, as JSON.
+    static STATE: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) };
+}
+
+/// Keeps `report` for [`tetlab_state`].
+pub fn publish(report: &crate::gui::report::Report) {
+    let json = serde_json::to_string(report).unwrap_or_default();
+    STATE.with(|state| *state.borrow_mut() = json);
+}
+
+/// The workbench's state after its last frame, as JSON ([`crate::gui::report::Report`]); empty
+/// before the first frame. `web/index.html` makes it `window.tetlab_state()`, for tests.
+#[wasm_bindgen::prelude::wasm_bindgen]
+pub fn tetlab_state() -> String {
+    STATE.with(|state| state.borrow().clone())
+}
+
 /// Writes a line to the browser console.
 pub fn log(line: &str) {
     web_sys::console::log_1(&line.into());

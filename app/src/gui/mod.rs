@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod link;
 pub mod panels;
 pub mod render;
+pub mod report;
 pub mod request;
 pub mod shortcuts;
 pub mod viewport;
@@ -872,6 +873,9 @@ impl eframe::App for TetlabApp {
         if self.frames_drawn == 1 {
             ctx.request_repaint();
         }
+        // What a browser test reads (window.tetlab_state()).
+        #[cfg(target_arch = "wasm32")]
+        crate::web::publish(&self.report());
         #[cfg(target_arch = "wasm32")]
         if self.frames_drawn == 2 {
             crate::web::log(&format!(
@@ -981,6 +985,27 @@ mod tests {
             state.lesson.title,
             teacher.lesson.as_ref().unwrap().lesson.title
         );
+    }
+
+    /// The report a browser test reads: the scene, the inversions, the lesson step and its
+    /// checks, the error.
+    #[test]
+    fn the_report_says_what_the_workbench_shows() {
+        let mut app = TetlabApp::with_preferences(Preferences::default());
+        app.lesson_request(LessonRequest::Builtin(3));
+        app.lesson_request(LessonRequest::Next);
+        let report = app.report();
+        assert_eq!((report.scene.as_str(), report.tets), ("tet", 1));
+        let lesson = report.lesson.expect("the lesson");
+        assert_eq!((lesson.step, lesson.steps), (2, 4));
+        assert_eq!(lesson.checks.len(), 1);
+        assert_eq!(lesson.checks[0].expect, "inverted_tets == 1");
+        assert!(!lesson.checks[0].holds);
+        app.do_step();
+        let report = app.report();
+        assert_eq!(report.inverted_tets, 1);
+        assert!(report.lesson.unwrap().checks[0].holds);
+        assert_eq!(report.link, app.link().fragment());
     }
 
     /// A fragment that cannot be read leaves the defaults and says which key was wrong.

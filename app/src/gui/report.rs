@@ -1,0 +1,123 @@
+//! What the workbench shows, as data: the scene, the inverted tets, whether it plays, the error,
+//! the lesson step and its checks, and where the selected particle and its opposite face are on
+//! the screen. A browser test reads it (`window.tetlab_state()`, `web/index.html`) to drive the
+//! page as a user would and check what happened, without reading pixels.
+
+use super::TetlabApp;
+use super::viewport;
+use glam::DVec3;
+use serde::Serialize;
+
+/// The workbench's state, as [`TetlabApp::report`] gives it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// The scene's name.
+    pub scene: String,
+    /// Its tets.
+    pub tets: usize,
+    /// How many are inverted.
+    pub inverted_tets: usize,
+    /// Frames simulated since the scene was loaded or reset.
+    pub frame: u64,
+    /// Whether the simulation plays.
+    pub playing: bool,
+    /// The error shown, if any.
+    pub error: Option<String>,
+    /// The lesson open, if any.
+    pub lesson: Option<LessonReport>,
+    /// The selected tet's selected corner and the centre of its opposite face, in the page's
+    /// (CSS) pixels, where both are in front of the camera.
+    pub drag: Option<DragReport>,
+    /// The link to this state (its fragment).
+    pub link: String,
+}
+
+/// The lesson open.
+#[derive(Clone, Debug, Serialize)]
+pub struct LessonReport {
+    /// Its title.
+    pub title: String,
+    /// The step shown, from 1.
+    pub step: usize,
+    /// How many steps it has.
+    pub steps: usize,
+    /// What the step expects, and whether it holds now.
+    pub checks: Vec<CheckReport>,
+}
+
+/// One expectation of a lesson step.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckReport {
+    /// The expectation, as the lesson panel writes it.
+    pub expect: String,
+    /// Whether it holds.
+    pub holds: bool,
+}
+
+/// Where to drag to invert the selected tet: from its selected particle through the centre of
+/// the opposite face, as far again beyond it.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct DragReport {
+    /// The selected particle on the screen.
+    pub from: [f32; 2],
+    /// Its reflection through the opposite face's centre, on the screen.
+    pub to: [f32; 2],
+}
+
+impl TetlabApp {
+    /// What the workbench shows now.
+    pub fn report(&self) -> Report {
+        let bench = &self.bench;
+        let lesson = self.lesson.as_ref().map(|state| {
+            let metrics = &bench.metrics;
+            let comparison = self.comparison.as_ref().map(|c| &c.bench.metrics);
+            LessonReport {
+                title: state.lesson.title.clone(),
+                step: state.step + 1,
+                steps: state.lesson.steps.len(),
+                checks: state
+                    .current()
+                    .expect
+                    .iter()
+                    .map(|e| CheckReport {
+                        expect: e.to_string(),
+                        holds: e.check(metrics, comparison).is_some_and(|(_, holds)| holds),
+                    })
+                    .collect(),
+            }
+        });
+        Report {
+            scene: bench.scene.name.clone(),
+            tets: bench.simulation.tets().len(),
+            inverted_tets: bench.metrics.inverted_tets,
+            frame: bench.simulation.frame(),
+            playing: bench.playing,
+            error: self.error.clone(),
+            lesson,
+            drag: self.drag_report(),
+            link: self.link().fragment(),
+        }
+    }
+
+    fn drag_report(&self) -> Option<DragReport> {
+        let bench = &self.bench;
+        let (tet, particle) = (bench.selected_tet?, bench.selected_particle?);
+        let positions = bench.simulation.positions();
+        let corners = bench.simulation.tets().get(tet)?;
+        let others: Vec<DVec3> = corners
+            .iter()
+            .filter(|&&i| i as usize != particle)
+            .map(|&i| positions[i as usize])
+            .collect();
+        let centre = others.iter().sum::<DVec3>() / others.len().max(1) as f64;
+        let p = positions[particle];
+        let beyond = 2.0 * centre - p;
+        let (camera, rect) = (&self.viewport.camera, self.viewport.rect);
+        let from = viewport::project(camera, rect, p)?.0;
+        let to = viewport::project(camera, rect, beyond)?.0;
+        Some(DragReport {
+            from: [from.x, from.y],
+            to: [to.x, to.y],
+        })
+    }
+}

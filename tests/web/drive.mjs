@@ -1,0 +1,139 @@
+// Drives tetlab's web page in headless Chromium (Debian's, through puppeteer-core: no browser is
+// downloaded) as a user would, and checks what the page reports (window.tetlab_state(),
+// app/src/gui/report.rs) after each step; keeps one screenshot per step.
+//
+//   node tests/web/drive.mjs URL SCREENSHOT_FOLDER [REPOSITORY]
+//
+// The steps: drag the selected particle through its opposite face (the tet inverts), Space (it
+// recovers), M (every tet inverted), drop a lesson file and go to its next step (its checks are
+// read), drop a Gmsh mesh (it loads), drop a broken mesh (the page shows the error).
+
+import puppeteer from "puppeteer-core";
+import fs from "node:fs";
+import os from "node:os";
+import path from "node:path";
+
+const [url, shots, repository = "."] = process.argv.slice(2);
+if (!url || !shots) {
+  console.error("usage: node tests/web/drive.mjs URL SCREENSHOT_FOLDER [REPOSITORY]");
+  process.exit(2);
+}
+fs.mkdirSync(shots, { recursive: true });
+
+const browser = await puppeteer.launch({
+  executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
+  headless: true,
+  userDataDir: fs.mkdtempSync(path.join(os.tmpdir(), "tetlab-chromium-")),
+  defaultViewport: { width: 1280, height: 800 },
+  args: [
+    "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
+    "--disable-component-update", "--disable-sync", "--disable-quic",
+    "--enable-unsafe-swiftshader", "--window-size=1280,800",
+  ],
+});
+const page = await browser.newPage();
+const consoleLines = [];
+page.on("console", (message) => consoleLines.push(message.text()));
+page.on("pageerror", (error) => consoleLines.push(`page error: ${error.message}`));
+
+let failed = false;
+let shot = 0;
+const state = () => page.evaluate(() => window.tetlab_state && window.tetlab_state());
+
+/// Waits until `holds(state)` (up to `seconds`), then keeps a screenshot named after the step.
+async function expect(step, holds, seconds = 30) {
+  const deadline = Date.now() + seconds * 1000;
+  let last = null;
+  while (Date.now() < deadline) {
+    last = await state();
+    if (last && holds(last)) break;
+    await new Promise((resolve) => setTimeout(resolve, 100));
+  }
+  shot += 1;
+  const file = path.join(shots, `${String(shot).padStart(2, "0")}-${step}.png`);
+  await page.screenshot({ path: file });
+  const ok = last && holds(last);
+  const summary = last
+    ? `scene ${last.scene}, ${last.inverted_tets} of ${last.tets} inverted, ` +
+      `${last.playing ? "playing" : "paused"}` +
+      (last.lesson ? `, lesson "${last.lesson.title}" step ${last.lesson.step}/${last.lesson.steps}` : "") +
+      (last.error ? `, error: ${last.error}` : "")
+    : "no state";
+  console.log(`${ok ? "ok  " : "FAIL"} ${step}: ${summary} (${file})`);
+  if (!ok) failed = true;
+  return last;
+}
+
+/// Drops a file on the page: the drop event the page's own handler reads.
+async function drop(name, text) {
+  await page.evaluate(({ name, text }) => {
+    const data = new DataTransfer();
+    data.items.add(new File([text], name));
+    const canvas = document.getElementById("tetlab");
+    for (const type of ["dragenter", "dragover", "drop"]) {
+      canvas.dispatchEvent(new DragEvent(type, { dataTransfer: data, bubbles: true, cancelable: true }));
+    }
+  }, { name, text });
+}
+
+try {
+  const started = Date.now();
+  await page.goto(url);
+  const first = await expect("ready", (s) => s.scene && s.tets > 0 && s.drag, 60);
+  console.log(`ready after ${((Date.now() - started) / 1000).toFixed(1)} s`);
+
+  // Drag the selected particle through its opposite face, paused: the tet inverts.
+  const { from, to } = first.drag;
+  await page.mouse.move(from[0], from[1]);
+  await page.mouse.down();
+  await page.mouse.move(to[0], to[1], { steps: 25 });
+  await page.mouse.up();
+  await expect("dragged-through-its-face", (s) => s.inverted_tets >= 1, 10);
+
+  // Space plays: it recovers.
+  await page.keyboard.press("Space");
+  await expect("space-recovers", (s) => s.playing && s.inverted_tets === 0);
+
+  // Pause, then M mirrors: every tet inverted.
+  await page.keyboard.press("Space");
+  await expect("paused", (s) => !s.playing, 10);
+  await page.keyboard.press("KeyM");
+  await expect("m-inverts-every-tet", (s) => s.tets > 0 && s.inverted_tets === s.tets, 10);
+
+  // A lesson file dropped opens; the next step (→) shows its checks.
+  const lessonFile = path.join(repository, "assets/lessons/03-heights.toml");
+  await drop("03-heights.toml", fs.readFileSync(lessonFile, "utf8"));
+  await expect("lesson-dropped", (s) => s.lesson && s.lesson.step === 1, 15);
+  await page.keyboard.press("ArrowRight");
+  const lesson = await expect("lesson-next-step", (s) => s.lesson && s.lesson.step === 2 && s.lesson.checks.length > 0, 10);
+  if (lesson && lesson.lesson) {
+    for (const check of lesson.lesson.checks) {
+      console.log(`     check: ${check.expect} (${check.holds ? "holds" : "not yet"})`);
+    }
+  }
+
+  // A Gmsh mesh dropped loads (the shared ball when it is there, else a one-tet mesh).
+  const ball = path.join(repository, "../shared/meshes/ball_v41.msh");
+  const [meshName, meshText, meshTets] = fs.existsSync(ball)
+    ? ["ball_v41.msh", fs.readFileSync(ball, "utf8"), 1812]
+    : ["one-tet.msh",
+       "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n" +
+       "$Elements\n1\n1 4 2 0 1 1 2 3 4\n$EndElements\n", 1];
+  await drop(meshName, meshText);
+  await expect("mesh-dropped", (s) => s.tets === meshTets && s.scene.startsWith(meshName.replace(".msh", "")), 20);
+
+  // A broken file dropped: the page says what is wrong, and keeps the mesh.
+  await drop("broken.msh", "$MeshFormat\n9.9 0 8\n$EndMeshFormat\n");
+  await expect("bad-file-reported", (s) => s.error && s.error.includes("broken.msh") && s.tets === meshTets, 10);
+} catch (error) {
+  console.log(`FAIL ${error.stack ?? error}`);
+  failed = true;
+} finally {
+  await browser.close();
+}
+if (failed) {
+  console.log("the page's console:");
+  for (const line of consoleLines.slice(-20)) console.log(`  ${line}`);
+  process.exit(1);
+}
+console.log("driven web test OK");
