@@ -46,14 +46,46 @@ pub enum LessonRequest {
 pub struct LessonPanel {
     /// The path typed in the "lesson file" field.
     pub path: String,
+    /// Per built-in lesson, the note that its mesh is not here (read once).
+    missing: Option<Vec<Option<String>>>,
+}
+
+/// What the lesson panel says of a lesson whose mesh file is not here (in a browser, or a clone
+/// without `../shared/meshes`), or `None` when it can be opened.
+pub fn missing_mesh_note(
+    number: usize,
+    header: &tetlab_core::lesson::LessonHeader,
+) -> Option<String> {
+    let mesh = header.missing_mesh()?;
+    let name = std::path::Path::new(mesh)
+        .file_name()
+        .map_or(mesh.into(), |n| n.to_string_lossy());
+    Some(format!(
+        "Lesson {number} needs the mesh {name} (../shared/meshes beside the repository), which is not here."
+    ))
 }
 
 impl Panel for LessonPanel {
     fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
         let comparison = context.comparison.map(|c| c.metrics);
+        // In a browser a lesson on a mesh file cannot be opened (the page has no file system):
+        // say so before it is clicked. On the desktop, opening it says what is missing.
+        let missing = self.missing.get_or_insert_with(|| {
+            BUILTIN
+                .iter()
+                .enumerate()
+                .map(|(k, lesson)| {
+                    let header = lesson.header().ok()?;
+                    cfg!(target_arch = "wasm32")
+                        .then(|| missing_mesh_note(k + 1, &header))
+                        .flatten()
+                })
+                .collect()
+        });
         let request = show(
             ui,
             context.lesson,
+            missing,
             &mut self.path,
             context.classroom,
             &context.bench.metrics,
@@ -68,6 +100,7 @@ impl Panel for LessonPanel {
 fn show(
     ui: &mut egui::Ui,
     state: Option<&LessonState>,
+    missing: &[Option<String>],
     path: &mut String,
     large: bool,
     metrics: &Metrics,
@@ -83,15 +116,23 @@ fn show(
                     s.lesson.source.file_name().and_then(|n| n.to_str())
                         == Some(BUILTIN[k - 1].file)
                 });
+                let note = missing.get(k - 1).and_then(Option::as_deref);
                 if ui
-                    .selectable_label(chosen, k.to_string())
+                    .add_enabled(
+                        note.is_none(),
+                        egui::Button::selectable(chosen, k.to_string()),
+                    )
                     .on_hover_text(BUILTIN[k - 1].file)
+                    .on_disabled_hover_text(note.unwrap_or_default())
                     .clicked()
                 {
                     request = Some(LessonRequest::Builtin(k));
                 }
             }
         });
+        for note in missing.iter().flatten() {
+            ui.small(note);
+        }
         ui.horizontal(|ui| {
             ui.add(
                 egui::TextEdit::singleline(path)
@@ -191,4 +232,26 @@ fn describe(step: &Step) -> String {
         parts.push(format!("{} frames", step.frames));
     }
     parts.join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tetlab_core::lesson::LessonHeader;
+
+    /// A lesson whose mesh is not here is named in the panel, by the mesh's file name; one on a
+    /// built-in scene is not.
+    #[test]
+    fn a_lesson_whose_mesh_is_missing_is_named() {
+        let text = "title = \"t\"\nscene = \"../nowhere/bunny.node\"\n[[step]]\ntext = \"x\"\n";
+        let header = LessonHeader::parse(std::path::Path::new("lessons/x.toml"), text).unwrap();
+        let note = missing_mesh_note(6, &header).expect("the mesh is missing");
+        assert!(
+            note.starts_with("Lesson 6 needs the mesh bunny.node"),
+            "{note}"
+        );
+        let cube = "title = \"c\"\nscene = \"cube\"\n";
+        let header = LessonHeader::parse(std::path::Path::new("x.toml"), cube).unwrap();
+        assert_eq!(missing_mesh_note(1, &header), None);
+    }
 }
