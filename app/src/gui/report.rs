@@ -43,6 +43,10 @@ pub struct LessonReport {
     pub steps: usize,
     /// What the step expects, and whether it holds now.
     pub checks: Vec<CheckReport>,
+    /// Frames the step still plays after "Do it".
+    pub frames_left: u64,
+    /// Whether the step is an exercise (a gradient the student writes or mends).
+    pub exercise: bool,
 }
 
 /// One expectation of a lesson step.
@@ -84,6 +88,8 @@ impl TetlabApp {
                         holds: e.check(metrics, comparison).is_some_and(|(_, holds)| holds),
                     })
                     .collect(),
+                frames_left: state.frames_left,
+                exercise: state.current().exercises().next().is_some(),
             }
         });
         Report {
