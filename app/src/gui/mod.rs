@@ -1005,7 +1005,7 @@ mod tests {
         let report = app.report();
         assert_eq!(report.inverted_tets, 1);
         assert!(report.lesson.unwrap().checks[0].holds);
-        assert_eq!(report.link, app.link().fragment());
+        assert_eq!(report.frame, app.bench.simulation.frame());
     }
 
     /// A fragment that cannot be read leaves the defaults and says which key was wrong.

@@ -28,8 +28,6 @@ pub struct Report {
     /// The selected tet's selected corner and the centre of its opposite face, in the page's
     /// (CSS) pixels, where both are in front of the camera.
     pub drag: Option<DragReport>,
-    /// The link to this state (its fragment).
-    pub link: String,
 }
 
 /// The lesson open.
@@ -101,7 +99,6 @@ impl TetlabApp {
             error: self.error.clone(),
             lesson,
             drag: self.drag_report(),
-            link: self.link().fragment(),
         }
     }
 
