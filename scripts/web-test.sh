@@ -44,8 +44,10 @@ echo "web page OK"
 
 # Then driven as a user would (tests/web/drive.mjs: puppeteer-core from the npm registry, against
 # Debian's chromium; no browser is downloaded): a tet dragged inside out, Space, M, a lesson and a
-# Gmsh mesh dropped, a broken file dropped; the page's state read after each step, one screenshot
-# per step kept in $TETLAB_WEB_SHOTS (default: a temporary folder).
+# Gmsh mesh dropped, a broken file dropped, each exercise graded (a wrong answer, then a right
+# one), lesson 6 on the fetched bunny, then every step of every built-in lesson with its checks
+# (TETLAB_WEB_LESSONS=0 leaves that last part out); the page's state read after each step, one
+# screenshot per step kept in $TETLAB_WEB_SHOTS (default: a temporary folder).
 if ! command -v npm >/dev/null; then
   echo "== installing Node.js and npm (for the driven test)"
   apt-get update -qq

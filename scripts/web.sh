@@ -20,9 +20,29 @@ echo "== building the workbench for wasm32-unknown-unknown"
 cargo build --quiet --locked --profile web --target wasm32-unknown-unknown -p tetlab --bin tetlab
 target="${CARGO_TARGET_DIR:-target}"
 mkdir -p "$out"
-wasm-bindgen --target web --no-typescript --out-dir "$out" \
+wasm-bindgen --target web --no-typescript --remove-name-section --remove-producers-section --out-dir "$out" \
   "$target/wasm32-unknown-unknown/web/tetlab.wasm"
 cp web/index.html "$out/index.html"
+
+# The meshes the built-in lessons name in ../shared/meshes (lesson 6's bunny: a .node and its
+# .ele), copied beside the page when that folder is beside the repository; never committed. The
+# page fetches them from meshes/ (app/src/web.rs); without them it greys those lessons out.
+rm -rf "$out/meshes"
+for name in $(sed -n 's|^scene = ".*shared/meshes/\([^"]*\)".*|\1|p' assets/lessons/*.toml | sort -u); do
+  case "$name" in
+    *.node | *.ele) files="${name%.*}.node ${name%.*}.ele" ;;
+    *) files="$name" ;;
+  esac
+  for file in $files; do
+    if [ -f "../shared/meshes/$file" ]; then
+      mkdir -p "$out/meshes"
+      cp "../shared/meshes/$file" "$out/meshes/$file"
+      echo "== placed ../shared/meshes/$file in $out/meshes/"
+    else
+      echo "== ../shared/meshes/$file is not here: the lessons on it are greyed out in the page"
+    fi
+  done
+done
 
 wasm="$out/tetlab_bg.wasm"
 # Binaryen's optimiser, where the machine has one that understands wasm-bindgen's externref

@@ -19,7 +19,7 @@ fn the_built_in_lessons_are_listed_and_observe_what_they_say() {
     let list = tetlab(&["lesson", "--list"]);
     assert!(list.status.success());
     let text = stdout(&list);
-    assert_eq!(text.lines().count(), 8, "{text}");
+    assert_eq!(text.lines().count(), 9, "{text}");
     assert!(text.contains("02-edges-cannot-uninvert.toml"));
 
     let output = tetlab(&["lesson", "2"]);
@@ -73,6 +73,57 @@ fn the_gradient_exercise_fails_until_the_student_mends_the_file() {
     let output = tetlab(&["lesson", "8", "--constraint-file", broken.to_str().unwrap()]);
     let line = assert_usage_error(&output, "broken.toml:");
     assert!(line.contains("unknown function `crosss`"), "{line}");
+}
+
+/// Lesson 9's exercise starts with no gradient at all: as shipped, its grade says so particle by
+/// particle and the run fails; a wrong answer is named at its particle with a configuration; a
+/// right one passes.
+#[test]
+fn the_write_a_gradient_exercise_is_graded() {
+    let output = tetlab(&["lesson", "9", "--quiet"]);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(text.contains("grade: p0: not written yet"), "{text}");
+
+    let dir = scratch("write");
+    let start = std::fs::read_to_string(asset("constraints/relative-volume.toml")).unwrap();
+    let gradient = "\n[gradient]\n\
+        p1 = \"cross(e2, e3) / (6 * rest)\"\n\
+        p2 = \"cross(e3, e1) / (6 * rest)\"\n\
+        p3 = \"cross(e1, e2) / (6 * rest)\"\n\
+        p0 = \"-(cross(e2, e3) + cross(e3, e1) + cross(e1, e2)) / (6 * rest)\"\n";
+    let answer = dir.join("my-answer.toml");
+    std::fs::write(&answer, format!("{start}{gradient}")).unwrap();
+    let output = tetlab(&[
+        "lesson",
+        "9",
+        "--quiet",
+        "--constraint-file",
+        answer.to_str().unwrap(),
+    ]);
+    let text = stdout(&output);
+    assert!(output.status.success(), "{text}{}", stderr(&output));
+    assert!(text.contains("grade: passed"), "{text}");
+
+    // p2's gradient with its sign lost.
+    let wrong =
+        format!("{start}{gradient}").replace("p2 = \"cross(e3, e1)", "p2 = \"cross(e1, e3)");
+    std::fs::write(&answer, wrong).unwrap();
+    let output = tetlab(&[
+        "lesson",
+        "9",
+        "--quiet",
+        "--constraint-file",
+        answer.to_str().unwrap(),
+    ]);
+    let text = stdout(&output);
+    assert_eq!(output.status.code(), Some(1), "{text}{}", stderr(&output));
+    assert!(text.contains("grade: p2: wrong"), "{text}");
+    assert!(
+        text.contains("grade: p2 is furthest off at p0 = ("),
+        "{text}"
+    );
+    assert!(text.contains("grade: p1: held"), "{text}");
 }
 
 #[test]

@@ -21,6 +21,8 @@ pub fn start() {
             ));
             return;
         };
+        // Before the workbench starts, so that a link to lesson 6 opens like any other.
+        fetch_lesson_meshes().await;
         let started = eframe::WebRunner::new()
             .start(
                 canvas,
@@ -32,6 +34,69 @@ pub fn start() {
             log_error(&format!("tetlab could not start: {error:?}"));
         }
     });
+}
+
+/// Where the page looks for the meshes its lessons need: beside it, in `meshes/`, where
+/// `scripts/web.sh` puts those of `../shared/meshes` when that folder is beside the repository.
+pub const MESHES: &str = "meshes/";
+
+/// Fetches the mesh files of the built-in lessons whose mesh is not built in (lesson 6's bunny,
+/// a `.node` and its `.ele`) from [`MESHES`] and hands them to the library
+/// ([`tetlab_core::text_file::provide`]), so that those lessons open as on the desktop. A file
+/// the site does not have leaves its lesson greyed out in the picker, its note saying why.
+async fn fetch_lesson_meshes() {
+    let mut files: Vec<String> = Vec::new();
+    for lesson in tetlab_core::lesson::BUILTIN {
+        let Some(mesh) = lesson
+            .header()
+            .ok()
+            .and_then(|h| h.missing_mesh().map(str::to_owned))
+        else {
+            continue;
+        };
+        let path = std::path::Path::new(&mesh);
+        let needed = match path.extension().and_then(|e| e.to_str()) {
+            Some("node" | "ele") => vec![path.with_extension("node"), path.with_extension("ele")],
+            _ => vec![path.to_owned()],
+        };
+        for file in needed {
+            if let Some(name) = file.file_name().and_then(|n| n.to_str())
+                && !files.iter().any(|f| f == name)
+            {
+                files.push(name.to_owned());
+            }
+        }
+    }
+    for name in files {
+        let url = format!("{MESHES}{name}");
+        match fetch_text(&url).await {
+            Ok(text) => {
+                log(&format!("tetlab: fetched {url} ({} bytes)", text.len()));
+                tetlab_core::text_file::provide(&name, text);
+            }
+            Err(why) => log(&format!("tetlab: {url} is not on this site ({why})")),
+        }
+    }
+}
+
+/// The text at `url`, or why not.
+async fn fetch_text(url: &str) -> Result<String, String> {
+    use wasm_bindgen_futures::JsFuture;
+    let window = web_sys::window().ok_or("no window")?;
+    let response = JsFuture::from(window.fetch_with_str(url))
+        .await
+        .map_err(|e| format!("{e:?}"))?
+        .dyn_into::<web_sys::Response>()
+        .map_err(|_| "not a response".to_owned())?;
+    if !response.ok() {
+        return Err(format!("HTTP {}", response.status()));
+    }
+    let text = response.text().map_err(|e| format!("{e:?}"))?;
+    JsFuture::from(text)
+        .await
+        .map_err(|e| format!("{e:?}"))?
+        .as_string()
+        .ok_or_else(|| "not text".to_owned())
 }
 
 /// The page's URL fragment (`#…`, or empty): a link to a state ([`crate::gui::link`]).

@@ -67,6 +67,8 @@ pub struct Lesson {
     pub settings: Settings,
     /// The steps, in order.
     pub steps: Vec<Step>,
+    /// The scene as it was built when the lesson was read ([`Lesson::scene`] gives it again).
+    built: Scene,
 }
 
 /// One step of a lesson.
@@ -176,8 +178,8 @@ impl Op {
 
 /// The measure of how far a constraint file's gradient is from automatic differentiation, as a
 /// lesson expects it: `gradient_error.NAME < 1e-6`, NAME a family read from a constraint file
-/// ([`crate::constraint_file::check::gradient_error`]: the largest relative error over random
-/// configurations; infinite when the file gives no gradient).
+/// ([`crate::constraint_file::grade::Grade::error`]: the largest relative error over random
+/// configurations; infinite when the file leaves a particle's gradient out).
 pub const GRADIENT_ERROR: &str = "gradient_error";
 
 impl Expectation {
@@ -250,25 +252,11 @@ impl Expectation {
     }
 }
 
-/// [`crate::constraint_file::check::gradient_error`] of `family`'s file, measured once per
-/// definition of the family (a lesson's checks are shown every frame).
+/// The error of `family`'s gradient against AD as its grade gives it
+/// ([`crate::constraint_file::grade::Grade::error`], worked out once per definition of the
+/// family); infinite for a family without a file.
 fn gradient_error(family: Family) -> f64 {
-    use std::sync::Mutex;
-    static MEASURED: Mutex<Vec<(Family, u64, f64)>> = Mutex::new(Vec::new());
-    let generation = family.generation();
-    let mut measured = MEASURED.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(&(_, _, error)) = measured
-        .iter()
-        .find(|(f, g, _)| *f == family && *g == generation)
-    {
-        return error;
-    }
-    let error = family.file().map_or(f64::INFINITY, |file| {
-        crate::constraint_file::check::gradient_error(&file)
-    });
-    measured.retain(|(f, _, _)| *f != family);
-    measured.push((family, generation, error));
-    error
+    crate::constraint_file::grade::of_family(family).map_or(f64::INFINITY, |g| g.error())
 }
 
 impl fmt::Display for Expectation {
@@ -513,7 +501,8 @@ impl LessonHeader {
     /// The mesh file the lesson needs, when it needs one that is not there.
     pub fn missing_mesh(&self) -> Option<&str> {
         let builtin = crate::scene::Builtin::from_name(&self.scene).is_some();
-        (!builtin && !Path::new(&self.scene).exists()).then_some(self.scene.as_str())
+        let here = crate::text_file::available(Path::new(&self.scene));
+        (!builtin && !here).then_some(self.scene.as_str())
     }
 }
 
@@ -745,12 +734,14 @@ impl Lesson {
             tet,
             settings,
             steps,
+            built: mesh,
         })
     }
 
-    /// The lesson's scene.
+    /// The lesson's scene at rest, as it was built when the lesson was read (so a page that
+    /// fetched the lesson's mesh builds it once, [`Lesson::parse_with`]).
     pub fn scene(&self) -> Scene {
-        Scene::from_spec(&self.scene, self.resolution).expect("checked when the lesson was read")
+        self.built.clone()
     }
 }
 

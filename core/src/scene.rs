@@ -135,7 +135,7 @@ impl Scene {
             return Scene::builtin(builtin, resolution);
         }
         let path = Path::new(spec);
-        if !path.exists() {
+        if !crate::text_file::available(path) {
             return Err(SceneError::Unknown(spec.to_owned()));
         }
         Scene::load(path).map_err(SceneError::Mesh)

@@ -52,11 +52,55 @@ pub fn decode(bytes: &[u8]) -> Result<&str, TextFileError> {
     }
 }
 
-/// The file at `path` as text.
+/// The file at `path` as text; where it cannot be read, a file of that name [`provide`]d by a
+/// front end without a file system.
 pub fn read(path: &Path) -> Result<String, TextFileError> {
-    let bytes = std::fs::read(path).map_err(|e| TextFileError {
-        line: None,
-        message: format!("cannot read: {e}"),
-    })?;
+    let bytes = match std::fs::read(path) {
+        Ok(bytes) => bytes,
+        Err(e) => {
+            return provided(path).ok_or_else(|| TextFileError {
+                line: None,
+                message: format!("cannot read: {e}"),
+            });
+        }
+    };
     decode(&bytes).map(str::to_owned)
+}
+
+/// Files handed over by a front end that has no file system: a web page fetches the meshes its
+/// lessons need from its own site and provides them here, by file name, so that a lesson naming
+/// `../shared/meshes/bunny.node` opens as on the desktop.
+static PROVIDED: std::sync::Mutex<Vec<(String, String)>> = std::sync::Mutex::new(Vec::new());
+
+/// Provides the text of a file named `name` (a file name, no folder) to [`read`] and
+/// [`available`], for paths that end in that name and cannot be read.
+///
+/// ```
+/// use std::path::Path;
+/// use tetlab_core::text_file::{available, provide, read};
+/// let path = Path::new("/nowhere/provided-doctest.node");
+/// assert!(!available(path) && read(path).is_err());
+/// provide("provided-doctest.node", "1 3 0 0\n0 0 0 0\n".into());
+/// assert!(available(path));
+/// assert_eq!(read(path).unwrap(), "1 3 0 0\n0 0 0 0\n");
+/// ```
+pub fn provide(name: &str, text: String) {
+    let mut provided = PROVIDED.lock().unwrap_or_else(|e| e.into_inner());
+    provided.retain(|(n, _)| n != name);
+    provided.push((name.to_owned(), text));
+}
+
+/// The provided text for `path`'s file name, if any.
+fn provided(path: &Path) -> Option<String> {
+    let name = path.file_name()?.to_str()?;
+    let provided = PROVIDED.lock().unwrap_or_else(|e| e.into_inner());
+    provided
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, text)| text.clone())
+}
+
+/// Whether `path` can be read: it exists, or a file of its name was [`provide`]d.
+pub fn available(path: &Path) -> bool {
+    path.exists() || provided(path).is_some()
 }

@@ -285,7 +285,7 @@ fn reverse_and_forward_mode_agree_on_every_example() {
         let file = ConstraintFile::parse(Path::new(example.path), example.text).unwrap();
         let mut worst: f64 = 0.0;
         for (k, points) in configurations(file.arity(), 300, 21).iter().enumerate() {
-            let rest = 0.1 * k as f64 / 300.0;
+            let rest = 0.1 * (k + 1) as f64 / 300.0; // never 0: C = V / rest − 1 needs one
             let forward = file
                 .evaluate(points, rest)
                 .automatic

@@ -6,8 +6,10 @@
 //
 // The steps: drag the selected particle through its opposite face (the tet inverts), Space (it
 // recovers), M (every tet inverted), drop a lesson file and go to its next step (its checks are
-// read), drop a Gmsh mesh (it loads), drop a broken mesh (the page shows the error); with
-// TETLAB_WEB_LESSONS=1, every built-in lesson's steps done and their checks read.
+// read), drop a Gmsh mesh (it loads), drop a broken mesh (the page shows the error); each
+// exercise graded (a wrong answer dropped, then a right one); lesson 6 on the bunny the page
+// fetched; then every built-in lesson's steps done and their checks read (TETLAB_WEB_LESSONS=0
+// leaves that part out).
 
 import puppeteer from "puppeteer-core";
 import fs from "node:fs";
@@ -77,6 +79,42 @@ async function drop(name, text) {
   }, { name, text });
 }
 
+/// The exercises that come with tetlab (as core/tests/exercises.rs grades them): the lesson and
+/// its exercise step, the file the student starts from, a right and a wrong answer made from it,
+/// and the particle the wrong one gets wrong.
+const GRADIENT = `
+[gradient]
+p1 = "cross(e2, e3) / (6 * rest)"
+p2 = "cross(e3, e1) / (6 * rest)"
+p3 = "cross(e1, e2) / (6 * rest)"
+p0 = "-(cross(e2, e3) + cross(e3, e1) + cross(e1, e2)) / (6 * rest)"
+`;
+const EXERCISES = [
+  { lesson: 8, step: 4, file: "height-wrong-sign.toml", wrongParticle: 2,
+    right: (text) => text.replace("g3 = (cross", "g3 = -(cross"),
+    wrong: (text) => text.replace("g3 = (cross", "g3 = -(cross").replace('p2 = "g2"', 'p2 = "n"') },
+  { lesson: 9, step: 2, file: "relative-volume.toml", wrongParticle: 3,
+    right: (text) => text + GRADIENT,
+    wrong: (text) => (text + GRADIENT).replace('p3 = "cross(e1, e2) / (6 * rest)"', 'p3 = "cross(e1, e2) / 6"') },
+];
+
+/// Does the lesson's current step (Enter) and waits until its frames are played; every check
+/// must then hold.
+async function doStep(name) {
+  await page.keyboard.press("Enter");
+  const deadline = Date.now() + 3000;
+  while (Date.now() < deadline) {
+    const s = await state();
+    if (s?.lesson?.frames_left > 0) break;
+    await new Promise((resolve) => setTimeout(resolve, 50));
+  }
+  const done = await expect(`${name}-done`,
+    (s) => s.lesson.frames_left === 0 && s.lesson.checks.every((c) => c.holds), 180);
+  for (const check of done?.lesson?.checks ?? []) {
+    console.log(`     ${check.holds ? "holds" : "FAILS"}: ${check.expect}`);
+  }
+}
+
 try {
   const started = Date.now();
   await page.goto(url);
@@ -122,22 +160,62 @@ try {
        "$Elements\n1\n1 4 2 0 1 1 2 3 4\n$EndElements\n", 1];
   await drop(meshName, meshText);
   await expect("mesh-dropped", (s) => s.tets === meshTets && s.scene.startsWith(meshName.replace(".msh", "")), 20);
+  // It plays (on the fast engine from 1000 tets), then pauses.
+  await page.keyboard.press("Space");
+  await expect("mesh-plays", (s) => s.playing && s.frame >= 10, 60);
+  await page.keyboard.press("Space");
+  await expect("mesh-paused", (s) => !s.playing, 10);
 
   // A broken file dropped: the page says what is wrong, and keeps the mesh.
   await drop("broken.msh", "$MeshFormat\n9.9 0 8\n$EndMeshFormat\n");
   await expect("bad-file-reported", (s) => s.error && s.error.includes("broken.msh") && s.tets === meshTets, 10);
 
+  // The exercises, graded in the page: each opened at its exercise step by a link, a wrong
+  // answer dropped (the grade names its particle and a configuration), then a right one (the
+  // grade passes), then the step done: every check holds.
+  for (const exercise of EXERCISES) {
+    const name = `exercise-${exercise.lesson}`;
+    await page.goto("about:blank");
+    await page.goto(`${url}#lesson=${exercise.lesson}&step=${exercise.step}`);
+    await expect(`${name}-opened`, (s) => s.lesson && s.lesson.step === exercise.step &&
+      s.lesson.exercise && s.lesson.grades.length === 1 && !s.lesson.grades[0].passed, 60);
+    const start = fs.readFileSync(path.join(repository, "assets/constraints", exercise.file), "utf8");
+    await drop(exercise.file, exercise.wrong(start));
+    const p = `p${exercise.wrongParticle}`;
+    const wrong = await expect(`${name}-wrong-answer-graded`, (s) => s.lesson.grades.length === 1 &&
+      !s.lesson.grades[0].passed && s.lesson.grades[0].lines.some((l) => l.startsWith(`${p}: wrong`)) &&
+      s.lesson.grades[0].lines.some((l) => l.startsWith(`${p} is furthest off at p0 = (`)), 20);
+    for (const line of wrong?.lesson?.grades[0]?.lines ?? []) console.log(`     grade: ${line}`);
+    await drop(exercise.file, exercise.right(start));
+    const right = await expect(`${name}-right-answer-graded`,
+      (s) => s.lesson.grades.length === 1 && s.lesson.grades[0].passed, 20);
+    console.log(`     grade: ${right?.lesson?.grades[0]?.lines[0]}`);
+    await doStep(name);
+  }
+
+  // Lesson 6 runs on the bunny, which scripts/web.sh put beside the page from ../shared/meshes.
+  if (fs.existsSync(path.join(repository, "../shared/meshes/bunny.node"))) {
+    await page.goto("about:blank");
+    await page.goto(`${url}#lesson=6`);
+    await expect("lesson-6-on-the-fetched-bunny",
+      (s) => s.lesson && s.lesson.title.startsWith("6.") && s.tets === 1351, 60);
+  } else {
+    console.log("skip lesson 6: ../shared/meshes/bunny.node is not beside the repository");
+  }
+
   // Every built-in lesson, in the page: each step done (Enter) and played to its end, then its
-  // checks read. A lesson whose mesh the page does not have, and exercise steps (a gradient the
-  // student writes), are named and left out. It takes about 12 minutes on a 2-core machine, so
-  // it runs only with TETLAB_WEB_LESSONS=1 (not yet in the test command).
-  for (let lesson = 1; process.env.TETLAB_WEB_LESSONS === "1"; lesson += 1) {
+  // checks read; an exercise step is answered first (a right answer dropped). A lesson whose mesh
+  // the page does not have is named and left out (CI has ../shared/meshes). The view is made
+  // smaller for this part: the software renderer draws each frame in proportion to its pixels.
+  await page.setViewport({ width: 640, height: 400 });
+  for (let lesson = 1; process.env.TETLAB_WEB_LESSONS !== "0"; lesson += 1) {
     await page.goto("about:blank");
     await page.goto(`${url}#lesson=${lesson}`);
     const opened = await expect(`lesson-${lesson}-opened`, (s) => s.lesson || s.error, 60);
     if (!opened || !opened.lesson) {
       if (opened && opened.error && opened.error.includes("there is no lesson")) break;
-      if (opened && opened.error && opened.error.includes(".node")) {
+      if (opened && opened.error && opened.error.includes(".node") &&
+          !fs.existsSync(path.join(repository, "../shared/meshes"))) {
         console.log(`     lesson ${lesson} needs a mesh the page does not have: left out`);
         continue;
       }
@@ -145,19 +223,16 @@ try {
       break;
     }
     for (let step = 1; step <= opened.lesson.steps; step += 1) {
-      await expect(`lesson-${lesson}-step-${step}`, (s) => s.lesson && s.lesson.step === step, 10);
-      const before = await state();
-      if (before.lesson.exercise) {
-        console.log(`     lesson ${lesson} step ${step} is an exercise: left out`);
-      } else {
-        await page.keyboard.press("Enter");
-        await new Promise((resolve) => setTimeout(resolve, 300));
-        const done = await expect(`lesson-${lesson}-step-${step}-done`,
-          (s) => s.lesson.frames_left === 0 && s.lesson.checks.every((c) => c.holds), 180);
-        for (const check of done.lesson.checks) {
-          console.log(`     ${check.holds ? "holds" : "FAILS"}: ${check.expect}`);
-        }
+      const before = await expect(`lesson-${lesson}-step-${step}`,
+        (s) => s.lesson && s.lesson.step === step, 10);
+      if (before?.lesson?.exercise) {
+        const exercise = EXERCISES.find((e) => e.lesson === lesson);
+        const start = fs.readFileSync(path.join(repository, "assets/constraints", exercise.file), "utf8");
+        await drop(exercise.file, exercise.right(start));
+        await expect(`lesson-${lesson}-step-${step}-answered`,
+          (s) => s.lesson.grades.every((g) => g.passed), 20);
       }
+      await doStep(`lesson-${lesson}-step-${step}`);
       await page.keyboard.press("ArrowRight");
     }
   }

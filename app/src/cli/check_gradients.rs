@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraint_file::check::{AGREEMENT, Report, check};
+use tetlab_core::constraint_file::check::{AGREEMENT, Reflection, Report, check};
 use tetlab_core::constraints::Family;
 use tetlab_core::verify::{CONDITIONING, random_check};
 
@@ -198,7 +198,10 @@ fn write_file_report(
         yes(o.rotation_invariant),
         report.rotation
     )?;
-    writeln!(out, "a reflection (x -> -x) leaves C {}", o.reflection)?;
+    match report.reflection {
+        Reflection::Untried => writeln!(out, "a reflection (x -> -x): {}", o.reflection)?,
+        _ => writeln!(out, "a reflection (x -> -x) leaves C {}", o.reflection)?,
+    }
     writeln!(
         out,
         "near-degenerate configurations: {}; C or its gradient undefined at {} (flagged, never NaN)",

@@ -251,6 +251,15 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
             };
             writeln!(out, "{verdict} {expectation} ({measured})").map_err(UsageError::stdout)?;
         }
+        // An exercise's grade: which particles held, and where a wrong one is furthest off.
+        for family in step.exercises() {
+            let Some(grade) = tetlab_core::constraint_file::grade::of_family(family) else {
+                continue;
+            };
+            for (line, _) in grade.lines() {
+                writeln!(out, "  grade: {line}").map_err(UsageError::stdout)?;
+            }
+        }
     }
     if let Some(session) = session
         && let Ending::Interrupted = session.close(clock.frame, out)?

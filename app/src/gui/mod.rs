@@ -55,6 +55,24 @@ pub struct Preferences {
     pub view: ViewOptions,
 }
 
+impl Preferences {
+    /// The preferences `storage` keeps (as JSON, the same on the desktop and in a page, which
+    /// then needs no RON), or the defaults when it keeps none or ones it cannot read.
+    pub fn load(storage: &dyn eframe::Storage) -> Preferences {
+        storage
+            .get_string(STORAGE_KEY)
+            .and_then(|text| serde_json::from_str(&text).ok())
+            .unwrap_or_default()
+    }
+
+    /// Keeps them in `storage`.
+    pub fn save(&self, storage: &mut dyn eframe::Storage) {
+        if let Ok(text) = serde_json::to_string(self) {
+            storage.set_string(STORAGE_KEY, text);
+        }
+    }
+}
+
 impl Default for Preferences {
     /// The solver's defaults, except that edits settle: inverting or dragging by hand is undone
     /// without launching the body out of view.
@@ -197,10 +215,7 @@ impl TetlabApp {
             render_state.adapter.get_info().backend
         ));
         install_fonts(&cc.egui_ctx);
-        let preferences: Preferences = cc
-            .storage
-            .and_then(|s| eframe::get_value(s, STORAGE_KEY))
-            .unwrap_or_default();
+        let preferences = cc.storage.map(Preferences::load).unwrap_or_default();
         // A page opened by a link shows the link's state, from the defaults.
         #[cfg(target_arch = "wasm32")]
         {
@@ -887,7 +902,7 @@ impl eframe::App for TetlabApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, STORAGE_KEY, &self.preferences());
+        self.preferences().save(storage);
     }
 }
 
@@ -916,7 +931,7 @@ mod tests {
     use tetlab_core::constraints::Family;
     use tetlab_core::solver::Method;
 
-    /// What `save` writes, `new` reads back: eframe stores the preferences as RON text.
+    /// What `save` writes, `new` reads back: the preferences as JSON text.
     #[test]
     fn preferences_survive_a_save_and_load() {
         let mut preferences = Preferences::default();
@@ -926,8 +941,8 @@ mod tests {
         preferences.settings.active[Family::HEIGHT] = true;
         preferences.settings.substeps = 7;
         preferences.view.see_through = true;
-        let text = ron::to_string(&preferences).unwrap();
-        let restored: Preferences = ron::from_str(&text).unwrap();
+        let text = serde_json::to_string(&preferences).unwrap();
+        let restored: Preferences = serde_json::from_str(&text).unwrap();
         assert_eq!(restored, preferences);
         let app = TetlabApp::with_preferences(restored);
         assert_eq!(app.bench.scene.name, "ball");
@@ -936,7 +951,8 @@ mod tests {
 
     #[test]
     fn missing_or_old_preferences_fall_back_to_defaults() {
-        let restored: Preferences = ron::from_str("(scene: (builtin: \"tet\"))").unwrap();
+        let restored: Preferences =
+            serde_json::from_str(r#"{"scene": {"builtin": "tet"}}"#).unwrap();
         assert_eq!(restored.scene.builtin, "tet");
         assert_eq!(restored.settings, Preferences::default().settings);
         assert!(restored.settings.settle_edits);

@@ -45,6 +45,19 @@ pub struct LessonReport {
     pub frames_left: u64,
     /// Whether the step is an exercise (a gradient the student writes or mends).
     pub exercise: bool,
+    /// The grade of each gradient the step is an exercise about, as the lesson panel shows it.
+    pub grades: Vec<GradeReport>,
+}
+
+/// A student's gradient, graded ([`tetlab_core::constraint_file::grade::Grade`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct GradeReport {
+    /// The family graded.
+    pub family: String,
+    /// Whether every particle's gradient is written and agrees with automatic differentiation.
+    pub passed: bool,
+    /// What the lesson panel says, a line each.
+    pub lines: Vec<String>,
 }
 
 /// One expectation of a lesson step.
@@ -88,6 +101,18 @@ impl TetlabApp {
                     .collect(),
                 frames_left: state.frames_left,
                 exercise: state.current().exercises().next().is_some(),
+                grades: state
+                    .current()
+                    .exercises()
+                    .filter_map(|family| {
+                        let grade = tetlab_core::constraint_file::grade::of_family(family)?;
+                        Some(GradeReport {
+                            family: family.name().to_owned(),
+                            passed: grade.passed(),
+                            lines: grade.lines().into_iter().map(|(line, _)| line).collect(),
+                        })
+                    })
+                    .collect(),
             }
         });
         Report {

@@ -38,6 +38,8 @@ pub enum Reflection {
     Negated,
     /// Neither.
     Changed,
+    /// Not known: C is undefined with rest 0 everywhere tried (C = V / rest − 1).
+    Untried,
 }
 
 impl Reflection {
@@ -47,6 +49,7 @@ impl Reflection {
             Reflection::Unchanged => "unchanged",
             Reflection::Negated => "negated",
             Reflection::Changed => "changed",
+            Reflection::Untried => "untried (C is undefined with rest 0)",
         }
     }
 }
@@ -96,34 +99,6 @@ impl Report {
     pub fn rotation_invariant(&self) -> bool {
         self.rotation <= INVARIANCE
     }
-}
-
-/// The configurations [`gradient_error`] compares on.
-pub const GRADIENT_ERROR_CONFIGS: usize = 100;
-
-/// The largest relative error of the file's gradient against AD over
-/// [`GRADIENT_ERROR_CONFIGS`] random configurations (seed 1), over every particle it gives a
-/// gradient for: what a lesson expects of a gradient (`gradient_error.NAME < 1e-6`). Infinite when
-/// the file gives none.
-///
-/// ```
-/// use std::path::Path;
-/// use tetlab_core::constraint_file::{ConstraintFile, check::gradient_error};
-/// let text = "name = \"e\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p1) - rest\"\n";
-/// let file = ConstraintFile::parse(Path::new("e.toml"), text).unwrap();
-/// assert_eq!(gradient_error(&file), f64::INFINITY, "no gradient given");
-/// let right = ConstraintFile::parse(Path::new("e.toml"), &format!("{text}[gradient]\np0 = \"normalize(p0 - p1)\"\n")).unwrap();
-/// assert!(gradient_error(&right) < 1e-12);
-/// ```
-pub fn gradient_error(file: &ConstraintFile) -> f64 {
-    let report = check(file, GRADIENT_ERROR_CONFIGS, 1);
-    report
-        .max_relative_error
-        .iter()
-        .flatten()
-        .copied()
-        .reduce(f64::max)
-        .unwrap_or(f64::INFINITY)
 }
 
 /// Whether `points` are far from degenerate: no two closer than [`CONDITIONING`] times the
@@ -176,7 +151,7 @@ pub fn check(file: &ConstraintFile, configs: usize, seed: u64) -> Report {
         near_degenerate: 0,
         undefined: 0,
     };
-    let (mut unchanged, mut negated) = (true, true);
+    let (mut unchanged, mut negated, mut reflected_any) = (true, true, false);
     let mut attempts = 0usize;
     while report.compared < configs && attempts < configs.saturating_mul(100).max(1000) {
         attempts += 1;
@@ -187,7 +162,9 @@ pub fn check(file: &ConstraintFile, configs: usize, seed: u64) -> Report {
             report.skipped += 1;
             continue;
         }
-        let rest = file.value(&points, 0.0) * rng.range(-1.5, 1.5);
+        // A rest value of the size C's own would have: the file's rest expression where it
+        // gives one (C = V / rest − 1 is undefined with rest 0), else C with rest 0.
+        let rest = file.rest_value(&points) * rng.range(-1.5, 1.5);
         let evaluation = file.evaluate(&points, rest);
         let Some(automatic) = evaluation.automatic else {
             report.skipped += 1;
@@ -243,11 +220,15 @@ pub fn check(file: &ConstraintFile, configs: usize, seed: u64) -> Report {
         let raw = file.value(&points, 0.0);
         let mirrored: Vec<DVec3> = points.iter().map(|p| DVec3::new(-p.x, p.y, p.z)).collect();
         let reflected = file.value(&mirrored, 0.0);
-        let tolerance = 1e-9 * raw.abs().max(1e-300);
-        unchanged &= (reflected - raw).abs() <= tolerance;
-        negated &= (reflected + raw).abs() <= tolerance;
+        if raw.is_finite() && reflected.is_finite() {
+            reflected_any = true;
+            let tolerance = 1e-9 * raw.abs().max(1e-300);
+            unchanged &= (reflected - raw).abs() <= tolerance;
+            negated &= (reflected + raw).abs() <= tolerance;
+        }
     }
     report.reflection = match (unchanged, negated) {
+        _ if !reflected_any => Reflection::Untried,
         (true, _) => Reflection::Unchanged,
         (false, true) => Reflection::Negated,
         _ => Reflection::Changed,

@@ -23,6 +23,7 @@
 
 pub mod check;
 pub mod expression;
+pub mod grade;
 pub mod program;
 
 use crate::constraints::Binding;
@@ -413,7 +414,7 @@ impl ConstraintFile {
     /// C and ∇C at `p` with rest value `rest`, in the precision of `V` (f64, f32, the fast
     /// solver's lanes), as a simulation uses them: ∇C by reverse-mode AD
     /// ([`program::Tape::gradient`]) or, with `use_gradient`, the file's own (a particle it gives
-    /// none for gets zero). Where C or ∇C is not finite, the evaluation is degenerate: C is 0
+    /// none for gets AD's). Where C or ∇C is not finite, the evaluation is degenerate: C is 0
     /// there and ∇C zero. Allocates nothing: the registers are on the stack
     /// ([`program::MAX_REGISTERS`]).
     ///
@@ -461,10 +462,14 @@ impl ConstraintFile {
         );
         let coordinates: [[V::Real; 3]; N] = std::array::from_fn(|i| p[i].to_array());
         let (value, gradients) = if own {
+            // Where the file gives no gradient, AD's: a student may write one particle's at a
+            // time (the exercise of lesson 9 starts with none).
+            let missing = self.gradient_outputs[..N].iter().any(Option::is_none);
+            let automatic = missing.then(|| self.value.gradient(&coordinates, rest).1);
             self.yours.run(&coordinates, rest, |r| {
                 let gradients = std::array::from_fn(|k| match self.gradient_outputs[k] {
                     Some(o) => r.vector(o),
-                    None => [V::Real::ZERO; 3],
+                    None => automatic.map_or([V::Real::ZERO; 3], |g: [[V::Real; 3]; N]| g[k]),
                 });
                 (r.scalar(0), gradients)
             })

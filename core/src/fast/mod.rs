@@ -36,7 +36,8 @@ use crate::integrate;
 use crate::projection::Rule;
 use crate::solver::{Settings, Simulation};
 use glam::{DVec3, Vec3A};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use web_time::Instant;
 
 /// The largest coordinate (m) the f32 engine holds: an edge of twice this, raised to the fourth
 /// power (the squared gradient of a volume), stays below f32's 3.4·10³⁸. Velocities are held up

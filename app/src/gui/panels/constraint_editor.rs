@@ -78,7 +78,7 @@ impl ConstraintEditor {
     /// typing) while it is open: the text on the left, what it defines and the gradient check on
     /// the right. Returns a newly compiled file when the text changed and compiles (the app
     /// defines its family).
-    fn show(&mut self, ui: &mut egui::Ui) -> Option<ConstraintFile> {
+    fn show(&mut self, ui: &mut egui::Ui, exercise: bool) -> Option<ConstraintFile> {
         if !self.open {
             return None;
         }
@@ -94,14 +94,16 @@ impl ConstraintEditor {
                         self.open = false;
                     }
                 });
-                compiled = self.contents(ui);
+                compiled = self.contents(ui, exercise);
             });
         compiled
     }
 
     /// The editor's contents, for any container: the text and the examples to start from on the
     /// left, what the text defines (or its mistake) and the gradient check on the right.
-    pub fn contents(&mut self, ui: &mut egui::Ui) -> Option<ConstraintFile> {
+    /// `exercise`: the text's family is what the open lesson step asks the student to write or
+    /// mend; its grade is shown with the status.
+    pub fn contents(&mut self, ui: &mut egui::Ui, exercise: bool) -> Option<ConstraintFile> {
         let mut compiled = None;
         let width = ui.available_width();
         let height = ui.available_height();
@@ -124,6 +126,9 @@ impl ConstraintEditor {
                         }
                         ui.separator();
                         self.status(ui);
+                        if let Some(family) = self.family.filter(|_| exercise) {
+                            super::lesson::show_grade(ui, family, 14.0);
+                        }
                     });
             });
         });
@@ -263,8 +268,14 @@ impl ConstraintEditor {
 
 impl Panel for ConstraintEditor {
     /// Below the 3D view while it is open; a text that compiled is asked to be defined.
-    fn ui(&mut self, ui: &mut egui::Ui, _: &Context<'_>, requests: &mut Vec<Request>) {
-        if let Some(file) = self.show(ui) {
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        let exercise = context.lesson.is_some_and(|state| {
+            state
+                .current()
+                .exercises()
+                .any(|family| Some(family) == self.family)
+        });
+        if let Some(file) = self.show(ui, exercise) {
             requests.push(Request::Constraint(Box::new(file)));
         }
     }

@@ -61,7 +61,7 @@ pub fn missing_mesh_note(
         .file_name()
         .map_or(mesh.into(), |n| n.to_string_lossy());
     Some(format!(
-        "Lesson {number} needs the mesh {name} (../shared/meshes beside the repository), which is not here."
+        "Lesson {number} needs the mesh {name}, which is not here: scripts/web.sh puts it beside the page (in meshes/) from ../shared/meshes, when that folder is beside the repository."
     ))
 }
 
@@ -187,6 +187,9 @@ fn show(
                 .monospace(),
         );
     }
+    for family in step.exercises() {
+        show_grade(ui, family, size);
+    }
     ui.add_space(size * 0.4);
     ui.horizontal(|ui| {
         let text = |t: &str| egui::RichText::new(t).size(size);
@@ -223,6 +226,30 @@ fn show(
         );
     }
     request
+}
+
+/// The grade of the student's gradient for an exercise step: which particles held against
+/// automatic differentiation, and for a wrong one where it is furthest off (never AD's answer).
+/// Worked out again whenever the family is redefined (as the student types in the editor).
+/// The constraint editor shows it too, beside the text being typed.
+pub fn show_grade(ui: &mut egui::Ui, family: tetlab_core::constraints::Family, size: f32) {
+    let Some(grade) = tetlab_core::constraint_file::grade::of_family(family) else {
+        return;
+    };
+    ui.add_space(size * 0.3);
+    ui.label(
+        egui::RichText::new(format!("Your gradient of {}, graded:", family.name()))
+            .size(size * 0.9)
+            .strong(),
+    );
+    for (line, good) in grade.lines() {
+        let colour = if good {
+            egui::Color32::from_rgb(60, 180, 90)
+        } else {
+            egui::Color32::from_rgb(220, 90, 60)
+        };
+        ui.label(egui::RichText::new(line).size(size * 0.85).color(colour));
+    }
 }
 
 /// "mirror, then 60 frames", or empty when the step does nothing by itself.
