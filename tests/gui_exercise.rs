@@ -47,11 +47,7 @@ fn an_exercise_is_graded_in_the_lesson_panel_as_the_student_types() {
     assert_eq!(harness.state().editor.error, None);
     // In the lesson panel and beside the editor.
     for line in ["p0: held", "p3: wrong", "p3 is furthest off at p0 = ("] {
-        assert_eq!(
-            harness.get_all_by_label_contains(line).count(),
-            2,
-            "{line}"
-        );
+        assert_eq!(harness.get_all_by_label_contains(line).count(), 2, "{line}");
     }
     harness.snapshot("lesson_exercise_wrong");
 
