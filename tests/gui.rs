@@ -8,7 +8,7 @@ mod gui_support;
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use gui_support::{click_at, pixels_like, workbench};
+use gui_support::{click_at, open_lesson_file, pixels_like, workbench};
 use tetlab::gui::{Preferences, TetlabApp, viewport};
 use tetlab_core::visual;
 
@@ -444,20 +444,6 @@ fn the_inspector_shows_the_numbers_of_the_selected_tet() {
     harness.get_by_label_contains("volume #0   C = ");
     harness.get_by_label_contains("finite-difference relative error");
     harness.snapshot("inspector");
-}
-
-fn open_lesson_file(harness: &mut Harness<'static, TetlabApp>, file: &str) {
-    // Relative to the package folder, where tests run: the same text in any clone, so the
-    // snapshots do not depend on where the repository is.
-    let path = format!("../assets/lessons/{file}");
-    harness.key_press(egui::Key::L);
-    harness.run_steps(1);
-    harness.get_by_label("lesson file").click();
-    harness.run_steps(1);
-    harness.get_by_label("lesson file").type_text(&path);
-    harness.run_steps(1);
-    harness.get_by_label("Open lesson").click();
-    harness.run_steps(2);
 }
 
 /// A lesson opened from its file: the step's text, "do it" with Enter, the expected observation

@@ -10,21 +10,12 @@ mod gui_support;
 
 use eframe::egui;
 use egui_kittest::kittest::Queryable;
-use gui_support::workbench;
+use gui_support::{open_lesson_file, workbench};
 
 #[test]
 fn an_exercise_is_graded_in_the_lesson_panel_as_the_student_types() {
     let mut harness = workbench("cube", 2);
-    harness.key_press(egui::Key::L);
-    harness.run_steps(1);
-    harness.get_by_label("lesson file").click();
-    harness.run_steps(1);
-    harness
-        .get_by_label("lesson file")
-        .type_text("../assets/lessons/09-write-a-gradient.toml");
-    harness.run_steps(1);
-    harness.get_by_label("Open lesson").click();
-    harness.run_steps(2);
+    open_lesson_file(&mut harness, "09-write-a-gradient.toml");
     harness.key_press(egui::Key::ArrowRight);
     harness.run_steps(2);
     harness.get_by_label_contains("step 2 of 2");

@@ -92,30 +92,22 @@ fn the_write_a_gradient_exercise_is_graded() {
         p2 = \"cross(e3, e1) / (6 * rest)\"\n\
         p3 = \"cross(e1, e2) / (6 * rest)\"\n\
         p0 = \"-(cross(e2, e3) + cross(e3, e1) + cross(e1, e2)) / (6 * rest)\"\n";
-    let answer = dir.join("my-answer.toml");
-    std::fs::write(&answer, format!("{start}{gradient}")).unwrap();
-    let output = tetlab(&[
-        "lesson",
-        "9",
-        "--quiet",
-        "--constraint-file",
-        answer.to_str().unwrap(),
-    ]);
+    // Hands `text` in as the answer to lesson 9.
+    let hand_in = |text: String| {
+        let answer = dir.join("my-answer.toml");
+        std::fs::write(&answer, text).unwrap();
+        let answer = answer.to_str().unwrap();
+        tetlab(&["lesson", "9", "--quiet", "--constraint-file", answer])
+    };
+    let output = hand_in(format!("{start}{gradient}"));
     let text = stdout(&output);
     assert!(output.status.success(), "{text}{}", stderr(&output));
     assert!(text.contains("grade: passed"), "{text}");
 
     // p2's gradient with its sign lost.
-    let wrong =
-        format!("{start}{gradient}").replace("p2 = \"cross(e3, e1)", "p2 = \"cross(e1, e3)");
-    std::fs::write(&answer, wrong).unwrap();
-    let output = tetlab(&[
-        "lesson",
-        "9",
-        "--quiet",
-        "--constraint-file",
-        answer.to_str().unwrap(),
-    ]);
+    let output = hand_in(
+        format!("{start}{gradient}").replace("p2 = \"cross(e3, e1)", "p2 = \"cross(e1, e3)"),
+    );
     let text = stdout(&output);
     assert_eq!(output.status.code(), Some(1), "{text}{}", stderr(&output));
     assert!(text.contains("grade: p2: wrong"), "{text}");

@@ -82,3 +82,20 @@ pub fn click_at(harness: &mut Harness<'static, TetlabApp>, pos: egui::Pos2) {
         harness.run_steps(1);
     }
 }
+
+/// Opens `assets/lessons/FILE` as a user would: L, the path typed in the lesson file field,
+/// "Open lesson".
+pub fn open_lesson_file(harness: &mut Harness<'static, TetlabApp>, file: &str) {
+    use egui_kittest::kittest::Queryable;
+    // Relative to the package folder, where tests run: the same text in any clone, so the
+    // snapshots do not depend on where the repository is.
+    let path = format!("../assets/lessons/{file}");
+    harness.key_press(egui::Key::L);
+    harness.run_steps(1);
+    harness.get_by_label("lesson file").click();
+    harness.run_steps(1);
+    harness.get_by_label("lesson file").type_text(&path);
+    harness.run_steps(1);
+    harness.get_by_label("Open lesson").click();
+    harness.run_steps(2);
+}
