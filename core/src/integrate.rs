@@ -4,8 +4,10 @@
 use crate::vector::{Real, Vector3};
 
 /// The prediction of a substep of length `h`: x_prev = x, and for every free particle (w > 0)
-/// v += g h, x += v h with gravity g along −y. With the ground on, a particle predicted below
-/// y = 0 is put back at its previous position, on the ground (sticking friction).
+/// v += g h, x += v h with gravity g along −y. With a ground (at height `ground` in the
+/// positions' frame: 0, or where y = 0 lies for the fast engine, which keeps positions relative
+/// to an origin near the body), a particle predicted below it is put back at its previous
+/// position, on the ground (sticking friction).
 pub(crate) fn predict<V: Vector3>(
     positions: &mut [V],
     previous: &mut [V],
@@ -13,12 +15,13 @@ pub(crate) fn predict<V: Vector3>(
     inverse_masses: &[V::Real],
     gravity: f64,
     h: f64,
-    ground: bool,
+    ground: Option<f64>,
 ) where
     V::Real: PartialOrd,
 {
     let pull = V::from_f64s(0.0, -gravity, 0.0) * V::Real::from_f64(h);
     let h = V::Real::from_f64(h);
+    let floor = ground.map(V::Real::from_f64);
     for i in 0..positions.len() {
         previous[i] = positions[i];
         if inverse_masses[i] == V::Real::ZERO {
@@ -26,21 +29,27 @@ pub(crate) fn predict<V: Vector3>(
         }
         velocities[i] += pull;
         positions[i] += velocities[i] * h;
-        if ground && positions[i].y() < V::Real::ZERO {
+        if let Some(floor) = floor
+            && positions[i].y() < floor
+        {
             positions[i] = previous[i];
-            positions[i].set_y(V::Real::ZERO);
+            positions[i].set_y(floor);
         }
     }
 }
 
-/// The ground as a constraint: y ≥ 0 for every free particle.
-pub(crate) fn project_ground<V: Vector3>(positions: &mut [V], inverse_masses: &[V::Real])
-where
+/// The ground as a constraint: y ≥ `ground` for every free particle.
+pub(crate) fn project_ground<V: Vector3>(
+    positions: &mut [V],
+    inverse_masses: &[V::Real],
+    ground: f64,
+) where
     V::Real: PartialOrd,
 {
+    let floor = V::Real::from_f64(ground);
     for (p, &w) in positions.iter_mut().zip(inverse_masses) {
-        if w > V::Real::ZERO && p.y() < V::Real::ZERO {
-            p.set_y(V::Real::ZERO);
+        if w > V::Real::ZERO && p.y() < floor {
+            p.set_y(floor);
         }
     }
 }

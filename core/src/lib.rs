@@ -12,7 +12,8 @@
 //!   [`fast`]: the same in f32, coloured, in SIMD lanes and on threads, for big meshes;
 //!   [`projection`]: the rule by which both solvers project one constraint.
 //! - [`mesh`], [`scene`]: tet meshes (TetGen, Gmsh) and the scenes built from them; [`metrics`]:
-//!   what a state is worth; [`visual`]: what front ends draw; [`lesson`]: lessons as TOML files;
+//!   what a state is worth; [`outcome`]: what a run came to; [`ensemble`]: one scene under many
+//!   projection orders; [`visual`]: what front ends draw; [`lesson`]: lessons as TOML files;
 //!   [`text_file`]: reading a user's text file; [`shared_meshes`]: where the reference meshes
 //!   beside a clone are.
 //! - [`limits`]: the range of every setting and the size of every scene tetlab accepts;
@@ -22,6 +23,7 @@ pub mod constraint_file;
 pub mod constraints;
 pub mod divergence;
 pub mod dual;
+pub mod ensemble;
 pub mod fast;
 pub mod finite_difference;
 pub mod inspector;
@@ -32,6 +34,7 @@ pub mod limits;
 pub mod material;
 pub mod mesh;
 pub mod metrics;
+pub mod outcome;
 pub mod projection;
 pub mod random;
 pub mod scene;

@@ -178,6 +178,14 @@ pub const FRAMES: Bounds<u64> = Bounds {
     max: 10_000_000,
 };
 
+/// Members of an ensemble: runs of one scene under different projection orders
+/// ([`crate::ensemble`]).
+pub const ENSEMBLE: Bounds<u64> = Bounds {
+    name: "ensemble",
+    min: 1,
+    max: 1024,
+};
+
 /// The resolution of a built-in scene (cells along a side); the scene must also stay within
 /// [`MAX_TETS`].
 pub const RESOLUTION: Bounds<u32> = Bounds {

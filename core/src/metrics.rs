@@ -29,6 +29,10 @@ pub struct Metrics {
     /// max over particles of |x − x_rest|, in metres: how far the body moved from its rest
     /// shape (a cantilever's tip deflection).
     pub max_displacement: f64,
+    /// max over particles of |v|, in m/s.
+    pub max_speed: f64,
+    /// The centre of mass (the lumped masses' weighted mean position), in metres.
+    pub centre_of_mass: DVec3,
     /// Root mean square of C over each family's constraints (metres for edges and heights,
     /// cubic metres for volumes), whether or not the family is active.
     pub residual: PerFamily<f64>,
@@ -48,8 +52,12 @@ impl Metrics {
     /// Ok when every measurement is finite; otherwise the first that is not, as the divergence
     /// of a state at `frame`.
     pub fn check(&self, frame: u64) -> Result<(), Divergence> {
-        let displacement = ("max_displacement", self.max_displacement);
-        let all = self.headline().into_iter().chain([displacement]);
+        let more = [
+            ("max_displacement", self.max_displacement),
+            ("max_speed", self.max_speed),
+            ("centre_of_mass", self.centre_of_mass.length()),
+        ];
+        let all = self.headline().into_iter().chain(more);
         if let Some((name, value)) = all.into_iter().find(|(_, v)| !v.is_finite()) {
             return Err(Divergence::new(frame, Cause::Metric { name, value }));
         }
@@ -114,6 +122,12 @@ impl Metrics {
                 .zip(simulation.rest_positions())
                 .map(|(p, r)| p.distance(*r))
                 .fold(0.0, larger),
+            max_speed: simulation
+                .velocities()
+                .iter()
+                .map(|v| v.length())
+                .fold(0.0, larger),
+            centre_of_mass: simulation.centre_of_mass(positions),
             residual: PerFamily::from_fn(|family| {
                 family.visit(Rms {
                     set: simulation.constraints(family),

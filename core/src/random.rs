@@ -54,3 +54,27 @@ impl SplitMix64 {
         .normalize()
     }
 }
+
+/// A permutation of 0..n drawn by Fisher–Yates from `seed` (with [`SplitMix64`]): the same
+/// permutation for the same seed on every machine. The order seeds of the solvers use it
+/// ([`crate::solver::Settings::order_seed`]).
+///
+/// ```
+/// use tetlab_core::random::permutation;
+/// let p = permutation(10, 7);
+/// let mut sorted = p.clone();
+/// sorted.sort_unstable();
+/// assert_eq!(sorted, (0..10).collect::<Vec<u32>>(), "every index once");
+/// assert_eq!(p, permutation(10, 7), "the same seed, the same order");
+/// assert_ne!(p, permutation(10, 8));
+/// ```
+pub fn permutation(n: usize, seed: u64) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut random = SplitMix64::new(seed);
+    for i in (1..n).rev() {
+        // Lemire's multiply-shift: a uniform index in 0..=i without a division.
+        let j = ((u128::from(random.next_u64()) * (i as u128 + 1)) >> 64) as usize;
+        order.swap(i, j);
+    }
+    order
+}

@@ -12,9 +12,7 @@ use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::mesh::TetMesh;
 use tetlab_core::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{
-    DEFAULT_SUBSTEPS, DENSITY, Engine, MAX_SETTLE_FRAMES, Method, Settings, Simulation,
-};
+use tetlab_core::solver::{DEFAULT_SUBSTEPS, DENSITY, Engine, Method, Settings, Simulation};
 
 /// Counts the allocations of each thread, to check that a step makes none. Per thread, because
 /// the other tests of this binary run (and allocate) at the same time.
@@ -485,31 +483,36 @@ fn settling_undoes_a_mirror_or_a_flatten_without_launching_the_body() {
             "{perturbation:?} at {substeps} substeps: settled, the cube stays on the ground: \
              its centre reached {highest} m"
         );
-        let settled = settled.expect("the edit settles");
+        let settled = settled.expect("the edit settles within the three seconds");
         assert!(
-            (2..MAX_SETTLE_FRAMES as usize).contains(&settled),
+            settled >= 2,
             "{perturbation:?} at {substeps} substeps: settling lasts while the violation is \
-             undone, not one frame and not until the limit: {settled} frames"
+             undone, not one frame: {settled} frames"
         );
     }
 }
 
+/// A soft tet far from rest is corrected for many frames: while it settles no particle speeds
+/// up, however long that takes (there is no time limit: a body still tangled when a limit of one
+/// second ran out was launched at hundreds of m/s), until a frame's corrections are within the
+/// tolerance; without settling, corrections are velocity.
 #[test]
-fn settling_never_speeds_a_particle_up_and_ends_at_the_limit() {
+fn settling_never_speeds_a_particle_up_and_lasts_until_the_violation_is_undone() {
     let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
     let settings = Settings {
         settle_edits: true,
         gravity: 0.0,
         ground: false,
-        // A soft tet far from rest keeps being corrected for longer than the limit.
         compliance: PerFamily::splat(1e-4),
         ..Settings::default()
     };
     let mut simulation = Simulation::new(&scene, settings);
     simulation.place(3, simulation.positions()[3] + DVec3::new(0.0, 30.0, 0.0));
-    for _ in 0..MAX_SETTLE_FRAMES - 1 {
+    let mut frames = 0;
+    while simulation.is_settling() {
         simulation.step();
-        assert!(simulation.is_settling());
+        frames += 1;
+        assert!(frames < 10_000, "the soft tet comes back");
         let fastest = simulation
             .velocities()
             .iter()
@@ -520,15 +523,16 @@ fn settling_never_speeds_a_particle_up_and_ends_at_the_limit() {
             "at rest and without gravity, settling adds no speed"
         );
     }
-    simulation.step();
-    assert!(
-        !simulation.is_settling(),
-        "{MAX_SETTLE_FRAMES} frames at most"
-    );
+    assert!(frames > 60, "a second was once the limit: {frames} frames");
+    // Moved away again without settling, the tet's corrections are velocity.
+    let mut settings = *simulation.settings();
+    settings.settle_edits = false;
+    simulation.set_settings(settings);
+    simulation.place(3, simulation.positions()[3] + DVec3::new(0.0, 1.0, 0.0));
     simulation.step();
     assert!(
         simulation.velocities()[3].length() > 0.0,
-        "after settling, corrections are velocity again"
+        "without settling, corrections are velocity"
     );
 }
 

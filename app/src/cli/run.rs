@@ -1,4 +1,6 @@
-//! `tetlab run`: a headless run, printing metrics per frame (`--json`) or a short summary.
+//! `tetlab run`: a headless run, printing metrics per frame (`--json`) or a short summary; or,
+//! with `--ensemble N`, the same run under N projection orders on both engines, reported as a
+//! distribution.
 
 use super::UsageError;
 use super::simulation_args::SimulationArgs;
@@ -6,17 +8,26 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write;
 use tetlab_core::constraints::Family;
+use tetlab_core::ensemble::{Ensemble, Member, Tally};
+use tetlab_core::limits;
 use tetlab_core::metrics::Metrics;
-use tetlab_core::solver::Simulation;
+use tetlab_core::outcome::Outcome;
+use tetlab_core::solver::{Engine, Simulation};
 
 /// Options of `tetlab run`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
     simulation: SimulationArgs,
-    /// Print one JSON object per frame (frame 0 is the state before the first step).
+    /// Print one JSON object per frame (frame 0 is the state before the first step); with
+    /// --ensemble, one per member and then the tally.
     #[arg(long)]
     json: bool,
+    /// Run the scene under N projection orders (order seeds 1..=N, 1..=1024) on both engines,
+    /// or on the one --engine names, and report how many recover (no inverted tet at the end)
+    /// [default: one run in the order of --order-seed].
+    #[arg(long, value_name = "N", value_parser = |s: &str| limits::ENSEMBLE.parse(s), conflicts_with = "order_seed")]
+    ensemble: Option<u64>,
 }
 
 /// One line of `--json` output.
@@ -29,7 +40,13 @@ pub struct FrameRecord {
     volume_error: f64,
     max_edge_strain: f64,
     max_displacement: f64,
-    /// `residual_<family>` for each family of the table, in its order.
+    /// The largest particle speed, m/s.
+    max_speed: f64,
+    /// How far the centre of mass is from where it was at frame 0, m.
+    centre_of_mass_displacement: f64,
+    /// The same across the ground (x and z), m.
+    centre_of_mass_horizontal_displacement: f64,
+    /// `residual_<family>` for each active family, in the table's order.
     #[serde(flatten)]
     residuals: BTreeMap<String, f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -44,12 +61,21 @@ pub struct FrameRecord {
     /// Threads of the fast engine.
     #[serde(skip_serializing_if = "Option::is_none")]
     threads: Option<usize>,
+    /// The order seed (frame 0; `null`: the mesh's order).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    order_seed: Option<Option<u64>>,
+    /// Whether edits settle (frame 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    edits_settle: Option<bool>,
 }
 
 impl FrameRecord {
-    /// The record of the simulation's current frame; frame 0 also carries the sizes.
-    pub fn new(simulation: &Simulation, metrics: &Metrics) -> Self {
+    /// The record of the simulation's current frame; frame 0 also carries the sizes and the
+    /// settings that decide the order and the settling. `start` is the centre of mass at frame 0.
+    pub fn new(simulation: &Simulation, metrics: &Metrics, start: glam::DVec3) -> Self {
         let first = simulation.frame() == 0;
+        let settings = simulation.settings();
+        let moved = metrics.centre_of_mass - start;
         FrameRecord {
             frame: simulation.frame(),
             time: simulation.time(),
@@ -58,9 +84,13 @@ impl FrameRecord {
             volume_error: metrics.volume_error,
             max_edge_strain: metrics.max_edge_strain,
             max_displacement: metrics.max_displacement,
+            max_speed: metrics.max_speed,
+            centre_of_mass_displacement: moved.length(),
+            centre_of_mass_horizontal_displacement: moved.x.hypot(moved.z),
             residuals: metrics
                 .residual
                 .iter()
+                .filter(|&(family, _)| settings.active[family])
                 .map(|(family, value)| (format!("residual_{}", family.name()), value))
                 .collect(),
             particles: first.then(|| simulation.positions().len()),
@@ -68,17 +98,23 @@ impl FrameRecord {
             edges: first.then(|| simulation.constraint_count(Family::EDGES)),
             engine: first.then(|| simulation.engine().name()),
             threads: first.then(|| simulation.threads()),
+            order_seed: first.then_some(settings.order_seed),
+            edits_settle: first.then(|| settings.edits_settle()),
         }
     }
 }
 
-/// Runs the simulation for `--frames` frames and reports.
+/// Runs the simulation for `--frames` frames and reports (or runs the ensemble).
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
+    if let Some(n) = args.ensemble {
+        return run_ensemble(args, n, out);
+    }
     let (scene, mut simulation) = args.simulation.build()?;
     let io = UsageError::stdout;
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
+    let mut outcome = Outcome::start(&simulation, &initial);
     if args.json {
-        write_json(out, &FrameRecord::new(&simulation, &initial)).map_err(io)?;
+        write_json(out, &FrameRecord::new(&simulation, &initial, outcome.start)).map_err(io)?;
     } else {
         writeln!(
             out,
@@ -102,32 +138,187 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         .map_err(io)?;
         summary_line(out, 0, &initial).map_err(io)?;
     }
-    let mut last_inverted_frame = (initial.inverted_tets > 0).then_some(0);
-    let mut last = initial;
     for _ in 0..args.simulation.frames {
-        last = SimulationArgs::step(&mut simulation)?;
-        if last.inverted_tets > 0 {
-            last_inverted_frame = Some(simulation.frame());
-        }
+        let metrics = SimulationArgs::step(&mut simulation)?;
+        outcome.observe(&simulation, &metrics);
         if args.json {
-            write_json(out, &FrameRecord::new(&simulation, &last)).map_err(io)?;
+            write_json(out, &FrameRecord::new(&simulation, &metrics, outcome.start)).map_err(io)?;
         }
     }
     if !args.json {
-        summary_line(out, simulation.frame(), &last).map_err(io)?;
-        let verdict = match last_inverted_frame {
-            _ if last.inverted_tets > 0 => {
-                format!("{} tets still inverted at the end", last.inverted_tets)
+        summary_line(out, simulation.frame(), &outcome.last).map_err(io)?;
+        let verdict = match outcome.last_inverted_frame {
+            _ if !outcome.recovered() => {
+                format!(
+                    "{} tets still inverted at the end",
+                    outcome.last.inverted_tets
+                )
             }
             Some(frame) => format!("no inverted tets from frame {} on", frame + 1),
             None => "no inverted tets at any frame".to_owned(),
         };
         writeln!(out, "{verdict}").map_err(io)?;
+        let moved = outcome.displacement();
+        writeln!(
+            out,
+            "largest speed {:.3} m/s (frame {}); centre of mass moved {:.3} m ({:.3} m across \
+             the ground)",
+            outcome.largest_speed.0,
+            outcome.largest_speed.1,
+            moved.length(),
+            outcome.horizontal_displacement()
+        )
+        .map_err(io)?;
+        if let Some(warning) = outcome.thrown_warning() {
+            let advice = if simulation.settings().edits_settle() {
+                ""
+            } else if simulation.settings().settle_edits {
+                " (edits do not settle while a material is active)"
+            } else {
+                " (--no-settle-edits: without it, edits settle and the body recovers where it lies)"
+            };
+            writeln!(out, "warning: {warning}{advice}").map_err(io)?;
+        }
     }
     Ok(())
 }
 
-fn write_json(out: &mut impl Write, record: &FrameRecord) -> std::io::Result<()> {
+/// `--ensemble N`: the run under order seeds 1..=N on each engine asked for, side by side on
+/// `--threads` workers; one line per member and the tally of each engine (or JSON).
+fn run_ensemble(args: &Args, n: u64, out: &mut impl Write) -> Result<(), UsageError> {
+    let io = UsageError::stdout;
+    let (scene, simulation) = args.simulation.build()?;
+    let engines = match args.simulation.solver.engine {
+        Some(engine @ (Engine::Reference | Engine::Fast)) => vec![engine],
+        _ => vec![Engine::Reference, Engine::Fast],
+    };
+    let ensemble = Ensemble {
+        scene: &scene,
+        settings: *simulation.settings(),
+        perturbation: args.simulation.perturb,
+        frames: args.simulation.frames,
+    };
+    if !args.json {
+        let perturbation = args.simulation.perturb.map(|p| p.to_string());
+        writeln!(
+            out,
+            "scene {}: {} particles, {} tets; perturbation {}; {} frames; {}",
+            scene.name,
+            simulation.positions().len(),
+            simulation.tets().len(),
+            perturbation.as_deref().unwrap_or("none"),
+            args.simulation.frames,
+            args.simulation
+                .describe(&simulation)
+                .replace(", the mesh's order", ""),
+        )
+        .map_err(io)?;
+        writeln!(
+            out,
+            "ensemble: order seeds 1..={n} on {}",
+            engines
+                .iter()
+                .map(|e| e.name())
+                .collect::<Vec<_>>()
+                .join(" and ")
+        )
+        .map_err(io)?;
+    }
+    let seeds: Vec<u64> = (1..=n).collect();
+    let members = ensemble.run(&engines, &seeds, args.simulation.solver.threads());
+    for member in &members {
+        if args.json {
+            write_json(out, &MemberRecord::new(member)).map_err(io)?;
+        } else {
+            let what = match &member.result {
+                Ok(outcome) => outcome.describe(),
+                Err(divergence) => divergence.to_string(),
+            };
+            writeln!(
+                out,
+                "  {:<9} seed {:>4}: {what}",
+                member.engine.name(),
+                member.order_seed
+            )
+            .map_err(io)?;
+        }
+    }
+    let tallies: Vec<Tally> = engines.iter().map(|&e| Tally::of(&members, e)).collect();
+    if args.json {
+        let tally: BTreeMap<&str, TallyRecord> = tallies
+            .iter()
+            .map(|t| (t.engine.name(), TallyRecord::new(t)))
+            .collect();
+        serde_json::to_writer(&mut *out, &serde_json::json!({ "ensemble": tally }))
+            .map_err(|e| UsageError(format!("stdout: {e}")))?;
+        writeln!(out).map_err(io)?;
+    } else {
+        for tally in &tallies {
+            writeln!(out, "{}: {}", tally.engine.name(), tally.describe()).map_err(io)?;
+        }
+    }
+    Ok(())
+}
+
+/// One member of an ensemble in `--json`.
+#[derive(Debug, Serialize)]
+struct MemberRecord {
+    engine: &'static str,
+    order_seed: u64,
+    /// Where it diverged, if it did.
+    diverged: Option<String>,
+    inverted_tets: Option<usize>,
+    last_inverted_frame: Option<u64>,
+    min_volume_ratio: Option<f64>,
+    max_edge_strain: Option<f64>,
+    max_speed: Option<f64>,
+    centre_of_mass_horizontal_displacement: Option<f64>,
+    thrown: Option<bool>,
+}
+
+impl MemberRecord {
+    fn new(member: &Member) -> MemberRecord {
+        let ok = member.result.as_ref().ok();
+        MemberRecord {
+            engine: member.engine.name(),
+            order_seed: member.order_seed,
+            diverged: member.result.as_ref().err().map(|d| d.to_string()),
+            inverted_tets: ok.map(|o| o.last.inverted_tets),
+            last_inverted_frame: ok.and_then(|o| o.last_inverted_frame),
+            min_volume_ratio: ok.map(|o| o.last.min_volume_ratio),
+            max_edge_strain: ok.map(|o| o.last.max_edge_strain),
+            max_speed: ok.map(|o| o.largest_speed.0),
+            centre_of_mass_horizontal_displacement: ok.map(Outcome::horizontal_displacement),
+            thrown: ok.map(Outcome::thrown),
+        }
+    }
+}
+
+/// One engine's tally in `--json`.
+#[derive(Debug, Serialize)]
+struct TallyRecord {
+    members: usize,
+    recovered: usize,
+    diverged: usize,
+    thrown: usize,
+    inverted_at_the_end: Vec<usize>,
+    summary: String,
+}
+
+impl TallyRecord {
+    fn new(tally: &Tally) -> TallyRecord {
+        TallyRecord {
+            members: tally.members,
+            recovered: tally.recovered,
+            diverged: tally.diverged,
+            thrown: tally.thrown,
+            inverted_at_the_end: tally.inverted_at_the_end.clone(),
+            summary: tally.describe(),
+        }
+    }
+}
+
+fn write_json(out: &mut impl Write, record: &impl Serialize) -> std::io::Result<()> {
     serde_json::to_writer(&mut *out, record)?;
     writeln!(out)
 }

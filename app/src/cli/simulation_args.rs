@@ -31,9 +31,14 @@ pub struct SimulationArgs {
     /// The solver's options.
     #[command(flatten)]
     pub solver: SolverArgs,
-    /// After the perturbation, let corrections move particles but not speed them up until the
-    /// violation is undone (otherwise a large violation launches the body).
+    /// Let the perturbation launch the body: without this, corrections after it may move
+    /// particles but not speed them up until the violation is undone (edits settle, as in the
+    /// workbench); with it, rigid constraints undo a large violation within a substep and
+    /// v = Δx/h throws the body.
     #[arg(long)]
+    pub no_settle_edits: bool,
+    /// Edits settle (the default; the option is kept for the commands that name it).
+    #[arg(long, hide = true, conflicts_with = "no_settle_edits")]
     pub settle_edits: bool,
 }
 
@@ -90,6 +95,11 @@ pub struct SolverArgs {
     /// [default: E=1e6,nu=0.3].
     #[arg(long, value_name = "E=PA,nu=N", value_parser = Material::parse)]
     pub material: Option<Material>,
+    /// Project each family's constraints in an order drawn from this seed (on the fast engine:
+    /// its colours), instead of the mesh's; a result that changes with it hangs on the order
+    /// [default: the mesh's order].
+    #[arg(long, value_name = "S")]
+    pub order_seed: Option<u64>,
 }
 
 /// `FAMILY=VALUE` as given, its value in range; the family is looked up later
@@ -133,6 +143,7 @@ impl SolverArgs {
             iterations: self.iterations,
             dt: self.dt,
             damping: self.damping,
+            order_seed: self.order_seed,
             ..Settings::default()
         };
         settings.set_gravity(self.gravity);
@@ -201,6 +212,10 @@ impl SolverArgs {
         if uses_material || self.material.is_some() {
             text += &format!(", material {}", s.material.describe());
         }
+        match s.order_seed {
+            Some(seed) => text += &format!(", order seed {seed}"),
+            None => text += ", the mesh's order",
+        }
         for family in s.active.families() {
             if let Some(file) = family.file() {
                 let gradient = if file.use_gradient {
@@ -223,7 +238,7 @@ impl SimulationArgs {
     /// The solver settings these options ask for ([`SolverArgs::settings`]).
     pub fn settings(&self) -> Result<Settings, UsageError> {
         Ok(Settings {
-            settle_edits: self.settle_edits,
+            settle_edits: !self.no_settle_edits,
             ..self.solver.settings()?
         })
     }
@@ -251,11 +266,20 @@ impl SimulationArgs {
 
     /// What [`SolverArgs::describe`] says of `simulation`'s settings, and whether edits settle.
     pub fn describe(&self, simulation: &Simulation) -> String {
-        let mut text = self.solver.describe(simulation);
-        if self.settle_edits {
-            text += ", settle edits";
-        }
-        text
+        self.solver.describe(simulation) + &describe_settling(simulation.settings())
+    }
+}
+
+/// ", edits settle", ", edits do not settle (--no-settle-edits)", or why they do not settle
+/// although asked to ([`Settings::edits_settle`]: a material is active).
+pub fn describe_settling(settings: &Settings) -> String {
+    match (settings.settle_edits, settings.edits_settle()) {
+        (_, true) => ", edits settle".to_owned(),
+        (false, false) => ", edits do not settle (--no-settle-edits)".to_owned(),
+        (true, false) => ", edits do not settle while neohookean is active (a material carries \
+                          its own momentum through an inversion; capping it leaves the body \
+                          squashed)"
+            .to_owned(),
     }
 }
 

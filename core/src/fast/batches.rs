@@ -1,17 +1,20 @@
 //! The fast solver's constraints, laid out for eight lanes.
 //!
-//! A [`Layout`] holds the elements constraints bind to, edges or tets: coloured so that no two
-//! elements of a colour share a particle, and packed [`LANES`] to a batch, each batch stored lane
-//! by lane. The particles of batch b are rows b·N..b·N + N of `particles` (row i: particle i of
-//! the element in each lane), their inverse masses the same rows of `weights`: a batch is loaded
-//! with one vector load per row. Every family bound to the same kind of element shares one layout
-//! (the built-in heights and volume, the neo-Hookean pair, a constraint file's tet family all
-//! share the tets'), and keeps only its own rest values and multipliers ([`Batches`]): K per
-//! element, K being its constraints per element (1 per edge or tet, 4 per tet for the heights).
-//! The K constraints of an element are projected one after the other on the element's particles
-//! held in registers, which are then written back once.
+//! A [`Layout`] holds the elements constraints bind to, one constraint per element: edges, tets,
+//! or the four (tet, vertex) pairs of each tet ([`crate::constraints::Binding::TetVertices`], each with its
+//! particles in the constraint's order). Its elements are coloured so that no two of a colour
+//! share a particle, and packed [`LANES`] to a batch, each batch stored lane by lane. The
+//! particles of batch b are rows b·N..b·N + N of `particles` (row i: particle i of the element in
+//! each lane), their inverse masses the same rows of `weights`: a batch is loaded with one vector
+//! load per row. Every family bound the same way shares one layout (the built-in volume, the
+//! neo-Hookean pair, a constraint file's tet family all share the tets'), and keeps only its own
+//! rest values and multipliers ([`Batches`]).
+//!
+//! The four heights of a tet are four elements, coloured apart (they share their particles), not
+//! one element projected four times in a row: projected back to back, they snap each inverted tet
+//! to its own rest shape before its neighbours move, and a mirrored cube recovered in a third of
+//! the orders (docs/performance.md, "Engines").
 
-use crate::constraints::Binding;
 use crate::lanes::{F32x8, LANES};
 use crate::vector::Real;
 use std::ops::Range;
@@ -41,11 +44,10 @@ pub struct Layout {
     particle_count: usize,
 }
 
-/// One family's constraints on a [`Layout`]: for each element, its K constraints' rest values
-/// and multipliers, K rows per batch.
+/// One family's constraints on a [`Layout`]: each element's rest value and multiplier, a row per
+/// batch.
 #[derive(Clone, Debug, Default)]
 pub struct Batches {
-    per_element: usize,
     rest: Vec<F32x8>,
     lambda: Vec<F32x8>,
 }
@@ -212,62 +214,33 @@ impl Layout {
     }
 }
 
-/// The orders of the one constraint per element of an edge or tet binding: the identity.
-pub(crate) fn identity<const N: usize>() -> [[usize; N]; 1] {
-    [std::array::from_fn(|i| i)]
-}
-
-/// The orders of the four constraints per tet of a tet-vertex binding: for constraint k, which
-/// of the tet's corners is its p0, p1, p2, p3 ([`crate::constraints::height::tet_vertex_order`]).
-pub(crate) fn tet_vertex_orders<const N: usize>() -> [[usize; N]; 4] {
-    let orders = crate::constraints::height::tet_vertex_order();
-    std::array::from_fn(|k| std::array::from_fn(|i| orders[k][i.min(3)]))
-}
-
-/// How many constraints per element a binding has: 4 per tet for tet vertices, 1 otherwise.
-pub(crate) fn per_element(binding: Binding) -> usize {
-    match binding {
-        Binding::TetVertices => 4,
-        Binding::Edges | Binding::Tets => 1,
-    }
-}
-
 impl Batches {
-    /// A family's batches on `layout`: constraint k of element e has rest value
-    /// `rest(e, k)`, for k below `per_element`.
-    pub(crate) fn new(
-        layout: &Layout,
-        per_element: usize,
-        rest: impl Fn(u32, usize) -> f32,
-    ) -> Self {
-        let mut batches = Batches {
-            per_element,
-            rest: Vec::with_capacity(layout.batch_count() * per_element),
-            lambda: vec![F32x8::ZERO; layout.batch_count() * per_element],
-        };
-        for lanes in &layout.elements {
-            for k in 0..per_element {
-                batches
-                    .rest
-                    .push(F32x8::new(lanes.map(|element| rest(element, k))));
-            }
+    /// A family's batches on `layout`: the constraint of element e has rest value `rest(e)`.
+    pub(crate) fn new(layout: &Layout, rest: impl Fn(u32) -> f32) -> Self {
+        Batches {
+            rest: layout
+                .elements
+                .iter()
+                .map(|lanes| F32x8::new(lanes.map(&rest)))
+                .collect(),
+            lambda: vec![F32x8::ZERO; layout.batch_count()],
         }
-        batches
     }
 
-    /// Constraints per element (K).
-    pub fn per_element(&self) -> usize {
-        self.per_element
+    /// Whether it holds no constraints (a family that is not active has none, though its
+    /// binding's layout may have elements for others).
+    pub(crate) fn is_empty(&self) -> bool {
+        self.rest.is_empty()
     }
 
-    /// The rest values (K rows per batch) and the multipliers, for the kernels.
+    /// The rest values (a row per batch) and the multipliers, for the kernels.
     pub(crate) fn rows(&mut self) -> (&[F32x8], &mut [F32x8]) {
         (&self.rest, &mut self.lambda)
     }
 
-    /// The rest value of constraint k of the element at (batch, lane).
-    pub(crate) fn rest_at(&self, (batch, lane): (usize, usize), k: usize) -> f32 {
-        self.rest[batch * self.per_element + k].to_array()[lane]
+    /// The rest value of the constraint of the element at (batch, lane).
+    pub(crate) fn rest_at(&self, (batch, lane): (usize, usize)) -> f32 {
+        self.rest[batch].to_array()[lane]
     }
 
     /// λ = 0 for every constraint (a new substep).

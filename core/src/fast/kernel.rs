@@ -1,11 +1,9 @@
 //! The fast solver's kernels: a family's constraints projected colour by colour, eight elements
-//! (edges or tets) at a time in SIMD lanes, through the generic formula ([`Constraint`]) and
-//! projection rule ([`correction_lanes`]); threads share large colours.
+//! (edges, tets or a tet's vertices) at a time in SIMD lanes, through the generic formula
+//! ([`Constraint`]) and projection rule ([`correction_lanes`]); threads share large colours.
 //!
-//! A batch's particles are gathered once into registers; the family's K constraints per element
-//! (four heights per tet, one volume) are projected one after the other on those registers; the
-//! new positions are then written back from them, once (Gauss–Seidel), or the sum of the
-//! corrections is added to the Jacobi sums.
+//! A batch's particles are gathered into registers, its constraints projected there, and the
+//! corrections added to the positions (Gauss–Seidel) or to the Jacobi sums.
 
 use super::batches::{Batches, Layout, Typed};
 use super::particles::Particles;
@@ -79,75 +77,10 @@ struct Access<'a> {
     sums: Option<Particles<'a>>,
 }
 
-/// An element order packed into a number, four bits per particle (particle i of the constraint
-/// is the element's particle `(order >> 4i) & 15`), so that it can be a const parameter of the
-/// kernel and the reordering of the registers be resolved when it is compiled.
-const fn pack(order: [usize; 4]) -> u32 {
-    (order[0] | order[1] << 4 | order[2] << 8 | order[3] << 12) as u32
-}
-
-/// The orders of the four constraints per tet of a tet-vertex binding
-/// ([`crate::constraints::height::tet_vertex_order`]).
-const TET_VERTEX: [u32; 4] = {
-    let orders = crate::constraints::height::tet_vertex_order();
-    [
-        pack(orders[0]),
-        pack(orders[1]),
-        pack(orders[2]),
-        pack(orders[3]),
-    ]
-};
-
-/// Particle i of a constraint in element order `ORDER`.
-#[inline(always)]
-const fn at<const ORDER: u32>(i: usize) -> usize {
-    ((ORDER >> (4 * i)) & 15) as usize
-}
-
-/// Projects one constraint of each element of a batch, whose particles are the element's in
-/// order `ORDER`, on the registers `p` (and, in Jacobi order, from `original`, adding the
-/// corrections to `sum`).
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn project_in_order<const N: usize, C: Constraint<N>, const ORDER: u32, const JACOBI: bool>(
-    constraint: &C,
-    p: &mut [Vec3x8; N],
-    original: &[Vec3x8; N],
-    sum: &mut [Vec3x8; N],
-    shape: &[Vec3x8; N],
-    weights: &[F32x8; N],
-    rest: F32x8,
-    lambda: &mut F32x8,
-    rule: Rule<F32x8>,
-) {
-    let from = if JACOBI { original } else { &*p };
-    let points: [Vec3x8; N] = std::array::from_fn(|i| from[at::<ORDER>(i)]);
-    let shape: [Vec3x8; N] = std::array::from_fn(|i| shape[at::<ORDER>(i)]);
-    let weights: [F32x8; N] = std::array::from_fn(|i| weights[at::<ORDER>(i)]);
-    let (_, d) = correction_lanes(
-        constraint.evaluate(&points, rest, &shape),
-        weights,
-        *lambda,
-        rule,
-    );
-    *lambda += d.delta_lambda;
-    for (i, delta) in d.delta_x.into_iter().enumerate() {
-        if JACOBI {
-            sum[at::<ORDER>(i)] += delta;
-        } else {
-            p[at::<ORDER>(i)] += delta;
-        }
-    }
-}
-
-/// Projects batches of elements that share no particle: per batch, the family's constraints on
-/// each element, K of them (one for an edge or a tet, four for a tet's vertices, in the orders
-/// of [`TET_VERTEX`]), one after the other; then the corrections are added to the positions
-/// (Gauss–Seidel) or, with `JACOBI`, to the sums. With K above one the particles stay in
-/// registers between the constraints and are gathered and written once.
+/// Projects batches of elements that share no particle, one constraint per element: the
+/// corrections are added to the positions (Gauss–Seidel) or, in Jacobi order, to the sums.
 #[inline]
-#[allow(clippy::too_many_arguments)]
-fn project_batches<const N: usize, C: Constraint<N>, const K: usize, const JACOBI: bool>(
+fn project_batches<const N: usize, C: Constraint<N>>(
     constraint: &C,
     particles: &[[[u32; LANES]; N]],
     weights: &[[F32x8; N]],
@@ -164,72 +97,43 @@ fn project_batches<const N: usize, C: Constraint<N>, const K: usize, const JACOB
     for (b, ((indices, weights), (rest, lambda))) in particles
         .iter()
         .zip(weights)
-        .zip(rest.chunks_exact(K).zip(lambda.chunks_exact_mut(K)))
+        .zip(rest.iter().zip(lambda.iter_mut()))
         .enumerate()
     {
-        let Some(original) = next else { break };
+        let Some(p) = next else { break };
         next = particles
             .get(b + 1)
             .map(|indices| gather_batch(read, indices));
         let shape = if C::USES_REST_SHAPE {
             gather_batch(access.rest_shape, indices)
         } else {
-            original
+            p
         };
-        if K == 1 {
-            let (_, d) = correction_lanes(
-                constraint.evaluate(&original, rest[0], &shape),
-                *weights,
-                lambda[0],
-                rule,
-            );
-            lambda[0] += d.delta_lambda;
-            for (&indices, delta) in indices.iter().zip(d.delta_x) {
-                scatter_add(write, indices, delta);
-            }
-            continue;
-        }
-        let mut p = original;
-        let mut sum = [Vec3x8::ZERO; N];
-        macro_rules! project {
-            ($k:expr) => {
-                project_in_order::<N, C, { TET_VERTEX[$k] }, JACOBI>(
-                    constraint,
-                    &mut p,
-                    &original,
-                    &mut sum,
-                    &shape,
-                    weights,
-                    rest[$k],
-                    &mut lambda[$k],
-                    rule,
-                )
-            };
-        }
-        project!(0);
-        project!(1);
-        project!(2);
-        project!(3);
-        for (i, &indices) in indices.iter().enumerate() {
-            if JACOBI {
-                scatter_add(write, indices, sum[i]);
-            } else {
-                scatter_set(read, indices, p[i]);
-            }
+        let evaluation = constraint.evaluate(&p, *rest, &shape);
+        let (_, d) = correction_lanes(evaluation, *weights, *lambda, rule);
+        *lambda += d.delta_lambda;
+        for (&indices, delta) in indices.iter().zip(d.delta_x) {
+            scatter_add(write, indices, delta);
         }
     }
 }
 
-/// Projects every constraint of a family (`batches`, on `layout`, K per element: 1, or 4 for a
-/// tet-vertex binding), colour by colour, moving `positions` (Gauss–Seidel) or, given `sums`,
-/// adding the corrections to `sums` (Jacobi: `positions` stay as they are); with `parallel`,
-/// large colours are shared by the threads of the current pool. Returns how many constraints it
-/// projected.
+/// The colour projected `k`-th: `order[k]`, or `k` when `order` is empty (the layout's order).
+#[inline]
+fn in_order(order: &[u32], k: usize) -> usize {
+    order.get(k).map_or(k, |&c| c as usize)
+}
+
+/// Projects every constraint of a family (`batches`, on `layout`), colour by colour in `order`
+/// (empty: the layout's), moving `positions` (Gauss–Seidel) or, given `sums`, adding the
+/// corrections to `sums` (Jacobi: `positions` stay as they are); with `parallel`, large colours
+/// are shared by the threads of the current pool. Returns how many constraints it projected.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn project_family<const N: usize, C: Constraint<N>, const K: usize>(
+pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
     constraint: &C,
     layout: &Layout,
+    order: &[u32],
     batches: &mut Batches,
     positions: &mut [Vec3A],
     rest_positions: &mut [Vec3A],
@@ -237,11 +141,6 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>, const K: usize>(
     rule: Rule<f64>,
     parallel: bool,
 ) -> usize {
-    assert!(
-        K == 1 || (K == 4 && N == 4),
-        "one constraint per element, or four per tet"
-    );
-    assert_eq!(batches.per_element(), K, "batches of another binding");
     let rule: Rule<F32x8> = rule.to();
     let Typed {
         particles,
@@ -256,56 +155,37 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>, const K: usize>(
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let mut count = 0;
-    for colour in colours.iter() {
+    for k in 0..colours.len() {
+        let colour = &colours[in_order(order, k)];
         let range = colour.batches.clone();
-        let rows = range.start * K..range.end * K;
         let (particles, weights, rest, lambda) = (
             &particles[range.clone()],
-            &weights[range],
-            &rest[rows.clone()],
-            &mut lambda[rows],
+            &weights[range.clone()],
+            &rest[range.clone()],
+            &mut lambda[range],
         );
         match parallel && colour.elements >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
             true => {
                 use rayon::prelude::*;
                 lambda
-                    .par_chunks_mut(CHUNK * K)
+                    .par_chunks_mut(CHUNK)
                     .zip(particles.par_chunks(CHUNK))
                     .zip(weights.par_chunks(CHUNK))
-                    .zip(rest.par_chunks(CHUNK * K))
+                    .zip(rest.par_chunks(CHUNK))
                     .for_each(|(((lambda, particles), weights), rest)| {
-                        project::<N, C, K>(
+                        project_batches::<N, C>(
                             constraint, particles, weights, rest, lambda, access, rule,
                         );
                     })
             }
-            _ => project::<N, C, K>(constraint, particles, weights, rest, lambda, access, rule),
+            _ => {
+                project_batches::<N, C>(constraint, particles, weights, rest, lambda, access, rule)
+            }
         }
-        count += colour.elements * K;
+        count += colour.elements;
     }
     count
-}
-
-/// [`project_batches`] in the order `access` asks for: Gauss–Seidel, or Jacobi with sums.
-#[inline(always)]
-fn project<const N: usize, C: Constraint<N>, const K: usize>(
-    constraint: &C,
-    particles: &[[[u32; LANES]; N]],
-    weights: &[[F32x8; N]],
-    rest: &[F32x8],
-    lambda: &mut [F32x8],
-    access: Access,
-    rule: Rule<F32x8>,
-) {
-    match access.sums {
-        Some(_) => project_batches::<N, C, K, true>(
-            constraint, particles, weights, rest, lambda, access, rule,
-        ),
-        None => project_batches::<N, C, K, false>(
-            constraint, particles, weights, rest, lambda, access, rule,
-        ),
-    }
 }
 
 /// [`project_batches`] for two families projected together ([`pair_correction_lanes`]): one
@@ -365,6 +245,7 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
 pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
     constraints: (&A, &B),
     layout: &Layout,
+    order: &[u32],
     (first, second): (&mut Batches, &mut Batches),
     positions: &mut [Vec3A],
     rest_positions: &mut [Vec3A],
@@ -387,7 +268,8 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let mut count = 0;
-    for colour in colours.iter() {
+    for k in 0..colours.len() {
+        let colour = &colours[in_order(order, k)];
         let range = colour.batches.clone();
         let (particles, weights) = (&particles[range.clone()], &weights[range.clone()]);
         let rest = (&rest_a[range.clone()], &rest_b[range.clone()]);

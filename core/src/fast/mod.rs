@@ -19,7 +19,7 @@
 //!   particles are loaded as padded 3-vectors and transposed, its inverse masses, rest values and
 //!   multipliers are stored lane by lane beside it; the loads skip their bounds checks
 //!   ([`particles`], the one `unsafe` module);
-//! - f32 instead of f64, and no grab or settling (nobody drags a benchmark);
+//! - f32 instead of f64;
 //! - optionally the [`Order::Jacobi`] order, for comparison.
 
 pub mod batches;
@@ -44,6 +44,10 @@ use web_time::Instant;
 /// to [`crate::solver::SOUND_LIMIT`], as in f64 (they are only ever multiplied by a substep).
 pub const POSITION_LIMIT: f64 = 1e9;
 
+/// A body whose centre is further than this many times its own size from the origin of the
+/// fast engine's coordinates is moved back to it ([`FastSimulation::recentre`]).
+const RECENTRE_FROM: f32 = 1.0;
+
 /// Time spent projecting each family, and how many projections, since the last reset.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Timings {
@@ -56,6 +60,11 @@ pub struct Timings {
 /// The soft body, fast. See the module documentation.
 pub struct FastSimulation {
     settings: Settings,
+    /// Where the positions are measured from, in the scene's frame: a particle is at
+    /// `origin + positions[i]`. It follows a body that travels far (thrown, falling), so that
+    /// its f32 coordinates stay about its own size, and their precision its size's
+    /// ([`FastSimulation::recentre`]).
+    origin: DVec3,
     positions: Vec<Vec3A>,
     previous: Vec<Vec3A>,
     velocities: Vec<Vec3A>,
@@ -66,12 +75,15 @@ pub struct FastSimulation {
     original: Vec<u32>,
     /// The new number of each particle, by the scene's number.
     renumber: Vec<u32>,
-    /// The edges and the tets of the body, coloured and in batches; every family bound to edges
-    /// shares the first, every family bound to tets the second (each is empty when no active
-    /// family uses it).
+    /// The edges, the tets and the (tet, vertex) pairs of the body, coloured and in batches;
+    /// every family of a binding shares that binding's (each is empty when no active family
+    /// uses it).
     layouts: Layouts,
     /// The rest values and multipliers of each active family (the others are left empty).
     sets: PerFamily<Batches>,
+    /// The order each family's colours are projected in: empty for the layout's order,
+    /// otherwise a permutation drawn from [`Settings::order_seed`].
+    colour_orders: PerFamily<Vec<u32>>,
     tets: usize,
     jacobi: Option<Jacobi>,
     #[cfg(feature = "parallel")]
@@ -106,11 +118,12 @@ struct Corrections {
     frame: Vec<Vec3A>,
 }
 
-/// The layouts of the elements families bind to.
+/// The layouts of the elements families bind to: edges, tets, and (tet, vertex) pairs.
 #[derive(Default)]
 struct Layouts {
     edges: Layout,
     tets: Layout,
+    tet_vertices: Layout,
 }
 
 impl Layouts {
@@ -118,33 +131,37 @@ impl Layouts {
     fn of(&self, binding: Binding) -> &Layout {
         match binding {
             Binding::Edges => &self.edges,
-            Binding::Tets | Binding::TetVertices => &self.tets,
+            Binding::Tets => &self.tets,
+            Binding::TetVertices => &self.tet_vertices,
         }
     }
 
-    /// Both, for the families' weights and the memory.
-    fn all_mut(&mut self) -> [&mut Layout; 2] {
-        [&mut self.edges, &mut self.tets]
+    /// Every one, for the families' weights and the memory.
+    fn all_mut(&mut self) -> [&mut Layout; 3] {
+        [&mut self.edges, &mut self.tets, &mut self.tet_vertices]
     }
 }
 
-/// One family's constraints as the fast solver holds them: on its layout, K per element.
+/// One family's constraints as the fast solver holds them: on its layout, one per element.
 #[derive(Clone, Copy)]
 pub struct FamilyBatches<'a> {
     layout: &'a Layout,
     batches: &'a Batches,
-    binding: Binding,
 }
 
 impl<'a> FamilyBatches<'a> {
-    /// The colours of the family's layout.
+    /// The colours of the family's layout (none for a family that is not active).
     pub fn colours(&self) -> &'a [Colour] {
-        &self.layout.colours
+        if self.batches.is_empty() {
+            &[]
+        } else {
+            &self.layout.colours
+        }
     }
 
     /// The number of constraints, padding not counted.
     pub fn len(&self) -> usize {
-        self.colours().iter().map(|c| c.elements).sum::<usize>() * self.batches.per_element()
+        self.colours().iter().map(|c| c.elements).sum::<usize>()
     }
 
     /// Whether there are none.
@@ -155,21 +172,12 @@ impl<'a> FamilyBatches<'a> {
     /// The particles (the first arity of four, in the constraint's order) and rest value of each
     /// constraint, colour by colour, padding left out.
     pub fn constraints(&self) -> impl Iterator<Item = ([u32; 4], f32)> + 'a {
-        let orders = match self.binding {
-            Binding::TetVertices => batches::tet_vertex_orders::<4>(),
-            _ => [batches::identity::<4>()[0]; 4],
-        };
-        let (layout, batches) = (self.layout, self.batches);
-        let arity = layout.arity();
-        layout.elements().flat_map(move |(_, particles, at)| {
-            (0..batches.per_element()).map(move |k| {
-                let mut ordered = [0; 4];
-                for (i, slot) in ordered.iter_mut().enumerate().take(arity) {
-                    *slot = particles[orders[k][i]];
-                }
-                (ordered, batches.rest_at(at, k))
-            })
-        })
+        let batches = self.batches;
+        let elements = (!batches.is_empty()).then(|| self.layout.elements());
+        elements
+            .into_iter()
+            .flatten()
+            .map(move |(_, particles, at)| (particles, batches.rest_at(at)))
     }
 
     /// Whether every colour of its layout really shares no particle.
@@ -248,30 +256,46 @@ impl FastSimulation {
                 .collect();
             layouts.edges = Layout::new(&edges, &inverse_masses);
         }
-        if uses(&|b| b != Binding::Edges) {
-            let tets: Vec<[u32; 4]> = simulation
-                .tets()
-                .iter()
+        let renumbered = |tets: &[[u32; 4]]| -> Vec<[u32; 4]> {
+            tets.iter()
                 .map(|tet| tet.map(|i| renumber[i as usize]))
-                .collect();
-            layouts.tets = Layout::new(&tets, &inverse_masses);
+                .collect()
+        };
+        if uses(&|b| b == Binding::Tets) {
+            layouts.tets = Layout::new(&renumbered(simulation.tets()), &inverse_masses);
+        }
+        if uses(&|b| b == Binding::TetVertices) {
+            // Each (tet, vertex) constraint is an element of its own, its particles in the
+            // constraint's order ([`Binding::particles`]), coloured apart from its tet's others.
+            let mesh = crate::mesh::TetMesh {
+                positions: Vec::new(),
+                tets: simulation.tets().to_vec(),
+            };
+            let flat = Binding::TetVertices.particles(&mesh);
+            let (constraints, _) = flat.as_chunks::<4>();
+            layouts.tet_vertices = Layout::new(&renumbered(constraints), &inverse_masses);
         }
         let sets = PerFamily::build(|family| {
             if !active[family] {
                 return Batches::default();
             }
-            let binding = family.row().binding;
-            let per_element = batches::per_element(binding);
             let rest = simulation.constraints(family).rest();
-            Batches::new(layouts.of(binding), per_element, |element, k| {
-                rest[element as usize * per_element + k] as f32
+            Batches::new(layouts.of(family.row().binding), |element| {
+                rest[element as usize] as f32
             })
         });
-        debug_assert!(layouts.edges.colouring_is_valid(n) && layouts.tets.colouring_is_valid(n));
+        debug_assert!(
+            layouts.edges.colouring_is_valid(n)
+                && layouts.tets.colouring_is_valid(n)
+                && layouts.tet_vertices.colouring_is_valid(n)
+        );
         let positions = take(simulation.positions());
         #[cfg(not(feature = "parallel"))]
         let _ = threads;
+        let colour_orders = colour_orders(simulation.settings(), &layouts);
         FastSimulation {
+            colour_orders,
+            origin: DVec3::ZERO,
             settings: *simulation.settings(),
             previous: positions.clone(),
             positions,
@@ -306,6 +330,7 @@ impl FastSimulation {
     /// # Panics
     /// If the slices are not one per particle.
     pub fn load(&mut self, positions: &[DVec3], velocities: &[DVec3], inverse_masses: &[f64]) {
+        self.origin = DVec3::ZERO;
         for (new, &old) in self.original.iter().enumerate() {
             let old = old as usize;
             self.positions[new] = positions[old].as_vec3a();
@@ -331,7 +356,7 @@ impl FastSimulation {
         corrections: Option<(&mut [DVec3], &mut [DVec3])>,
     ) {
         for (new, &old) in self.original.iter().enumerate() {
-            positions[old as usize] = self.positions[new].as_dvec3();
+            positions[old as usize] = self.origin + self.positions[new].as_dvec3();
             velocities[old as usize] = self.velocities[new].as_dvec3();
         }
         if let Some((last, frame)) = corrections {
@@ -348,7 +373,20 @@ impl FastSimulation {
     /// change of either needs a new [`FastSimulation`], whose constraints are built for them).
     pub fn set_settings(&mut self, settings: Settings) {
         debug_assert!(settings.active == self.settings.active);
+        if settings.order_seed != self.settings.order_seed {
+            self.colour_orders = colour_orders(&settings, &self.layouts);
+        }
         self.settings = settings;
+    }
+
+    /// The order `family`'s colours are projected in, as indices into
+    /// [`FamilyBatches::colours`].
+    pub fn colour_order(&self, family: Family) -> Vec<usize> {
+        let colours = self.batches(family).colours().len();
+        let order = &self.colour_orders[family];
+        (0..colours)
+            .map(|k| order.get(k).map_or(k, |&c| c as usize))
+            .collect()
     }
 
     /// The threads the projections run on.
@@ -362,11 +400,9 @@ impl FastSimulation {
 
     /// The constraints of `family`, coloured and in batches (empty when it is not active).
     pub fn batches(&self, family: Family) -> FamilyBatches<'_> {
-        let binding = family.row().binding;
         FamilyBatches {
-            layout: self.layouts.of(binding),
+            layout: self.layouts.of(family.row().binding),
             batches: &self.sets[family],
-            binding,
         }
     }
 
@@ -447,7 +483,51 @@ impl FastSimulation {
 
     /// Positions in the scene's particle numbering.
     pub fn positions(&self) -> Vec<DVec3> {
-        self.in_scene_order(&self.positions)
+        let mut positions = self.in_scene_order(&self.positions);
+        for p in &mut positions {
+            *p += self.origin;
+        }
+        positions
+    }
+
+    /// Moves the origin of the f32 coordinates to the body when the body has travelled from it
+    /// by more than its own size ([`RECENTRE_FROM`]), axis by axis: a body thrown 1 km up keeps
+    /// coordinates of its own size, and their 2⁻²⁴ relative precision. (Unmoved, a bunny 2 km
+    /// up computed its sliver tets' volumes from coordinates of 2000 m, each good to 10⁻⁴ m,
+    /// and ended with tets squashed to 44 % and inverted that the f64 engine kept whole.)
+    ///
+    /// The shift is a multiple of 2⁻¹⁰ of the body's size, so that the origin is one too: the
+    /// ground, at y = −origin.y in these coordinates, stays exact in f32 up to 2¹⁴ body sizes
+    /// away. A body within its own size of the origin (every body at rest near the scene's
+    /// origin) is never moved, and its bits never change.
+    fn recentre(&mut self) {
+        let (low, high) = self.positions.iter().fold(
+            (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+            |(low, high), p| (low.min(*p), high.max(*p)),
+        );
+        let size = (high - low).max_element();
+        if !(size.is_finite() && size > 0.0) {
+            return;
+        }
+        let centre = (low + high) * 0.5;
+        let grid = 2f32.powi(size.log2().floor() as i32 - 10);
+        let shift = Vec3A::select(
+            centre.abs().cmpgt(Vec3A::splat(RECENTRE_FROM * size)),
+            (centre / grid).round() * grid,
+            Vec3A::ZERO,
+        );
+        if shift == Vec3A::ZERO {
+            return;
+        }
+        for p in self.positions.iter_mut().chain(&mut self.previous) {
+            *p -= shift;
+        }
+        self.origin += shift.as_dvec3();
+    }
+
+    /// Where the ground (y = 0) is in the f32 coordinates.
+    fn ground(&self) -> Option<f64> {
+        self.settings.ground.then_some(-self.origin.y)
     }
 
     /// Velocities in the scene's particle numbering.
@@ -463,17 +543,27 @@ impl FastSimulation {
         out
     }
 
-    /// Ok while every coordinate is finite and below [`POSITION_LIMIT`] in size and every
-    /// velocity component below [`crate::solver::SOUND_LIMIT`]; otherwise the first that is not
-    /// (particles in the scene's numbering).
+    /// Ok while every f32 coordinate (measured from the engine's origin, which follows the
+    /// body) is finite and below [`POSITION_LIMIT`] in size, every position below
+    /// [`crate::solver::SOUND_LIMIT`], and every velocity component below that too; otherwise
+    /// the first that is not (particles in the scene's numbering).
     pub fn check(&self) -> Result<(), Divergence> {
         let f64s = |v: &Vec3A| v.as_dvec3().to_array();
+        let original = |i: usize| self.original[i] as usize;
         Divergence::find(
             self.frame,
             (POSITION_LIMIT, crate::solver::SOUND_LIMIT),
             self.positions.iter().map(f64s),
             self.velocities.iter().map(f64s),
-            |i| self.original[i] as usize,
+            original,
+        )?;
+        let global = |v: &Vec3A| (self.origin + v.as_dvec3()).to_array();
+        Divergence::find(
+            self.frame,
+            (crate::solver::SOUND_LIMIT, crate::solver::SOUND_LIMIT),
+            self.positions.iter().map(global),
+            std::iter::empty(),
+            original,
         )
     }
 
@@ -509,6 +599,7 @@ impl FastSimulation {
             + (self.original.capacity() + self.renumber.capacity()) * size_of::<u32>()
             + self.layouts.edges.heap_bytes()
             + self.layouts.tets.heap_bytes()
+            + self.layouts.tet_vertices.heap_bytes()
             + self
                 .sets
                 .iter_ref()
@@ -561,13 +652,15 @@ impl FastSimulation {
 
     /// One frame; `parallel`: large colours are shared by the threads of the current pool.
     fn step_on(&mut self, parallel: bool, inputs: &FrameInputs) {
+        self.recentre();
         let settings = self.settings;
         let h = settings.dt / settings.substeps.max(1) as f64;
         let substeps = settings.substeps.max(1);
+        let ground = self.ground();
         let grab = inputs.grab.map(|(particle, target, compliance)| {
             (
                 self.renumber[particle] as usize,
-                target.as_vec3a(),
+                (target - self.origin).as_vec3a(),
                 compliance,
             )
         });
@@ -591,7 +684,7 @@ impl FastSimulation {
                 &self.inverse_masses,
                 settings.gravity,
                 h,
-                settings.ground,
+                ground,
             );
             if let Some((i, target, compliance)) = grab
                 && compliance <= 0.0
@@ -666,6 +759,7 @@ impl FastSimulation {
             if let Some(partner) = family.partner_in(&active) {
                 struct ProjectPair<'a> {
                     layout: &'a Layout,
+                    order: &'a [u32],
                     batches: (&'a mut Batches, &'a mut Batches),
                     positions: &'a mut [Vec3A],
                     rest_positions: &'a mut [Vec3A],
@@ -689,6 +783,7 @@ impl FastSimulation {
                         kernel::project_pair::<N, A, M, B>(
                             (first, second),
                             self.layout,
+                            self.order,
                             self.batches,
                             self.positions,
                             self.rest_positions,
@@ -703,6 +798,7 @@ impl FastSimulation {
                     partner,
                     ProjectPair {
                         layout: self.layouts.of(family.row().binding),
+                        order: &self.colour_orders[family],
                         batches: self.sets.pair_mut(family, partner),
                         positions: &mut self.positions,
                         rest_positions: &mut self.rest_positions,
@@ -722,7 +818,7 @@ impl FastSimulation {
             }
             struct Project<'a> {
                 layout: &'a Layout,
-                binding: Binding,
+                order: &'a [u32],
                 batches: &'a mut Batches,
                 positions: &'a mut [Vec3A],
                 rest_positions: &'a mut [Vec3A],
@@ -730,13 +826,14 @@ impl FastSimulation {
                 rule: Rule<f64>,
                 parallel: bool,
             }
-            impl Project<'_> {
-                /// The kernel for K constraints per element.
+            impl Visit for Project<'_> {
+                type Output = usize;
                 #[inline]
-                fn with<const N: usize, C: Constraint<N>, const K: usize>(self, c: &C) -> usize {
-                    kernel::project_family::<N, C, K>(
+                fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> usize {
+                    kernel::project_family::<N, C>(
                         c,
                         self.layout,
+                        self.order,
                         self.batches,
                         self.positions,
                         self.rest_positions,
@@ -746,21 +843,9 @@ impl FastSimulation {
                     )
                 }
             }
-            impl Visit for Project<'_> {
-                type Output = usize;
-                #[inline]
-                fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> usize {
-                    // Constraints per element, a constant of each instance of the kernel.
-                    match self.binding {
-                        Binding::TetVertices => self.with::<N, C, 4>(c),
-                        _ => self.with::<N, C, 1>(c),
-                    }
-                }
-            }
-            let binding = family.row().binding;
             let count = family.visit(Project {
-                layout: self.layouts.of(binding),
-                binding,
+                layout: self.layouts.of(family.row().binding),
+                order: &self.colour_orders[family],
                 batches: &mut self.sets[family],
                 positions: &mut self.positions,
                 rest_positions: &mut self.rest_positions,
@@ -787,10 +872,24 @@ impl FastSimulation {
                 self.positions[i] += c.delta_x[0];
             }
         }
-        if self.settings.ground {
-            integrate::project_ground(&mut self.positions, &self.inverse_masses);
+        if let Some(ground) = self.ground() {
+            integrate::project_ground(&mut self.positions, &self.inverse_masses, ground);
         }
     }
+}
+
+/// The order of each active family's colours that `settings` ask for ([`Settings::order_seed`]):
+/// empty (the layout's order) without a seed.
+fn colour_orders(settings: &Settings, layouts: &Layouts) -> PerFamily<Vec<u32>> {
+    PerFamily::build(|family| {
+        if !settings.active[family] {
+            return Vec::new();
+        }
+        let colours = layouts.of(family.row().binding).colours.len();
+        settings
+            .projection_order(family, colours)
+            .unwrap_or_default()
+    })
 }
 
 #[cfg(test)]

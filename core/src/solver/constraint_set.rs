@@ -1,6 +1,7 @@
 //! The constraints of one family as the reference solver keeps them: flat arrays, one entry per
-//! constraint in projection order (the particles, `arity` of them each; the rest value; the XPBD
-//! multiplier λ), built once from the family's binding to the mesh.
+//! constraint in the binding's order (the particles, `arity` of them each; the rest value; the
+//! XPBD multiplier λ), built once from the family's binding to the mesh, and the order a sweep
+//! projects them in (the binding's, or a permutation drawn from an order seed).
 
 use crate::constraints::{Constraint, Family, Visit};
 use crate::material::Material;
@@ -17,6 +18,9 @@ pub struct ConstraintSet {
     particles: Vec<u32>,
     rest: Vec<f64>,
     lambda: Vec<f64>,
+    /// The order a sweep projects the constraints in; empty for 0, 1, 2, …
+    /// ([`crate::solver::Settings::order_seed`]).
+    order: Vec<u32>,
 }
 
 impl ConstraintSet {
@@ -30,6 +34,7 @@ impl ConstraintSet {
             lambda: vec![0.0; particles.len() / family.arity()],
             particles,
             rest: Vec::new(),
+            order: Vec::new(),
         };
         set.measure_rest(family, &mesh.positions, material);
         set
@@ -123,9 +128,22 @@ impl ConstraintSet {
         self.lambda.fill(0.0);
     }
 
+    /// Sets the order a sweep projects the constraints in: a permutation of 0..len, or `None`
+    /// for the binding's order.
+    pub(crate) fn set_order(&mut self, order: Option<Vec<u32>>) {
+        self.order = order.unwrap_or_default();
+        debug_assert!(self.order.is_empty() || self.order.len() == self.len());
+    }
+
+    /// The constraint a sweep projects `k`-th.
+    #[inline]
+    pub fn in_order(&self, k: usize) -> usize {
+        self.order.get(k).map_or(k, |&c| c as usize)
+    }
+
     /// The bytes its arrays take (their capacities).
     pub(crate) fn heap_bytes(&self) -> usize {
-        self.particles.capacity() * size_of::<u32>()
+        (self.particles.capacity() + self.order.capacity()) * size_of::<u32>()
             + (self.rest.capacity() + self.lambda.capacity()) * size_of::<f64>()
     }
 }

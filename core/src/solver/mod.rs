@@ -15,7 +15,9 @@
 //! The correction Δp of a substep is, per particle, the position after the sweeps minus the
 //! predicted one ([`Simulation::corrections`]). An edit (a perturbation, a particle placed by hand)
 //! settles until no particle's Δp, summed over a frame's substeps, exceeds
-//! [`Simulation::settle_tolerance`], or for at most [`MAX_SETTLE_FRAMES`] frames.
+//! [`Simulation::settle_tolerance`]: until its violation is undone, however long that takes. (It
+//! once ended after at most a second as well; a body still tangled then, its rigid constraints
+//! still fighting, was launched at hundreds of m/s when the cap came off.)
 //!
 //! Each constraint is projected by the rule of [`crate::projection`] (XPBD or PBD), which the
 //! fast solver shares. All state lives in flat arrays, one [`ConstraintSet`] per family,
@@ -47,9 +49,6 @@ use glam::DVec3;
 /// The largest coordinate or velocity component (in m or m/s) a sound simulation in f64 has:
 /// below it, volumes (cubes), squared residuals and their sums over any mesh stay finite.
 pub const SOUND_LIMIT: f64 = 1e30;
-
-/// The longest an edit settles, in frames (one second at 60 frames per second).
-pub const MAX_SETTLE_FRAMES: u32 = 60;
 
 /// An edit has settled when the speed the corrections of a frame would give a particle, ΣΔp / h
 /// over its substeps, is at most this many mean rest edge lengths per second (plus what gravity
@@ -151,7 +150,23 @@ impl Simulation {
             threads: 1,
         };
         simulation.update_inverse_masses();
+        simulation.apply_orders();
         simulation
+    }
+
+    #[doc(hidden)]
+    pub fn scratch_set_order(&mut self, family: Family, order: Vec<u32>) {
+        self.sets[family].set_order(Some(order));
+    }
+
+    /// Gives every family's constraints the order [`Settings::order_seed`] asks for.
+    fn apply_orders(&mut self) {
+        for family in Family::all() {
+            let order = self
+                .settings
+                .projection_order(family, self.sets[family].len());
+            self.sets[family].set_order(order);
+        }
     }
 
     /// The settings in force.
@@ -185,6 +200,10 @@ impl Simulation {
                 tets: self.tets.clone(),
             });
             self.sets[family] = ConstraintSet::new(family, mesh, &self.settings.material);
+            let order = self
+                .settings
+                .projection_order(family, self.sets[family].len());
+            self.sets[family].set_order(order);
             // The fast engine's constraints were built from the old ones.
             self.fast.solver = None;
         }
@@ -200,7 +219,11 @@ impl Simulation {
             }
         }
         self.fast.set_settings(&self.settings, &settings);
+        let reorder = settings.order_seed != self.settings.order_seed;
         self.settings = settings;
+        if reorder {
+            self.apply_orders();
+        }
         self.rebuild_stale_sets();
     }
 
@@ -231,6 +254,11 @@ impl Simulation {
         self.settling.is_some()
     }
 
+    /// For how many frames the edit being settled has been settling, `None` when none is.
+    pub fn settling_frames(&self) -> Option<u32> {
+        self.settling
+    }
+
     /// The largest sum of Δp over a frame's substeps, in metres, at which an edit counts as
     /// settled: [`SETTLE_SPEED`] × the mean rest edge length × h, plus g h Δt, the sum of the
     /// g h² a substep that gravity alone causes in a body at rest on the ground.
@@ -249,6 +277,45 @@ impl Simulation {
     pub fn settle_tolerance(&self) -> f64 {
         let h = self.substep_length();
         (SETTLE_SPEED * self.mean_edge + self.settings.gravity.abs() * self.settings.dt) * h
+    }
+
+    /// The centre of mass of the particles at `positions` (one per particle, e.g.
+    /// [`Simulation::positions`] or [`Simulation::rest_positions`]), weighted by the lumped
+    /// masses, pinned particles included.
+    ///
+    /// ```
+    /// use tetlab_core::scene::{Builtin, Scene};
+    /// use tetlab_core::solver::{Settings, Simulation};
+    /// let cube = Simulation::new(&Scene::builtin(Builtin::Cube, 2).unwrap(), Settings::default());
+    /// // The unit cube on the ground, centred on the y axis: its centre is half a metre up.
+    /// let centre = cube.centre_of_mass(cube.rest_positions());
+    /// assert!((centre - glam::DVec3::new(0.0, 0.5, 0.0)).length() < 1e-12);
+    /// ```
+    pub fn centre_of_mass(&self, positions: &[DVec3]) -> DVec3 {
+        let mut weighted = DVec3::ZERO;
+        let mut mass = 0.0;
+        for (p, w) in positions.iter().zip(&self.lumped_inverse_masses) {
+            weighted += *p / *w;
+            mass += 1.0 / *w;
+        }
+        if mass > 0.0 {
+            weighted / mass
+        } else {
+            DVec3::ZERO
+        }
+    }
+
+    /// The diagonal of the rest shape's bounding box, in metres: the size of the body.
+    pub fn rest_diagonal(&self) -> f64 {
+        let (low, high) = self.rest_positions.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(low, high), p| (low.min(*p), high.max(*p)),
+        );
+        if self.rest_positions.is_empty() {
+            0.0
+        } else {
+            low.distance(high)
+        }
     }
 
     /// Inverse masses in use (0 for pinned or grabbed-rigidly particles).
@@ -272,17 +339,17 @@ impl Simulation {
     }
 
     /// Ok while every coordinate and velocity component is finite and below [`SOUND_LIMIT`] in
-    /// size; otherwise the first that is not. Within the input [`crate::limits`] only an
-    /// instability leaves that range; front ends check after every frame and stop.
+    /// size, and on the fast engine every f32 coordinate (measured from its origin, which
+    /// follows the body) below [`crate::fast::POSITION_LIMIT`]; otherwise the first that is not.
+    /// Within the input [`crate::limits`] only an instability leaves that range; front ends
+    /// check after every frame and stop.
     pub fn check(&self) -> Result<(), Divergence> {
-        // The f32 engine holds coordinates up to its own limit.
-        let positions = match self.engine() {
-            Engine::Fast => crate::fast::POSITION_LIMIT,
-            _ => SOUND_LIMIT,
-        };
+        if let (Engine::Fast, Some(fast)) = (self.engine(), &self.fast.solver) {
+            fast.check()?;
+        }
         Divergence::find(
             self.frame,
-            (positions, SOUND_LIMIT),
+            (SOUND_LIMIT, SOUND_LIMIT),
             self.positions.iter().map(|p| p.to_array()),
             self.velocities.iter().map(|v| v.to_array()),
             |i| i,
@@ -452,9 +519,7 @@ impl Simulation {
         }
         if let Some(frames) = self.settling {
             let largest = self.largest_frame_correction();
-            self.settling = (self.settings.edits_settle()
-                && largest > self.settle_tolerance()
-                && frames + 1 < MAX_SETTLE_FRAMES)
+            self.settling = (self.settings.edits_settle() && largest > self.settle_tolerance())
                 .then_some(frames + 1);
         }
         self.frame += 1;
@@ -499,7 +564,7 @@ impl Simulation {
         let h = self.substep_length();
         self.project_soft_grab(h);
         if self.settings.ground {
-            integrate::project_ground(&mut self.positions, &self.inverse_masses);
+            integrate::project_ground(&mut self.positions, &self.inverse_masses, 0.0);
         }
     }
 
@@ -520,12 +585,16 @@ impl Simulation {
     }
 
     /// The constraints one sweep projects, in order: every constraint of each active family
-    /// (edges, then heights, then volumes), as (family, index in the family).
+    /// (edges, then heights, then volumes), each family's in the order of
+    /// [`Settings::order_seed`], as (family, index in the family).
     pub fn projection_order(&self) -> impl Iterator<Item = (Family, usize)> + '_ {
         let active = self.settings.active;
         Family::all()
             .filter(move |&f| active[f] && !f.projected_by_partner(&active))
-            .flat_map(move |f| (0..self.constraint_count(f)).map(move |c| (f, c)))
+            .flat_map(move |f| {
+                let set = &self.sets[f];
+                (0..set.len()).map(move |k| (f, set.in_order(k)))
+            })
     }
 
     /// The constraints of `family` on tet `tet`, as indices in the family: its edges (six), its
@@ -623,11 +692,11 @@ impl Simulation {
     /// it leads a pair).
     pub fn project(&mut self, family: Family, c: usize) {
         self.fast.edited();
-        self.project_range(family, c..c + 1, self.substep_length());
+        self.project_range(family, Projected::One(c), self.substep_length());
     }
 
-    /// Projects constraints `range` of `family` in turn, alone or with its partner.
-    fn project_range(&mut self, family: Family, range: std::ops::Range<usize>, h: f64) {
+    /// Projects the constraints `which` of `family` in turn, alone or with its partner.
+    fn project_range(&mut self, family: Family, which: Projected, h: f64) {
         let rule = self.rule(family, h);
         if let Some(partner) = family.partner_in(&self.settings.active) {
             let rules = [rule, self.rule(partner, h)];
@@ -639,7 +708,7 @@ impl Simulation {
                 rest_positions: &self.rest_positions,
                 inverse_masses: &self.inverse_masses,
                 rules,
-                range,
+                which,
             };
             family.visit_pair(partner, sweep);
             return;
@@ -650,7 +719,7 @@ impl Simulation {
             rest_positions: &self.rest_positions,
             inverse_masses: &self.inverse_masses,
             rule,
-            range,
+            which,
         });
     }
 
@@ -672,7 +741,7 @@ impl Simulation {
             &self.inverse_masses,
             self.settings.gravity,
             h,
-            self.settings.ground,
+            self.settings.ground.then_some(0.0),
         );
         if let Some(grab) = self.rigid_grab() {
             self.positions[grab.particle] = grab.target;
@@ -691,7 +760,7 @@ impl Simulation {
             if !active[family] || family.projected_by_partner(&active) {
                 continue;
             }
-            self.project_range(family, 0..self.sets[family].len(), h);
+            self.project_range(family, Projected::All, h);
         }
         self.end_sweep();
     }
@@ -725,15 +794,43 @@ impl Simulation {
     }
 }
 
-/// Projects the constraints of one family's `set` (every one in order, Gauss–Seidel, or `only`
-/// one): λ += Δλ, xᵢ += Δxᵢ.
+/// Which constraints of a family a projection call makes.
+#[derive(Clone, Copy)]
+pub(super) enum Projected {
+    /// Every one, in the set's order (a sweep).
+    All,
+    /// Constraint c alone (step-by-step mode).
+    One(usize),
+}
+
+impl Projected {
+    /// The positions in the set's order to go through.
+    pub(super) fn range(self, set: &ConstraintSet) -> std::ops::Range<usize> {
+        match self {
+            Projected::All => 0..set.len(),
+            Projected::One(c) => c..c + 1,
+        }
+    }
+
+    /// The constraint at position `k` of [`Projected::range`].
+    #[inline]
+    pub(super) fn at(self, set: &ConstraintSet, k: usize) -> usize {
+        match self {
+            Projected::All => set.in_order(k),
+            Projected::One(c) => c,
+        }
+    }
+}
+
+/// Projects the constraints of one family's `set` (every one in the set's order, Gauss–Seidel,
+/// or one): λ += Δλ, xᵢ += Δxᵢ.
 struct Sweep<'a> {
     set: &'a mut ConstraintSet,
     positions: &'a mut [DVec3],
     rest_positions: &'a [DVec3],
     inverse_masses: &'a [f64],
     rule: Rule<f64>,
-    range: std::ops::Range<usize>,
+    which: Projected,
 }
 
 impl Visit for Sweep<'_> {
@@ -741,7 +838,8 @@ impl Visit for Sweep<'_> {
 
     #[inline]
     fn visit<const N: usize, C: Constraint<N>>(self, _: Family, constraint: &C) {
-        for c in self.range {
+        for k in self.which.range(self.set) {
+            let c = self.which.at(self.set, k);
             let idx = self.set.indices::<N>(c);
             let p = idx.map(|i| self.positions[i as usize]);
             let shape = if C::USES_REST_SHAPE {

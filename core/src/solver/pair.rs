@@ -2,11 +2,10 @@
 //! ([`crate::constraints::Row::projected_with`]: the neo-Hookean pair): constraint c of each has
 //! the same particles, and one 2 × 2 solve ([`pair_correction_lanes`]) moves them.
 
-use super::ConstraintSet;
+use super::{ConstraintSet, Projected};
 use crate::constraints::{Constraint, Evaluation, VisitPair};
 use crate::projection::{PairCorrection, Rule, pair_correction_lanes};
 use glam::DVec3;
-use std::ops::Range;
 
 /// What the pair is projected with: the two families' constraints, the particles and the rules.
 pub(super) struct Pair<'a> {
@@ -58,7 +57,8 @@ pub(super) struct PairSweep<'a> {
     pub rest_positions: &'a [DVec3],
     pub inverse_masses: &'a [f64],
     pub rules: [Rule<f64>; 2],
-    pub range: Range<usize>,
+    /// Which constraints, in the first family's order.
+    pub which: Projected,
 }
 
 impl VisitPair for PairSweep<'_> {
@@ -70,7 +70,8 @@ impl VisitPair for PairSweep<'_> {
         first: &A,
         second: &B,
     ) {
-        for c in self.range.clone() {
+        for k in self.which.range(self.first) {
+            let c = self.which.at(self.first, k);
             let pair = Pair {
                 first: &*self.first,
                 second: &*self.second,
