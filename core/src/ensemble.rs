@@ -123,6 +123,9 @@ pub struct Tally {
     pub thrown: usize,
     /// The inverted tets at the end of each member that did not diverge, smallest first.
     pub inverted_at_the_end: Vec<usize>,
+    /// The largest max edge strain at the end among the members that did not diverge: a body
+    /// may end with no tet inverted yet tangled.
+    pub largest_strain: f64,
 }
 
 impl Tally {
@@ -140,11 +143,16 @@ impl Tally {
             diverged: mine.len() - outcomes.len(),
             thrown: outcomes.iter().filter(|o| o.thrown()).count(),
             inverted_at_the_end,
+            largest_strain: outcomes
+                .iter()
+                .map(|o| o.last.max_edge_strain)
+                .fold(0.0, f64::max),
         }
     }
 
-    /// "recovers in 16 of 16 orderings", "recovers in 3 of 4 orderings (the others end with 2
-    /// and 170 inverted)", with divergences and throws named.
+    /// "recovers in 16 of 16 orderings", "recovers in 3 of 4 orderings (1 ends with 170
+    /// inverted)", with divergences and throws named; and, where some member ends strained, how
+    /// much ("max edge strain at the end up to 0.64").
     ///
     /// ```
     /// use tetlab_core::ensemble::Tally;
@@ -156,11 +164,14 @@ impl Tally {
     ///     diverged: 1,
     ///     thrown: 0,
     ///     inverted_at_the_end: vec![0, 0, 7],
+    ///     largest_strain: 0.002,
     /// };
     /// assert_eq!(
     ///     tally.describe(),
     ///     "recovers in 2 of 4 orderings (1 ends with 7 inverted; 1 diverges)"
     /// );
+    /// let tangled = Tally { largest_strain: 0.64, ..tally };
+    /// assert!(tangled.describe().ends_with("; max edge strain at the end up to 0.64"));
     /// ```
     pub fn describe(&self) -> String {
         let mut text = format!(
@@ -200,6 +211,13 @@ impl Tally {
         }
         if !notes.is_empty() {
             text += &format!(" ({})", notes.join("; "));
+        }
+        // A percent of strain is a shape that holds; beyond it, say how far some member is off.
+        if self.largest_strain > 0.01 {
+            text += &format!(
+                "; max edge strain at the end up to {:.2}",
+                self.largest_strain
+            );
         }
         text
     }

@@ -625,7 +625,8 @@ impl Lesson {
         if let Some(d) = checked(&limits::DAMPING, &s.damping, error)? {
             settings.damping = d;
         }
-        settings.settle_edits = s.settle_edits.unwrap_or(settings.settle_edits);
+        // Edits settle unless the lesson says otherwise, as in the workbench and `tetlab run`.
+        settings.settle_edits = s.settle_edits.unwrap_or(true);
         if let Some(material) = &s.material {
             let material = Material::parse(material.get_ref()).map_err(|e| {
                 error(

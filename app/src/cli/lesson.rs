@@ -42,6 +42,14 @@ pub struct Args {
     /// The neo-Hookean material instead of the lesson's: E=PA,nu=N, as for `tetlab run`.
     #[arg(long, value_name = "E=PA,nu=N", value_parser = tetlab_core::material::Material::parse, conflicts_with = "list")]
     material: Option<tetlab_core::material::Material>,
+    /// Project each family's constraints in an order drawn from this seed, as for `tetlab run`
+    /// [default: the mesh's order].
+    #[arg(long, value_name = "S", conflicts_with = "list")]
+    order_seed: Option<u64>,
+    /// Let perturbations launch the body, whatever the lesson says (edits settle unless the
+    /// lesson sets settle_edits = false).
+    #[arg(long, conflicts_with = "list")]
+    no_settle_edits: bool,
 }
 
 /// Whether every expected observation of the lesson was observed.
@@ -110,6 +118,12 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     if let Some(engine) = args.engine {
         lesson.settings.engine = engine;
     }
+    if args.order_seed.is_some() {
+        lesson.settings.order_seed = args.order_seed;
+    }
+    if args.no_settle_edits {
+        lesson.settings.settle_edits = false;
+    }
     let mut run = LessonRun::new(&lesson);
     run.simulation.set_threads(args.threads.map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
@@ -160,7 +174,13 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     }
 
     writeln!(out, "# {}", lesson.title).map_err(UsageError::stdout)?;
-    writeln!(out, "\nengine {}", run.simulation.describe_engine()).map_err(UsageError::stdout)?;
+    let engine = format!(
+        "engine {}{}{}",
+        run.simulation.describe_engine(),
+        super::simulation_args::describe_order(run.simulation.settings()),
+        super::simulation_args::describe_settling(run.simulation.settings())
+    );
+    writeln!(out, "\n{engine}").map_err(UsageError::stdout)?;
     let mut all_observed = true;
     for (k, step) in lesson.steps.iter().enumerate() {
         writeln!(
@@ -175,9 +195,8 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
             rec.set_time_sequence("frame", clock.frame as i64);
             rec.set_duration_secs("sim_time", clock.time);
             let text = format!(
-                "# {}\n\nengine {}\n\n## step {} of {}\n\n{}",
+                "# {}\n\n{engine}\n\n## step {} of {}\n\n{}",
                 lesson.title,
-                run.simulation.describe_engine(),
                 k + 1,
                 lesson.steps.len(),
                 step.text
@@ -212,7 +231,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
                 }
             }
             match &session {
-                Some(session) if session.interrupted() => ControlFlow::Break(()),
+                Some(session) if session.should_stop() => ControlFlow::Break(()),
                 Some(session) => {
                     session.advance();
                     ControlFlow::Continue(())

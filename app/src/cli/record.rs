@@ -92,7 +92,7 @@ fn run(
     let mut recorder = Recorder::new(rec, "", scene, simulation, args.arrows, args.tet as usize);
     recorder.log_frame(simulation, initial);
     for _ in 0..args.simulation.frames {
-        if session.interrupted() {
+        if session.should_stop() {
             break;
         }
         let metrics = SimulationArgs::step(simulation)?;

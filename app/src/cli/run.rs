@@ -302,6 +302,7 @@ struct TallyRecord {
     diverged: usize,
     thrown: usize,
     inverted_at_the_end: Vec<usize>,
+    largest_strain: f64,
     summary: String,
 }
 
@@ -313,6 +314,7 @@ impl TallyRecord {
             diverged: tally.diverged,
             thrown: tally.thrown,
             inverted_at_the_end: tally.inverted_at_the_end.clone(),
+            largest_strain: tally.largest_strain,
             summary: tally.describe(),
         }
     }

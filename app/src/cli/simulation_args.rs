@@ -212,10 +212,7 @@ impl SolverArgs {
         if uses_material || self.material.is_some() {
             text += &format!(", material {}", s.material.describe());
         }
-        match s.order_seed {
-            Some(seed) => text += &format!(", order seed {seed}"),
-            None => text += ", the mesh's order",
-        }
+        text += &describe_order(s);
         for family in s.active.families() {
             if let Some(file) = family.file() {
                 let gradient = if file.use_gradient {
@@ -267,6 +264,14 @@ impl SimulationArgs {
     /// What [`SolverArgs::describe`] says of `simulation`'s settings, and whether edits settle.
     pub fn describe(&self, simulation: &Simulation) -> String {
         self.solver.describe(simulation) + &describe_settling(simulation.settings())
+    }
+}
+
+/// ", order seed S" or ", the mesh's order": the order the constraints are projected in.
+pub fn describe_order(settings: &Settings) -> String {
+    match settings.order_seed {
+        Some(seed) => format!(", order seed {seed}"),
+        None => ", the mesh's order".to_owned(),
     }
 }
 

@@ -3,8 +3,10 @@
 //! ([`super::summary`]), and only then renamed to `FILE`: a failed or interrupted write never
 //! leaves a broken recording under the name the user asked for, and never replaces what is not
 //! a regular file. Ctrl-C (and SIGTERM) stop after the current frame; a write past the file-size
-//! limit fails rather than killing tetlab.
+//! limit fails rather than killing tetlab, and the file is written by [`super::file_writer`],
+//! which reports a failed write at once instead of hanging.
 
+use super::file_writer::{FileWriter, WriteFailure};
 use super::summary::Summary;
 use crate::cli::UsageError;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -45,7 +47,7 @@ pub enum Destination {
 pub struct Session {
     target: Target,
     rec: RecordingStream,
-    writer_errors: WriterErrors,
+    failure: WriteFailure,
     interrupted: Arc<AtomicBool>,
     progress: Progress,
 }
@@ -55,13 +57,12 @@ impl Session {
     pub fn open(destination: Destination, frames: u64, quiet: bool) -> Result<Session, UsageError> {
         let interrupted = interrupt_flag()?;
         survive_file_size_limit()?;
-        let writer_errors = WriterErrors::install();
         let target = Target::new(destination)?;
-        let rec = target.open()?;
+        let (rec, failure) = target.open()?;
         Ok(Session {
             target,
             rec,
-            writer_errors,
+            failure,
             interrupted,
             progress: Progress::new(frames, quiet),
         })
@@ -77,6 +78,12 @@ impl Session {
         self.interrupted.load(Ordering::SeqCst)
     }
 
+    /// Whether to stop recording: Ctrl-C or SIGTERM asked to, or a write of the file failed
+    /// (a full disk), after which nothing more can be kept and [`Session::close`] says why.
+    pub fn should_stop(&self) -> bool {
+        self.interrupted() || self.failure.get().is_some()
+    }
+
     /// One more frame recorded.
     pub fn advance(&self) {
         self.progress.advance();
@@ -87,9 +94,7 @@ impl Session {
     pub fn close(self, last_frame: u64, out: &mut impl Write) -> Result<Ending, UsageError> {
         self.progress.finish();
         let interrupted = self.interrupted();
-        let kept = self
-            .target
-            .close(self.rec, last_frame, &self.writer_errors)?;
+        let kept = self.target.close(self.rec, last_frame, &self.failure)?;
         if let Some(kept) = kept {
             writeln!(out, "wrote {kept}").map_err(UsageError::stdout)?;
         }
@@ -106,7 +111,7 @@ impl Session {
     /// since the run did not succeed.
     pub fn close_after(self, last_frame: u64, failure: UsageError) -> UsageError {
         self.progress.finish();
-        match self.target.close(self.rec, last_frame, &self.writer_errors) {
+        match self.target.close(self.rec, last_frame, &self.failure) {
             Ok(Some(kept)) => UsageError(format!(
                 "{}; kept the recording up to it: {kept}",
                 failure.0
@@ -153,24 +158,32 @@ impl Target {
         })
     }
 
-    fn open(&self) -> Result<RecordingStream, UsageError> {
+    /// The stream, and where a failed write of its file is kept (never set for a viewer).
+    fn open(&self) -> Result<(RecordingStream, WriteFailure), UsageError> {
         let builder = rerun::RecordingStreamBuilder::new("tetlab");
         match self {
             Target::File {
                 path,
                 partial,
                 flag,
-            } => builder.save(partial).map_err(|e| {
-                // It may have been created before the first write failed (a file-size limit).
-                let _ = std::fs::remove_file(partial);
-                UsageError(format!(
-                    "{flag} {}: cannot create the file: {}",
-                    path.display(),
-                    io_cause(&e)
-                ))
-            }),
+            } => {
+                let cannot = |cause: String| {
+                    // It may have been created before the first write failed (a file-size limit).
+                    let _ = std::fs::remove_file(partial);
+                    UsageError(format!(
+                        "{flag} {}: cannot create the file: {cause}",
+                        path.display()
+                    ))
+                };
+                let (writer, failure) =
+                    FileWriter::create(partial).map_err(|e| cannot(e.to_string()))?;
+                let sinks: Vec<Box<dyn rerun::sink::LogSink>> = vec![Box::new(writer)];
+                let rec = builder.set_sinks(sinks).map_err(|e| cannot(io_cause(&e)))?;
+                Ok((rec, failure))
+            }
             Target::Viewer { url } => builder
                 .connect_grpc_opts(url.clone())
+                .map(|rec| (rec, WriteFailure::default()))
                 .map_err(|e| UsageError(format!("--connect {url}: {e}"))),
         }
     }
@@ -181,11 +194,14 @@ impl Target {
         self,
         rec: RecordingStream,
         last_frame: u64,
-        writer_errors: &WriterErrors,
+        failure: &WriteFailure,
     ) -> Result<Option<String>, UsageError> {
         let flushed = rec.flush_blocking();
+        // Dropping the last handle of the stream drops its sink, which writes the file's footer.
         drop(rec);
-        let flushed = flushed.map_err(|e| writer_errors.first().unwrap_or_else(|| e.to_string()));
+        let flushed = flushed
+            .map_err(|e| failure.get().unwrap_or_else(|| e.to_string()))
+            .and_then(|()| failure.get().map_or(Ok(()), Err));
         match self {
             Target::Viewer { url } => flushed.map(|()| None).map_err(|e| {
                 UsageError(format!(
@@ -294,48 +310,6 @@ fn io_cause(error: &dyn std::error::Error) -> String {
         cause = source;
     }
     cause.to_string()
-}
-
-/// Errors that rerun's writer thread reports as tracing events (it has no other way to say that a
-/// write failed, e.g. on a full disk), kept so the one-line error can name the cause.
-#[derive(Clone, Default)]
-struct WriterErrors(Arc<std::sync::Mutex<Vec<String>>>);
-
-impl WriterErrors {
-    /// Installs a subscriber that keeps ERROR events and prints nothing.
-    fn install() -> WriterErrors {
-        use tracing_subscriber::layer::SubscriberExt;
-        let errors = WriterErrors::default();
-        let subscriber = tracing_subscriber::registry().with(errors.clone());
-        // Only fails if a subscriber is already set; then causes are simply not captured.
-        let _ = tracing::subscriber::set_global_default(subscriber);
-        errors
-    }
-
-    fn first(&self) -> Option<String> {
-        self.0.lock().ok()?.first().cloned()
-    }
-}
-
-impl<S: tracing::Subscriber> tracing_subscriber::Layer<S> for WriterErrors {
-    fn on_event(&self, event: &tracing::Event<'_>, _: tracing_subscriber::layer::Context<'_, S>) {
-        if *event.metadata().level() != tracing::Level::ERROR {
-            return;
-        }
-        struct Message(String);
-        impl tracing::field::Visit for Message {
-            fn record_debug(&mut self, field: &tracing::field::Field, value: &dyn std::fmt::Debug) {
-                if field.name() == "message" {
-                    self.0 = format!("{value:?}");
-                }
-            }
-        }
-        let mut message = Message(String::new());
-        event.record(&mut message);
-        if let Ok(mut errors) = self.0.lock() {
-            errors.push(message.0);
-        }
-    }
 }
 
 /// Set by Ctrl-C (SIGINT) or SIGTERM; checked between frames.
