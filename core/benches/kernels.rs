@@ -34,6 +34,7 @@ fn kernels(c: &mut Criterion) {
                 black_box(&[tet32[0], tet32[1]]),
                 0.9,
                 [w32[0], w32[1]],
+                1e3,
             )
         })
     });
@@ -44,20 +45,21 @@ fn kernels(c: &mut Criterion) {
                 black_box(&[tet[0], tet[1]]),
                 0.9,
                 [w[0], w[1]],
+                1e3,
             )
         })
     });
     group.bench_function("height f32", |b| {
-        b.iter(|| project_kernel(height::evaluate::<Vec3A>, black_box(&tet32), 0.7, w32))
+        b.iter(|| project_kernel(height::evaluate::<Vec3A>, black_box(&tet32), 0.7, w32, 1e3))
     });
     group.bench_function("height f64", |b| {
-        b.iter(|| project_kernel(height::evaluate::<DVec3>, black_box(&tet), 0.7, w))
+        b.iter(|| project_kernel(height::evaluate::<DVec3>, black_box(&tet), 0.7, w, 1e3))
     });
     group.bench_function("volume f32", |b| {
-        b.iter(|| project_kernel(volume::evaluate::<Vec3A>, black_box(&tet32), 0.2, w32))
+        b.iter(|| project_kernel(volume::evaluate::<Vec3A>, black_box(&tet32), 0.2, w32, 1e3))
     });
     group.bench_function("volume f64", |b| {
-        b.iter(|| project_kernel(volume::evaluate::<DVec3>, black_box(&tet), 0.2, w))
+        b.iter(|| project_kernel(volume::evaluate::<DVec3>, black_box(&tet), 0.2, w, 1e3))
     });
     // Eight constraints at once in SIMD lanes (time per eight).
     let lanes = tet32.map(|p| Vec3x8::gather([p; LANES]));
@@ -70,6 +72,7 @@ fn kernels(c: &mut Criterion) {
                 black_box(&[lanes[0], lanes[1]]),
                 rest4(0.9),
                 [w4[0], w4[1]],
+                rest4(1e3),
             )
         })
     });
@@ -80,6 +83,7 @@ fn kernels(c: &mut Criterion) {
                 black_box(&lanes),
                 rest4(0.7),
                 w4,
+                rest4(1e3),
             )
         })
     });
@@ -90,6 +94,7 @@ fn kernels(c: &mut Criterion) {
                 black_box(&lanes),
                 rest4(0.2),
                 w4,
+                rest4(1e3),
             )
         })
     });
@@ -184,6 +189,7 @@ fn frame(c: &mut Criterion) {
                         black_box(&edge),
                         F32x8::new([0.9; LANES]),
                         [w; 2],
+                        F32x8::new([1e3; LANES]),
                     ));
                 }
                 for _ in 0..tet_batches {
@@ -192,6 +198,7 @@ fn frame(c: &mut Criterion) {
                         black_box(&tet),
                         F32x8::new([0.2; LANES]),
                         [w; 4],
+                        F32x8::new([1e3; LANES]),
                     ));
                 }
             }

@@ -151,6 +151,11 @@ impl Mask for Mask8 {
     fn any(self) -> bool {
         self.0.to_bitmask() != 0
     }
+
+    #[inline(always)]
+    fn count(self) -> u32 {
+        self.0.to_bitmask().count_ones()
+    }
 }
 
 impl Real for F32x8 {

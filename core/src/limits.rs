@@ -171,6 +171,14 @@ pub const DAMPING: Bounds<f64> = Bounds {
     max: 1e6,
 };
 
+/// How far one projection may move a particle, in longest rest edges of its element
+/// ([`crate::solver::Settings::reach`]). Below 1 a body could not even be mirrored back.
+pub const REACH: Bounds<f64> = Bounds {
+    name: "reach",
+    min: 1.0,
+    max: 1e9,
+};
+
 /// Frames a headless run simulates.
 pub const FRAMES: Bounds<u64> = Bounds {
     name: "frames",

@@ -10,7 +10,10 @@
 //!   memory, so that more sweeps make the material stiffer, as in PBD.
 //!
 //! A constraint is skipped (no correction) where its evaluation is degenerate (undefined ∇C),
-//! where every particle is fixed, and where it is [`LOCKED`].
+//! where every particle is fixed, where it is [`LOCKED`], and where its step would be longer
+//! than [`DEFAULT_REACH`] times the longest rest edge of its element: such a step is not a correction
+//! but a singularity of ∇C (see [`DEFAULT_REACH`]). The degenerate and the too long are counted
+//! ([`Skips`]).
 
 use crate::constraints::{Evaluation, Family};
 use crate::solver::{Method, Settings};
@@ -82,35 +85,93 @@ impl Rule<f64> {
 }
 
 /// The correction that projecting one constraint would make, or `None` when it is skipped
-/// (degenerate, or every particle pinned). In any precision: the f64 path and the fast f32 path
-/// share it, through [`correction_lanes`].
+/// (degenerate, every particle pinned, or a step longer than `reach`, [`DEFAULT_REACH`]). In any
+/// precision: the f64 path and the fast f32 path share it, through [`correction_lanes`].
 #[inline]
 pub(crate) fn correction<V: Vector3, const N: usize>(
     evaluation: Evaluation<V, N>,
     weights: [V::Real; N],
     lambda: V::Real,
     rule: Rule<V::Real>,
+    reach: V::Real,
 ) -> Option<Correction<N, V>>
 where
     V::Real: Real<Mask = bool>,
 {
-    let (skipped, correction) = correction_lanes(evaluation, weights, lambda, rule);
-    (!skipped).then_some(correction)
+    let (skipped, correction) = correction_lanes(evaluation, weights, lambda, rule, reach);
+    (!skipped.any()).then_some(correction)
+}
+
+/// Whether a projection (or each lane of one) was skipped (`all`), and the reasons that are
+/// counted: its ∇C undefined or not finite where some particle could move (`degenerate`), or its
+/// step longer than its reach (`too_long`). A constraint whose particles are all fixed (or
+/// [`LOCKED`]) is skipped without being counted: that is a pin, not a fault.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Skipped<M> {
+    /// Skipped, for any reason.
+    pub all: M,
+    /// ∇C undefined (degenerate, or not finite).
+    pub degenerate: M,
+    /// The step, max |Δxᵢ|, longer than the reach.
+    pub too_long: M,
+}
+
+impl<M: crate::vector::Mask> Skipped<M> {
+    /// Whether it (some lane of it) was skipped.
+    #[inline(always)]
+    pub fn any(self) -> bool {
+        self.all.any()
+    }
+}
+
+/// Projections skipped for a counted reason ([`Skipped`]), summed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SkipCounts {
+    /// With ∇C undefined or not finite.
+    pub degenerate: u64,
+    /// With a step longer than the reach ([`DEFAULT_REACH`]).
+    pub too_long: u64,
+}
+
+impl SkipCounts {
+    /// Adds the lanes `skipped` flags.
+    #[inline(always)]
+    pub(crate) fn add<M: crate::vector::Mask>(&mut self, skipped: Skipped<M>) {
+        self.degenerate += u64::from(skipped.degenerate.count());
+        self.too_long += u64::from(skipped.too_long.count());
+    }
+
+    /// Whether none was skipped.
+    pub fn is_zero(&self) -> bool {
+        *self == SkipCounts::default()
+    }
+}
+
+impl std::ops::Add for SkipCounts {
+    type Output = SkipCounts;
+    fn add(self, other: SkipCounts) -> SkipCounts {
+        SkipCounts {
+            degenerate: self.degenerate + other.degenerate,
+            too_long: self.too_long + other.too_long,
+        }
+    }
 }
 
 /// The projection rule without a branch, for one constraint or several in lanes:
 /// Σ wᵢ|∇ᵢC|²; XPBD Δλ = (−C − α̃λ) / (Σ wᵢ|∇ᵢC|² + α̃), PBD Δλ = −k′C / Σ wᵢ|∇ᵢC|²; Δxᵢ = wᵢ ∇ᵢC Δλ.
-/// The mask is set and the correction is zero where the evaluation is degenerate, where
-/// Σ wᵢ|∇ᵢC|² is not positive and finite (every particle fixed), and where the constraint is
-/// [`LOCKED`]: its free particles can barely change it.
+/// The correction is zero where the evaluation is degenerate, where Σ wᵢ|∇ᵢC|² is not positive
+/// and finite (every particle fixed), where the constraint is [`LOCKED`] (its free particles
+/// can barely change it), and where the step max |Δxᵢ| is longer than `reach` (or not a number);
+/// the counted reasons are returned ([`Skipped`]).
 #[inline(always)]
 pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
     evaluation: Evaluation<V, N>,
     weights: [V::Real; N],
     lambda: V::Real,
     rule: Rule<V::Real>,
-) -> (<V::Real as Real>::Mask, Correction<N, V>) {
-    let (skipped, weighted_norm) = skipped_lanes(&evaluation, &weights);
+    reach: V::Real,
+) -> (Skipped<<V::Real as Real>::Mask>, Correction<N, V>) {
+    let (skipped, degenerate, weighted_norm) = skipped_lanes(&evaluation, &weights);
     let delta_lambda = match rule {
         Rule::Xpbd { alpha_tilde } => {
             (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
@@ -118,27 +179,39 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
         Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
         Rule::CompliantPbd { alpha_tilde } => -evaluation.value / (weighted_norm + alpha_tilde),
     };
-    let delta_lambda = V::Real::select(skipped, V::Real::ZERO, delta_lambda);
     let mut delta_x = [V::ZERO; N];
+    let mut step = V::Real::ZERO;
     for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
-        *dx = V::select(skipped, V::ZERO, *g * (w * delta_lambda));
+        *dx = *g * (w * delta_lambda);
+        let squared = dx.length_squared();
+        step = V::Real::select(squared.gt(step), squared, step);
+    }
+    let too_long = !skipped & !step.le(reach * reach);
+    let skipped = skipped | too_long;
+    for dx in &mut delta_x {
+        *dx = V::select(skipped, V::ZERO, *dx);
     }
     (
-        skipped,
+        Skipped {
+            all: skipped,
+            degenerate,
+            too_long,
+        },
         Correction {
-            delta_lambda,
+            delta_lambda: V::Real::select(skipped, V::Real::ZERO, delta_lambda),
             delta_x,
         },
     )
 }
 
-/// Whether a projection skips the constraint (degenerate, every particle fixed, or [`LOCKED`]),
-/// and Σ wᵢ|∇ᵢC|².
+/// Whether a projection skips the constraint (degenerate, every particle fixed, or [`LOCKED`]);
+/// of those, the degenerate ones where some particle is free (the ones counted); and
+/// Σ wᵢ|∇ᵢC|².
 #[inline(always)]
 fn skipped_lanes<V: Vector3, const N: usize>(
     evaluation: &Evaluation<V, N>,
     weights: &[V::Real; N],
-) -> (<V::Real as Real>::Mask, V::Real) {
+) -> (<V::Real as Real>::Mask, <V::Real as Real>::Mask, V::Real) {
     // Σ wᵢ|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
     let mut weighted_norm = V::Real::ZERO;
     let mut norm = V::Real::ZERO;
@@ -150,9 +223,13 @@ fn skipped_lanes<V: Vector3, const N: usize>(
         heaviest = V::Real::select(w.gt(heaviest), *w, heaviest);
     }
     let locked = weighted_norm.le(V::Real::from_f64(LOCKED) * heaviest * norm);
-    let skipped =
-        evaluation.degenerate | !weighted_norm.gt(V::Real::ZERO) | !weighted_norm.finite() | locked;
-    (skipped, weighted_norm)
+    let undefined = evaluation.degenerate | !weighted_norm.finite();
+    let skipped = undefined | !weighted_norm.gt(V::Real::ZERO) | locked;
+    (
+        skipped,
+        undefined & heaviest.gt(V::Real::ZERO),
+        weighted_norm,
+    )
 }
 
 /// What projecting two constraints of the same particles together makes: Δλ of each and the
@@ -163,6 +240,8 @@ pub struct PairCorrection<const N: usize, V: Vector3 = DVec3> {
     pub delta_lambda: [V::Real; 2],
     /// Δx for each particle.
     pub delta_x: [V; N],
+    /// Why each of the two was skipped, among the counted reasons (a step too long skips both).
+    pub skipped: [Skipped<<V::Real as Real>::Mask>; 2],
 }
 
 /// Two constraints on the same particles projected together (the neo-Hookean pair, whose two
@@ -176,7 +255,8 @@ pub struct PairCorrection<const N: usize, V: Vector3 = DVec3> {
 /// second answers (a stiff material's deviatoric constraint then squashes each tet). A
 /// constraint that [`correction_lanes`] would skip takes no part; under PBD (no multiplier's
 /// memory) λ counts as 0. The diagonal gains ε (a + b) so that the system stays solvable when
-/// the gradients are parallel and the compliances nearly 0 (a tet at rest).
+/// the gradients are parallel and the compliances nearly 0 (a tet at rest). A step longer than
+/// `reach` skips both ([`DEFAULT_REACH`]).
 #[inline(always)]
 pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
     first: Evaluation<V, N>,
@@ -184,11 +264,12 @@ pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
     weights: [V::Real; N],
     lambda: [V::Real; 2],
     rules: [Rule<V::Real>; 2],
+    reach: V::Real,
 ) -> PairCorrection<N, V> {
     let zero = V::Real::ZERO;
     let one = V::Real::ONE;
     let part = |e: &Evaluation<V, N>, lambda: V::Real, rule: Rule<V::Real>| {
-        let (skipped, weighted_norm) = skipped_lanes(e, &weights);
+        let (skipped, degenerate, weighted_norm) = skipped_lanes(e, &weights);
         let (alpha, rhs) = match rule {
             Rule::Xpbd { alpha_tilde } => (alpha_tilde, -e.value - alpha_tilde * lambda),
             Rule::CompliantPbd { alpha_tilde } => (alpha_tilde, -e.value),
@@ -201,13 +282,14 @@ pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
         let diagonal = V::Real::select(skipped, one, weighted_norm + alpha);
         (
             skipped,
+            degenerate,
             gradients,
             diagonal,
             V::Real::select(skipped, zero, rhs),
         )
     };
-    let (skip_a, ga, mut a, rhs_a) = part(&first, lambda[0], rules[0]);
-    let (skip_b, gb, mut b, rhs_b) = part(&second, lambda[1], rules[1]);
+    let (skip_a, degenerate_a, ga, mut a, rhs_a) = part(&first, lambda[0], rules[0]);
+    let (skip_b, degenerate_b, gb, mut b, rhs_b) = part(&second, lambda[1], rules[1]);
     let mut ab = zero;
     for k in 0..N {
         ab += weights[k] * ga[k].dot(gb[k]);
@@ -219,31 +301,68 @@ pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
     let delta_a = V::Real::select(skip_a, zero, (b * rhs_a - ab * rhs_b) / det);
     let delta_b = V::Real::select(skip_b, zero, (a * rhs_b - ab * rhs_a) / det);
     let mut delta_x = [V::ZERO; N];
+    let mut step = zero;
     for k in 0..N {
         delta_x[k] = (ga[k] * delta_a + gb[k] * delta_b) * weights[k];
+        let squared = delta_x[k].length_squared();
+        step = V::Real::select(squared.gt(step), squared, step);
     }
+    let too_long = !(skip_a & skip_b) & !step.le(reach * reach);
+    for dx in &mut delta_x {
+        *dx = V::select(too_long, V::ZERO, *dx);
+    }
+    let skipped = |all, degenerate| Skipped {
+        all: all | too_long,
+        degenerate,
+        too_long,
+    };
     PairCorrection {
-        delta_lambda: [delta_a, delta_b],
+        delta_lambda: [
+            V::Real::select(too_long, zero, delta_a),
+            V::Real::select(too_long, zero, delta_b),
+        ],
         delta_x,
+        skipped: [skipped(skip_a, degenerate_a), skipped(skip_b, degenerate_b)],
     }
 }
 
 /// One rigid XPBD projection of a constraint at `points` with rest value `rest` and inverse
-/// masses `weights`, starting from λ = 0: Δx per particle (zero when skipped). The kernel the
-/// solvers run per constraint, for benchmarks (`core/benches/kernels.rs`).
+/// masses `weights`, starting from λ = 0, with a reach of `reach`: Δx per particle (zero when
+/// skipped). The kernel the solvers run per constraint, for benchmarks (`core/benches/kernels.rs`).
 pub fn project_kernel<V: Vector3, const N: usize>(
     evaluate: impl Fn(&[V; N], V::Real) -> Evaluation<V, N>,
     points: &[V; N],
     rest: V::Real,
     weights: [V::Real; N],
+    reach: V::Real,
 ) -> [V; N] {
     let rule = Rule::Xpbd {
         alpha_tilde: V::Real::ZERO,
     };
-    correction_lanes(evaluate(points, rest), weights, V::Real::ZERO, rule)
+    correction_lanes(evaluate(points, rest), weights, V::Real::ZERO, rule, reach)
         .1
         .delta_x
 }
+
+/// How far one projection may move a particle by default ([`crate::solver::Settings::reach`]),
+/// in longest rest edges of its element (the constraint's particles at rest: an edge's length,
+/// a tet's longest edge): 100. A step
+/// max |Δxᵢ| = wᵢ|∇ᵢC||Δλ| beyond it is skipped and counted ([`Skipped::too_long`]).
+///
+/// A projection moves a particle by about |C| / |∇C|, which grows without bound where ∇C
+/// vanishes and C does not: the dihedral angle's cosine at a folded or flattened hinge
+/// (cos θ = ±1, where d cos θ / dθ = 0) passes `check-gradients` and yet, with the rule off,
+/// throws a flattened bunny's centre of mass 1.2 × 10⁸ m in two frames (`tetlab run --scene
+/// ../shared/meshes/bunny.node --perturb flatten --constraints edges --constraint-file
+/// assets/constraints/dihedral-cosine.toml --frames 2 --reach 1e9`); with it, 12 m: still a
+/// constraint that should not be used there, but one whose run stays finite and says so. A built-in family's step is its violation (an edge's |ℓ − d|, a
+/// height's |h − d|) or a tet's size (a volume's |V − V₀| over its face areas), up to some tens
+/// of rest edges in a body launched apart, and unbounded only for a tet collapsed to a point.
+/// 100 rest edges is past any step of a built-in family on a body that holds together, and
+/// short of the steps a singular ∇C takes. `scripts/reach-battery.sh` runs the built-in families
+/// on every shipped scene and perturbation, settled and launched, at reach 10, 30, 100 and 10⁹,
+/// and prints in how many runs the rule skips a step and in how many it changes the outcome.
+pub const DEFAULT_REACH: f64 = 100.0;
 
 /// Below this fraction of max wᵢ · Σ|∇ᵢC|², Σ wᵢ|∇ᵢC|² says that the particles free to move
 /// (w > 0) can barely change the constraint: those that could are pinned or held, and the free

@@ -16,6 +16,9 @@ pub trait Mask:
     /// Whether any flag is set.
     fn any(self) -> bool;
 
+    /// How many flags are set.
+    fn count(self) -> u32;
+
     /// `self & other()`, calling `other` only when some flag of `self` is set (for a rare
     /// condition, most calls then skip the work).
     #[inline(always)]
@@ -28,6 +31,11 @@ impl Mask for bool {
     #[inline(always)]
     fn any(self) -> bool {
         self
+    }
+
+    #[inline(always)]
+    fn count(self) -> u32 {
+        u32::from(self)
     }
 }
 

@@ -53,7 +53,10 @@ fn weightless(engine: Engine, families: &str) -> Simulation {
 /// of resolution 3 at 10 substeps. The fast engine's are of scenes without heights that stay
 /// near the origin: its heights are coloured one by one since (docs/performance.md, "Engines"),
 /// and a body that travels far from the origin is followed by its f32 coordinates
-/// (`FastSimulation::recentre`); neither changes these.
+/// (`FastSimulation::recentre`); neither changes these. The fast engine's two hashes were taken
+/// again when it came to keep what f32 rounding leaves out of each position (its residuals, in
+/// `core/src/integrate.rs`), which changes its arithmetic and not its order: with the residuals
+/// left out, edges + volume gives b91899e's 0x71460353a638923d again.
 #[test]
 fn without_an_order_seed_the_order_is_the_tables_bit_for_bit() {
     let cases = [
@@ -70,12 +73,12 @@ fn without_an_order_seed_the_order_is_the_tables_bit_for_bit() {
         (
             weightless(Engine::Fast, "edges,volume"),
             Perturbation::Mirror,
-            0x71460353a638923d,
+            0xa315baa093e079c0,
         ),
         (
             weightless(Engine::Fast, "edges,neohookean"),
             Perturbation::Flatten,
-            0xbfb415143db55079,
+            0x9ad59ee7ba953579,
         ),
     ];
     for (simulation, perturbation, expected) in cases {

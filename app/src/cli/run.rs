@@ -49,6 +49,11 @@ pub struct FrameRecord {
     /// `residual_<family>` for each active family, in the table's order.
     #[serde(flatten)]
     residuals: BTreeMap<String, f64>,
+    /// `skipped_degenerate_<family>` and `skipped_too_long_<family>` for each active family:
+    /// its projections skipped so far because ∇C was undefined, or because the step was beyond
+    /// the reach (`tetlab_core::projection::DEFAULT_REACH`).
+    #[serde(flatten)]
+    skipped: BTreeMap<String, u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     particles: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -92,6 +97,23 @@ impl FrameRecord {
                 .iter()
                 .filter(|&(family, _)| settings.active[family])
                 .map(|(family, value)| (format!("residual_{}", family.name()), value))
+                .collect(),
+            skipped: simulation
+                .skipped()
+                .iter()
+                .filter(|&(family, _)| settings.active[family])
+                .flat_map(|(family, counts)| {
+                    [
+                        (
+                            format!("skipped_degenerate_{}", family.name()),
+                            counts.degenerate,
+                        ),
+                        (
+                            format!("skipped_too_long_{}", family.name()),
+                            counts.too_long,
+                        ),
+                    ]
+                })
                 .collect(),
             particles: first.then(|| simulation.positions().len()),
             tets: first.then(|| simulation.tets().len()),
@@ -169,6 +191,9 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             outcome.horizontal_displacement()
         )
         .map_err(io)?;
+        for line in super::simulation_args::describe_skipped(&simulation) {
+            writeln!(out, "{line}").map_err(io)?;
+        }
         if let Some(warning) = outcome.thrown_warning() {
             let advice = if simulation.settings().edits_settle() {
                 ""

@@ -100,6 +100,10 @@ pub struct SolverArgs {
     /// [default: the mesh's order].
     #[arg(long, value_name = "S")]
     pub order_seed: Option<u64>,
+    /// How far one projection may move a particle, in longest rest edges of its element
+    /// (1..=1e9); a longer step is skipped and counted: where ∇C vanishes and C does not.
+    #[arg(long, value_name = "K", default_value_t = Settings::default().reach, value_parser = |s: &str| limits::REACH.parse(s), allow_hyphen_values = true)]
+    pub reach: f64,
 }
 
 /// `FAMILY=VALUE` as given, its value in range; the family is looked up later
@@ -144,6 +148,7 @@ impl SolverArgs {
             dt: self.dt,
             damping: self.damping,
             order_seed: self.order_seed,
+            reach: self.reach,
             ..Settings::default()
         };
         settings.set_gravity(self.gravity);
@@ -213,6 +218,9 @@ impl SolverArgs {
             text += &format!(", material {}", s.material.describe());
         }
         text += &describe_order(s);
+        if s.reach != Settings::default().reach {
+            text += &format!(", reach {} rest edges", s.reach.show());
+        }
         for family in s.active.families() {
             if let Some(file) = family.file() {
                 let gradient = if file.use_gradient {
@@ -286,6 +294,27 @@ pub fn describe_settling(settings: &Settings) -> String {
                           squashed)"
             .to_owned(),
     }
+}
+
+/// One line per family with projections skipped so far (∇C undefined, or a step beyond the
+/// reach): "skipped projections of dihedral-cosine: 1204 with a step beyond 100 rest edges of
+/// their element, 12 with ∇C undefined". None when nothing was skipped.
+pub fn describe_skipped(simulation: &Simulation) -> Vec<String> {
+    simulation
+        .skipped()
+        .iter()
+        .filter(|(_, counts)| !counts.is_zero())
+        .map(|(family, counts)| {
+            format!(
+                "skipped projections of {}: {} with a step beyond {} rest edges of their \
+                 element, {} with ∇C undefined",
+                family.name(),
+                counts.too_long,
+                simulation.settings().reach.show(),
+                counts.degenerate
+            )
+        })
+        .collect()
 }
 
 /// Loads the constraint file of `--constraint-file PATH` and adds its family to the table with

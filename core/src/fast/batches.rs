@@ -38,6 +38,9 @@ pub struct Layout {
     weights: Vec<F32x8>,
     /// Per batch, the element (edge or tet number) in each lane.
     elements: Vec<[u32; LANES]>,
+    /// Per batch, the size of each lane's element (its longest rest edge), what the reach of
+    /// its projections is measured in ([`crate::solver::Settings::reach`]).
+    size: Vec<F32x8>,
     /// Elements of one colour share no particle; colours are projected in order.
     pub colours: Vec<Colour>,
     /// Every particle index above is below this.
@@ -56,6 +59,7 @@ pub struct Batches {
 pub(crate) struct Typed<'a, const N: usize> {
     pub particles: &'a [[[u32; LANES]; N]],
     pub weights: &'a [[F32x8; N]],
+    pub size: &'a [F32x8],
     pub colours: &'a [Colour],
     pub particle_count: usize,
 }
@@ -63,8 +67,13 @@ pub(crate) struct Typed<'a, const N: usize> {
 impl Layout {
     /// Colours `elements` (each its particles, in the new numbering) greedily: each takes the first
     /// colour none of its particles has yet; within a colour they are sorted by first particle,
-    /// for locality, and packed into batches.
-    pub(crate) fn new<const N: usize>(elements: &[[u32; N]], inverse_masses: &[f32]) -> Layout {
+    /// for locality, and packed into batches. `rest_positions` (the new numbering) give each
+    /// element's size.
+    pub(crate) fn new<const N: usize>(
+        elements: &[[u32; N]],
+        inverse_masses: &[f32],
+        rest_positions: &[glam::Vec3A],
+    ) -> Layout {
         let mut colour_of = vec![usize::MAX; elements.len()];
         let mut remaining: Vec<usize> = (0..elements.len()).collect();
         let mut base = 0;
@@ -116,6 +125,10 @@ impl Layout {
                 layout
                     .elements
                     .push(std::array::from_fn(|k| element(k) as u32));
+                layout.size.push(F32x8::new(std::array::from_fn(|k| {
+                    let corners = elements[element(k)].map(|i| rest_positions[i as usize]);
+                    crate::solver::longest_edge(corners.iter().map(|p| p.as_dvec3())) as f32
+                })));
             }
             layout.colours.push(Colour {
                 batches: start..layout.elements.len(),
@@ -134,6 +147,7 @@ impl Layout {
         Typed {
             particles: self.particles.as_chunks::<N>().0,
             weights: self.weights.as_chunks::<N>().0,
+            size: &self.size,
             colours: &self.colours,
             particle_count: self.particle_count,
         }
@@ -209,7 +223,7 @@ impl Layout {
     /// The bytes its arrays take (their capacities).
     pub(crate) fn heap_bytes(&self) -> usize {
         (self.particles.capacity() + self.elements.capacity()) * size_of::<[u32; LANES]>()
-            + self.weights.capacity() * size_of::<F32x8>()
+            + (self.weights.capacity() + self.size.capacity()) * size_of::<F32x8>()
             + self.colours.capacity() * size_of::<Colour>()
     }
 }

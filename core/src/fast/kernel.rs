@@ -9,8 +9,8 @@ use super::batches::{Batches, Layout, Typed};
 use super::particles::Particles;
 use crate::constraints::Constraint;
 use crate::lanes::{F32x8, LANES, Vec3x8};
-use crate::projection::{Rule, correction_lanes, pair_correction_lanes};
-use crate::vector::Vector3;
+use crate::projection::{Rule, SkipCounts, correction_lanes, pair_correction_lanes};
+use crate::vector::{Real, Vector3};
 use glam::Vec3A;
 
 /// Colours with fewer elements than this are projected on one thread even when several are
@@ -79,24 +79,29 @@ struct Access<'a> {
 
 /// Projects batches of elements that share no particle, one constraint per element: the
 /// corrections are added to the positions (Gauss–Seidel) or, in Jacobi order, to the sums.
+/// Returns the projections skipped for a counted reason.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn project_batches<const N: usize, C: Constraint<N>>(
     constraint: &C,
     particles: &[[[u32; LANES]; N]],
     weights: &[[F32x8; N]],
+    (size, reach): (&[F32x8], F32x8),
     rest: &[F32x8],
     lambda: &mut [F32x8],
     access: Access,
     rule: Rule<F32x8>,
-) {
+) -> SkipCounts {
+    let mut skips = SkipCounts::default();
     let read = access.read;
     let write = access.sums.unwrap_or(read);
     // The next batch is gathered before this one is written (they share no particle), so that
     // its loads overlap this one's arithmetic.
     let mut next = particles.first().map(|indices| gather_batch(read, indices));
-    for (b, ((indices, weights), (rest, lambda))) in particles
+    for (b, (((indices, weights), size), (rest, lambda))) in particles
         .iter()
         .zip(weights)
+        .zip(size)
         .zip(rest.iter().zip(lambda.iter_mut()))
         .enumerate()
     {
@@ -110,12 +115,14 @@ fn project_batches<const N: usize, C: Constraint<N>>(
             p
         };
         let evaluation = constraint.evaluate(&p, *rest, &shape);
-        let (_, d) = correction_lanes(evaluation, *weights, *lambda, rule);
+        let (skipped, d) = correction_lanes(evaluation, *weights, *lambda, rule, *size * reach);
+        skips.add(skipped);
         *lambda += d.delta_lambda;
         for (&indices, delta) in indices.iter().zip(d.delta_x) {
             scatter_add(write, indices, delta);
         }
     }
+    skips
 }
 
 /// The colour projected `k`-th: `order[k]`, or `k` when `order` is empty (the layout's order).
@@ -127,7 +134,8 @@ fn in_order(order: &[u32], k: usize) -> usize {
 /// Projects every constraint of a family (`batches`, on `layout`), colour by colour in `order`
 /// (empty: the layout's), moving `positions` (Gauss–Seidel) or, given `sums`, adding the
 /// corrections to `sums` (Jacobi: `positions` stay as they are); with `parallel`, large colours
-/// are shared by the threads of the current pool. Returns how many constraints it projected.
+/// are shared by the threads of the current pool. Returns how many constraints it projected, and
+/// how many of them were skipped for a counted reason.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
@@ -138,13 +146,15 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
     positions: &mut [Vec3A],
     rest_positions: &mut [Vec3A],
     sums: Option<&mut [Vec3A]>,
-    rule: Rule<f64>,
+    (rule, reach): (Rule<f64>, f64),
     parallel: bool,
-) -> usize {
+) -> (usize, SkipCounts) {
     let rule: Rule<F32x8> = rule.to();
+    let reach = F32x8::from_f64(reach);
     let Typed {
         particles,
         weights,
+        size,
         colours,
         particle_count,
     } = layout.typed::<N>();
@@ -155,16 +165,18 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let mut count = 0;
+    let mut skips = SkipCounts::default();
     for k in 0..colours.len() {
         let colour = &colours[in_order(order, k)];
         let range = colour.batches.clone();
-        let (particles, weights, rest, lambda) = (
+        let (particles, weights, size, rest, lambda) = (
             &particles[range.clone()],
             &weights[range.clone()],
+            &size[range.clone()],
             &rest[range.clone()],
             &mut lambda[range],
         );
-        match parallel && colour.elements >= PARALLEL_MIN {
+        let skipped = match parallel && colour.elements >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
             true => {
                 use rayon::prelude::*;
@@ -172,20 +184,36 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
                     .par_chunks_mut(CHUNK)
                     .zip(particles.par_chunks(CHUNK))
                     .zip(weights.par_chunks(CHUNK))
-                    .zip(rest.par_chunks(CHUNK))
-                    .for_each(|(((lambda, particles), weights), rest)| {
+                    .zip(size.par_chunks(CHUNK).zip(rest.par_chunks(CHUNK)))
+                    .map(|(((lambda, particles), weights), (size, rest))| {
                         project_batches::<N, C>(
-                            constraint, particles, weights, rest, lambda, access, rule,
-                        );
+                            constraint,
+                            particles,
+                            weights,
+                            (size, reach),
+                            rest,
+                            lambda,
+                            access,
+                            rule,
+                        )
                     })
+                    .reduce(SkipCounts::default, |a, b| a + b)
             }
-            _ => {
-                project_batches::<N, C>(constraint, particles, weights, rest, lambda, access, rule)
-            }
-        }
+            _ => project_batches::<N, C>(
+                constraint,
+                particles,
+                weights,
+                (size, reach),
+                rest,
+                lambda,
+                access,
+                rule,
+            ),
+        };
+        skips = skips + skipped;
         count += colour.elements;
     }
-    count
+    (count, skips)
 }
 
 /// [`project_batches`] for two families projected together ([`pair_correction_lanes`]): one
@@ -196,13 +224,14 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
 fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
     (first, second): (&A, &B),
     particles: &[[[u32; LANES]; N]],
-    weights: &[[F32x8; N]],
+    (weights, size, reach): (&[[F32x8; N]], &[F32x8], F32x8),
     (rest_a, rest_b): (&[F32x8], &[F32x8]),
     (lambda_a, lambda_b): (&mut [F32x8], &mut [F32x8]),
     access: Access,
     rules: [Rule<F32x8>; 2],
-) {
+) -> [SkipCounts; 2] {
     assert_eq!(N, M, "a pair shares its particles");
+    let mut skips = [SkipCounts::default(); 2];
     for (b, (indices, weights)) in particles.iter().zip(weights).enumerate() {
         let p = gather_batch(access.read, indices);
         let shape = if A::USES_REST_SHAPE || B::USES_REST_SHAPE {
@@ -225,7 +254,11 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
             *weights,
             [lambda_a[b], lambda_b[b]],
             rules,
+            size[b] * reach,
         );
+        for (counts, skipped) in skips.iter_mut().zip(d.skipped) {
+            counts.add(skipped);
+        }
         lambda_a[b] += d.delta_lambda[0];
         lambda_b[b] += d.delta_lambda[1];
         for (i, &indices) in indices.iter().enumerate() {
@@ -235,11 +268,12 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
             }
         }
     }
+    skips
 }
 
 /// [`project_family`] for two families projected together, element by element (the neo-Hookean
 /// pair: one constraint of each per tet, on the same layout). Returns how many constraints of
-/// each it projected.
+/// each it projected, and how many of each were skipped for a counted reason.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
@@ -250,13 +284,15 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
     positions: &mut [Vec3A],
     rest_positions: &mut [Vec3A],
     sums: Option<&mut [Vec3A]>,
-    rules: [Rule<f64>; 2],
+    (rules, reach): ([Rule<f64>; 2], f64),
     parallel: bool,
-) -> usize {
+) -> (usize, [SkipCounts; 2]) {
     let rules: [Rule<F32x8>; 2] = rules.map(Rule::to);
+    let reach = F32x8::from_f64(reach);
     let Typed {
         particles,
         weights,
+        size,
         colours,
         particle_count,
     } = layout.typed::<N>();
@@ -268,13 +304,16 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let mut count = 0;
+    let mut skips = [SkipCounts::default(); 2];
+    let add = |a: [SkipCounts; 2], b: [SkipCounts; 2]| [a[0] + b[0], a[1] + b[1]];
     for k in 0..colours.len() {
         let colour = &colours[in_order(order, k)];
         let range = colour.batches.clone();
         let (particles, weights) = (&particles[range.clone()], &weights[range.clone()]);
+        let size = &size[range.clone()];
         let rest = (&rest_a[range.clone()], &rest_b[range.clone()]);
         let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
-        match parallel && colour.elements >= PARALLEL_MIN {
+        let skipped = match parallel && colour.elements >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
             true => {
                 use rayon::prelude::*;
@@ -282,31 +321,35 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
                     .par_chunks_mut(CHUNK)
                     .zip(lambda_b.par_chunks_mut(CHUNK))
                     .zip(particles.par_chunks(CHUNK))
-                    .zip(weights.par_chunks(CHUNK))
+                    .zip(weights.par_chunks(CHUNK).zip(size.par_chunks(CHUNK)))
                     .zip(rest.0.par_chunks(CHUNK).zip(rest.1.par_chunks(CHUNK)))
-                    .for_each(|((((lambda_a, lambda_b), particles), weights), rest)| {
-                        project_pair_batches::<N, A, M, B>(
-                            constraints,
-                            particles,
-                            weights,
-                            rest,
-                            (lambda_a, lambda_b),
-                            access,
-                            rules,
-                        );
-                    })
+                    .map(
+                        |((((lambda_a, lambda_b), particles), (weights, size)), rest)| {
+                            project_pair_batches::<N, A, M, B>(
+                                constraints,
+                                particles,
+                                (weights, size, reach),
+                                rest,
+                                (lambda_a, lambda_b),
+                                access,
+                                rules,
+                            )
+                        },
+                    )
+                    .reduce(|| [SkipCounts::default(); 2], add)
             }
             _ => project_pair_batches::<N, A, M, B>(
                 constraints,
                 particles,
-                weights,
+                (weights, size, reach),
                 rest,
                 (lambda_a, lambda_b),
                 access,
                 rules,
             ),
-        }
+        };
+        skips = add(skips, skipped);
         count += colour.elements;
     }
-    count
+    (count, skips)
 }

@@ -33,7 +33,7 @@ pub use kernel::PARALLEL_MIN;
 use crate::constraints::{Binding, Constraint, Family, PerFamily, Visit, VisitPair};
 use crate::divergence::Divergence;
 use crate::integrate;
-use crate::projection::Rule;
+use crate::projection::{Rule, SkipCounts};
 use crate::solver::{Settings, Simulation};
 use glam::{DVec3, Vec3A};
 use std::time::Duration;
@@ -57,6 +57,12 @@ pub struct Timings {
     pub projections: PerFamily<u64>,
 }
 
+/// The f32 position of `p` and what its rounding left out, as f32: `p ≈ x + r` to f32's
+/// precision squared ([`integrate::Residuals`]).
+fn residual(p: DVec3) -> Vec3A {
+    (p - p.as_vec3a().as_dvec3()).as_vec3a()
+}
+
 /// The soft body, fast. See the module documentation.
 pub struct FastSimulation {
     settings: Settings,
@@ -67,6 +73,11 @@ pub struct FastSimulation {
     origin: DVec3,
     positions: Vec<Vec3A>,
     previous: Vec<Vec3A>,
+    /// What each position's f32 rounding left out: the particle is at `origin + positions[i] +
+    /// residuals[i]`, and velocities come from that sum ([`integrate::Residuals`]).
+    residuals: Vec<Vec3A>,
+    /// [`FastSimulation::residuals`] at the start of the substep.
+    previous_residuals: Vec<Vec3A>,
     velocities: Vec<Vec3A>,
     /// The rest positions, for families whose formula reads the rest shape.
     rest_positions: Vec<Vec3A>,
@@ -89,6 +100,8 @@ pub struct FastSimulation {
     #[cfg(feature = "parallel")]
     pool: Option<rayon::ThreadPool>,
     timings: Timings,
+    /// Projections skipped for a counted reason since the last [`FastSimulation::take_skipped`].
+    skipped: PerFamily<SkipCounts>,
     frame: u64,
     /// Δp of the last substep and its sum over the frame, when a frame asks for them
     /// ([`FrameInputs`]); the predicted positions they are measured from. Empty until then.
@@ -234,10 +247,15 @@ impl FastSimulation {
                 .map(|&i| values[i as usize].as_vec3a())
                 .collect()
         };
+        let residuals: Vec<Vec3A> = original
+            .iter()
+            .map(|&i| residual(simulation.positions()[i as usize]))
+            .collect();
         let inverse_masses: Vec<f32> = original
             .iter()
             .map(|&i| simulation.inverse_masses()[i as usize] as f32)
             .collect();
+        let rest_positions = take(simulation.rest_positions());
         // Only the families in use are built: the settings do not change after this.
         let active = simulation.settings().active;
         let uses =
@@ -254,7 +272,7 @@ impl FastSimulation {
                 .iter()
                 .map(|edge| edge.map(|i| renumber[i as usize]))
                 .collect();
-            layouts.edges = Layout::new(&edges, &inverse_masses);
+            layouts.edges = Layout::new(&edges, &inverse_masses, &rest_positions);
         }
         let renumbered = |tets: &[[u32; 4]]| -> Vec<[u32; 4]> {
             tets.iter()
@@ -262,7 +280,8 @@ impl FastSimulation {
                 .collect()
         };
         if uses(&|b| b == Binding::Tets) {
-            layouts.tets = Layout::new(&renumbered(simulation.tets()), &inverse_masses);
+            let tets = renumbered(simulation.tets());
+            layouts.tets = Layout::new(&tets, &inverse_masses, &rest_positions);
         }
         if uses(&|b| b == Binding::TetVertices) {
             // Each (tet, vertex) constraint is an element of its own, its particles in the
@@ -273,7 +292,8 @@ impl FastSimulation {
             };
             let flat = Binding::TetVertices.particles(&mesh);
             let (constraints, _) = flat.as_chunks::<4>();
-            layouts.tet_vertices = Layout::new(&renumbered(constraints), &inverse_masses);
+            let constraints = renumbered(constraints);
+            layouts.tet_vertices = Layout::new(&constraints, &inverse_masses, &rest_positions);
         }
         let sets = PerFamily::build(|family| {
             if !active[family] {
@@ -299,8 +319,10 @@ impl FastSimulation {
             settings: *simulation.settings(),
             previous: positions.clone(),
             positions,
+            previous_residuals: residuals.clone(),
+            residuals,
             velocities: take(simulation.velocities()),
-            rest_positions: take(simulation.rest_positions()),
+            rest_positions,
             inverse_masses,
             original,
             renumber,
@@ -318,6 +340,7 @@ impl FastSimulation {
                 })
                 .flatten(),
             timings: Timings::default(),
+            skipped: PerFamily::default(),
             frame: 0,
             corrections: Corrections::default(),
         }
@@ -334,10 +357,12 @@ impl FastSimulation {
         for (new, &old) in self.original.iter().enumerate() {
             let old = old as usize;
             self.positions[new] = positions[old].as_vec3a();
+            self.residuals[new] = residual(positions[old]);
             self.velocities[new] = velocities[old].as_vec3a();
             self.inverse_masses[new] = inverse_masses[old] as f32;
         }
         self.previous.copy_from_slice(&self.positions);
+        self.previous_residuals.copy_from_slice(&self.residuals);
         for layout in self.layouts.all_mut() {
             layout.set_weights(&self.inverse_masses);
         }
@@ -356,7 +381,8 @@ impl FastSimulation {
         corrections: Option<(&mut [DVec3], &mut [DVec3])>,
     ) {
         for (new, &old) in self.original.iter().enumerate() {
-            positions[old as usize] = self.origin + self.positions[new].as_dvec3();
+            positions[old as usize] =
+                self.origin + self.positions[new].as_dvec3() + self.residuals[new].as_dvec3();
             velocities[old as usize] = self.velocities[new].as_dvec3();
         }
         if let Some((last, frame)) = corrections {
@@ -484,8 +510,8 @@ impl FastSimulation {
     /// Positions in the scene's particle numbering.
     pub fn positions(&self) -> Vec<DVec3> {
         let mut positions = self.in_scene_order(&self.positions);
-        for p in &mut positions {
-            *p += self.origin;
+        for (new, &old) in self.original.iter().enumerate() {
+            positions[old as usize] += self.origin + self.residuals[new].as_dvec3();
         }
         positions
     }
@@ -592,6 +618,8 @@ impl FastSimulation {
     pub fn heap_bytes(&self) -> usize {
         (self.positions.capacity()
             + self.previous.capacity()
+            + self.residuals.capacity()
+            + self.previous_residuals.capacity()
             + self.velocities.capacity()
             + self.rest_positions.capacity())
             * size_of::<Vec3A>()
@@ -622,6 +650,12 @@ impl FastSimulation {
     /// Time and projections per family since the last [`FastSimulation::reset_timings`].
     pub fn timings(&self) -> Timings {
         self.timings
+    }
+
+    /// The projections skipped for a counted reason (∇C undefined, or a step beyond
+    /// [`crate::projection::DEFAULT_REACH`]) since the last call, per family; the count starts again.
+    pub fn take_skipped(&mut self) -> PerFamily<SkipCounts> {
+        std::mem::take(&mut self.skipped)
     }
 
     /// Starts the timings afresh.
@@ -682,14 +716,21 @@ impl FastSimulation {
                 &mut self.previous,
                 &mut self.velocities,
                 &self.inverse_masses,
-                settings.gravity,
-                h,
-                ground,
+                integrate::Substep {
+                    gravity: settings.gravity,
+                    h,
+                    ground,
+                },
+                Some(integrate::Residuals {
+                    now: &mut self.residuals,
+                    previous: &mut self.previous_residuals,
+                }),
             );
             if let Some((i, target, compliance)) = grab
                 && compliance <= 0.0
             {
                 self.positions[i] = target;
+                self.residuals[i] = Vec3A::ZERO;
             }
             let track = inputs.settling || (inputs.corrections && substep + 1 == substeps);
             if track {
@@ -722,6 +763,10 @@ impl FastSimulation {
                 h,
                 settings.damping,
                 inputs.settling,
+                Some(&integrate::Residuals {
+                    now: &mut self.residuals,
+                    previous: &mut self.previous_residuals,
+                }),
             );
         }
     }
@@ -765,10 +810,11 @@ impl FastSimulation {
                     rest_positions: &'a mut [Vec3A],
                     sums: Option<&'a mut [Vec3A]>,
                     rules: [Rule<f64>; 2],
+                    reach: f64,
                     parallel: bool,
                 }
                 impl VisitPair for ProjectPair<'_> {
-                    type Output = usize;
+                    type Output = (usize, [SkipCounts; 2]);
                     #[inline]
                     fn visit_pair<
                         const N: usize,
@@ -779,7 +825,7 @@ impl FastSimulation {
                         self,
                         first: &A,
                         second: &B,
-                    ) -> usize {
+                    ) -> (usize, [SkipCounts; 2]) {
                         kernel::project_pair::<N, A, M, B>(
                             (first, second),
                             self.layout,
@@ -788,13 +834,13 @@ impl FastSimulation {
                             self.positions,
                             self.rest_positions,
                             self.sums,
-                            self.rules,
+                            (self.rules, self.reach),
                             self.parallel,
                         )
                     }
                 }
                 let rules = [rule, Rule::for_settings(&self.settings, partner, h)];
-                let count = family.visit_pair(
+                let (count, skipped) = family.visit_pair(
                     partner,
                     ProjectPair {
                         layout: self.layouts.of(family.row().binding),
@@ -804,15 +850,17 @@ impl FastSimulation {
                         rest_positions: &mut self.rest_positions,
                         sums,
                         rules,
+                        reach: self.settings.reach,
                         parallel,
                     },
                 );
                 self.apply_jacobi(family);
                 // One pair projection is a projection of each: each family gets half the time.
                 let half = started.elapsed() / 2;
-                for f in [family, partner] {
+                for (f, skipped) in [family, partner].into_iter().zip(skipped) {
                     self.timings.time[f] += half;
                     self.timings.projections[f] += count as u64;
+                    self.skipped[f] = self.skipped[f] + skipped;
                 }
                 continue;
             }
@@ -824,12 +872,17 @@ impl FastSimulation {
                 rest_positions: &'a mut [Vec3A],
                 sums: Option<&'a mut [Vec3A]>,
                 rule: Rule<f64>,
+                reach: f64,
                 parallel: bool,
             }
             impl Visit for Project<'_> {
-                type Output = usize;
+                type Output = (usize, SkipCounts);
                 #[inline]
-                fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> usize {
+                fn visit<const N: usize, C: Constraint<N>>(
+                    self,
+                    _: Family,
+                    c: &C,
+                ) -> (usize, SkipCounts) {
                     kernel::project_family::<N, C>(
                         c,
                         self.layout,
@@ -838,12 +891,12 @@ impl FastSimulation {
                         self.positions,
                         self.rest_positions,
                         self.sums,
-                        self.rule,
+                        (self.rule, self.reach),
                         self.parallel,
                     )
                 }
             }
-            let count = family.visit(Project {
+            let (count, skipped) = family.visit(Project {
                 layout: self.layouts.of(family.row().binding),
                 order: &self.colour_orders[family],
                 batches: &mut self.sets[family],
@@ -851,11 +904,13 @@ impl FastSimulation {
                 rest_positions: &mut self.rest_positions,
                 sums,
                 rule,
+                reach: self.settings.reach,
                 parallel,
             });
             self.apply_jacobi(family);
             self.timings.time[family] += started.elapsed();
             self.timings.projections[family] += count as u64;
+            self.skipped[family] = self.skipped[family] + skipped;
         }
         if let Some((i, target, compliance)) = grab
             && compliance > 0.0
@@ -866,8 +921,9 @@ impl FastSimulation {
                 alpha_tilde: (compliance / (h * h)) as f32,
             };
             let weights = [self.inverse_masses[i], 0.0];
-            if let Some(c) = crate::projection::correction(evaluation, weights, *grab_lambda, rule)
-            {
+            let unbounded = f32::INFINITY;
+            let correction = crate::projection::correction;
+            if let Some(c) = correction(evaluation, weights, *grab_lambda, rule, unbounded) {
                 *grab_lambda += c.delta_lambda;
                 self.positions[i] += c.delta_x[0];
             }

@@ -18,6 +18,9 @@ pub struct ConstraintSet {
     particles: Vec<u32>,
     rest: Vec<f64>,
     lambda: Vec<f64>,
+    /// The size of each constraint's element: the longest rest edge among its particles, what
+    /// its reach is measured in ([`crate::solver::Settings::reach`]).
+    size: Vec<f64>,
     /// The order a sweep projects the constraints in; empty for 0, 1, 2, …
     /// ([`crate::solver::Settings::order_seed`]).
     order: Vec<u32>,
@@ -28,12 +31,17 @@ impl ConstraintSet {
     /// with its rest value measured on the mesh's rest positions ([`Constraint::rest_value`]).
     pub(crate) fn new(family: Family, mesh: &TetMesh, material: &Material) -> ConstraintSet {
         let particles = family.row().binding.particles(mesh);
+        let size = particles
+            .chunks_exact(family.arity())
+            .map(|idx| longest_edge(idx.iter().map(|&i| mesh.positions[i as usize])))
+            .collect();
         let mut set = ConstraintSet {
             generation: Some(family.generation()),
             arity: family.arity(),
             lambda: vec![0.0; particles.len() / family.arity()],
             particles,
             rest: Vec::new(),
+            size,
             order: Vec::new(),
         };
         set.measure_rest(family, &mesh.positions, material);
@@ -112,6 +120,11 @@ impl ConstraintSet {
         &self.rest
     }
 
+    /// The size of each constraint's element: the longest rest edge among its particles.
+    pub fn size(&self) -> &[f64] {
+        &self.size
+    }
+
     /// The XPBD multiplier λ of each constraint, accumulated within the current substep.
     pub fn lambda(&self) -> &[f64] {
         &self.lambda
@@ -144,6 +157,19 @@ impl ConstraintSet {
     /// The bytes its arrays take (their capacities).
     pub(crate) fn heap_bytes(&self) -> usize {
         (self.particles.capacity() + self.order.capacity()) * size_of::<u32>()
-            + (self.rest.capacity() + self.lambda.capacity()) * size_of::<f64>()
+            + (self.rest.capacity() + self.lambda.capacity() + self.size.capacity())
+                * size_of::<f64>()
     }
+}
+
+/// The longest distance between two of `points` (an edge's length, a tet's longest edge): the
+/// size of an element.
+pub(crate) fn longest_edge(points: impl Iterator<Item = DVec3> + Clone) -> f64 {
+    let mut longest: f64 = 0.0;
+    for (k, a) in points.clone().enumerate() {
+        for b in points.clone().skip(k + 1) {
+            longest = longest.max(a.distance(b));
+        }
+    }
+    longest
 }

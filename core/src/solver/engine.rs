@@ -194,6 +194,9 @@ impl Simulation {
         };
         let solver = self.fast.solver.as_mut().expect("made ready above");
         solver.step_frame(&inputs);
+        for (family, counts) in solver.take_skipped().iter() {
+            self.skipped[family] = self.skipped[family] + counts;
+        }
         solver.store(
             &mut self.positions,
             &mut self.velocities,

@@ -34,6 +34,7 @@ mod pair;
 mod settings;
 
 pub use constraint_set::ConstraintSet;
+pub(crate) use constraint_set::longest_edge;
 pub use engine::{Engine, FAST_FROM_TETS};
 pub use masses::DENSITY;
 pub use settings::{DEFAULT_SUBSTEPS, Method, Settings};
@@ -42,7 +43,7 @@ use crate::constraints::{Constraint, Family, PerFamily, Visit, distance};
 use crate::divergence::Divergence;
 use crate::integrate;
 use crate::mesh::TetMesh;
-use crate::projection::{Rule, correction};
+use crate::projection::{Rule, SkipCounts, correction, correction_lanes};
 use crate::scene::Scene;
 use glam::DVec3;
 
@@ -106,6 +107,8 @@ pub struct Simulation {
     fast: engine::FastEngine,
     /// Threads for the fast engine.
     threads: usize,
+    /// Projections skipped for a counted reason since the start (or the last reset), per family.
+    skipped: PerFamily<SkipCounts>,
 }
 
 impl Simulation {
@@ -148,6 +151,7 @@ impl Simulation {
             definitions: crate::constraints::file::definitions(),
             fast: engine::FastEngine::default(),
             threads: 1,
+            skipped: PerFamily::default(),
         };
         simulation.update_inverse_masses();
         simulation.apply_orders();
@@ -323,6 +327,15 @@ impl Simulation {
         &self.inverse_masses
     }
 
+    /// Per family, the projections skipped since the start (or the last reset) because ∇C was
+    /// undefined or not finite, or because the step would have moved a particle further than
+    /// [`crate::projection::DEFAULT_REACH`] rest edges of its element. Zero for every built-in family on
+    /// every scene tetlab ships; a constraint file whose ∇C vanishes where C does not counts
+    /// here instead of flinging particles away.
+    pub fn skipped(&self) -> &PerFamily<SkipCounts> {
+        &self.skipped
+    }
+
     /// The tets, as indices into the positions.
     pub fn tets(&self) -> &[[u32; 4]] {
         &self.tets
@@ -427,6 +440,7 @@ impl Simulation {
     /// Back to the rest shape, at rest, at frame 0.
     pub fn reset(&mut self) {
         self.positions.copy_from_slice(&self.rest_positions);
+        self.skipped = PerFamily::default();
         self.stop();
         self.settling = None;
         self.frame = 0;
@@ -670,6 +684,7 @@ impl Simulation {
             inverse_masses: &self.inverse_masses,
             rule,
             c,
+            reach: self.settings.reach,
         });
         if let Some(partner) = family.partner_in(&self.settings.active) {
             let pair = pair::Pair {
@@ -679,6 +694,7 @@ impl Simulation {
                 rest_positions: &self.rest_positions,
                 inverse_masses: &self.inverse_masses,
                 rules: [rule, self.rule(partner, h)],
+                reach: self.settings.reach,
             };
             let correction = family.visit_pair(partner, pair::PairAt { pair, c });
             let skipped = projection.delta_lambda.is_none();
@@ -701,14 +717,17 @@ impl Simulation {
         if let Some(partner) = family.partner_in(&self.settings.active) {
             let rules = [rule, self.rule(partner, h)];
             let (first, second) = self.sets.pair_mut(family, partner);
+            let (skipped_first, skipped_second) = self.skipped.pair_mut(family, partner);
             let sweep = pair::PairSweep {
                 first,
                 second,
+                skipped: [skipped_first, skipped_second],
                 positions: &mut self.positions,
                 rest_positions: &self.rest_positions,
                 inverse_masses: &self.inverse_masses,
                 rules,
                 which,
+                reach: self.settings.reach,
             };
             family.visit_pair(partner, sweep);
             return;
@@ -720,6 +739,8 @@ impl Simulation {
             inverse_masses: &self.inverse_masses,
             rule,
             which,
+            skipped: &mut self.skipped[family],
+            reach: self.settings.reach,
         });
     }
 
@@ -739,9 +760,12 @@ impl Simulation {
             &mut self.previous,
             &mut self.velocities,
             &self.inverse_masses,
-            self.settings.gravity,
-            h,
-            self.settings.ground.then_some(0.0),
+            integrate::Substep {
+                gravity: self.settings.gravity,
+                h,
+                ground: self.settings.ground.then_some(0.0),
+            },
+            None,
         );
         if let Some(grab) = self.rigid_grab() {
             self.positions[grab.particle] = grab.target;
@@ -775,7 +799,9 @@ impl Simulation {
         let rule = Rule::Xpbd {
             alpha_tilde: compliance / (h * h),
         };
-        if let Some(c) = correction(evaluation, [self.inverse_masses[i], 0.0], grab.lambda, rule) {
+        let unbounded = f64::INFINITY;
+        let weights = [self.inverse_masses[i], 0.0];
+        if let Some(c) = correction(evaluation, weights, grab.lambda, rule, unbounded) {
             grab.lambda += c.delta_lambda;
             self.positions[i] += c.delta_x[0];
         }
@@ -790,6 +816,7 @@ impl Simulation {
             h,
             self.settings.damping,
             settling,
+            None,
         );
     }
 }
@@ -831,6 +858,9 @@ struct Sweep<'a> {
     inverse_masses: &'a [f64],
     rule: Rule<f64>,
     which: Projected,
+    skipped: &'a mut SkipCounts,
+    /// [`Settings::reach`].
+    reach: f64,
 }
 
 impl Visit for Sweep<'_> {
@@ -849,9 +879,12 @@ impl Visit for Sweep<'_> {
             };
             let evaluation = constraint.evaluate(&p, self.set.rest()[c], &shape);
             let weights = idx.map(|i| self.inverse_masses[i as usize]);
-            if let Some(correction) =
-                correction(evaluation, weights, self.set.lambda()[c], self.rule)
-            {
+            let (lambda, reach) = (self.set.lambda()[c], self.reach * self.set.size()[c]);
+            let (skipped, correction) =
+                correction_lanes(evaluation, weights, lambda, self.rule, reach);
+            if skipped.any() {
+                self.skipped.add(skipped);
+            } else {
                 self.set.add_lambda(c, correction.delta_lambda);
                 for (&i, dx) in idx.iter().zip(correction.delta_x) {
                     self.positions[i as usize] += dx;
@@ -908,6 +941,7 @@ struct Describe<'a> {
     inverse_masses: &'a [f64],
     rule: Rule<f64>,
     c: usize,
+    reach: f64,
 }
 
 impl Visit for Describe<'_> {
@@ -921,7 +955,8 @@ impl Visit for Describe<'_> {
         let evaluation = constraint.evaluate(&p, self.set.rest()[c], &shape);
         let weights = idx.map(|i| self.inverse_masses[i as usize]);
         let lambda = self.set.lambda()[c];
-        let correction = correction(evaluation, weights, lambda, self.rule);
+        let reach = self.reach * self.set.size()[c];
+        let correction = correction(evaluation, weights, lambda, self.rule, reach);
         let mut projection = Projection {
             family,
             constraint: c,

@@ -4,7 +4,7 @@
 
 use super::{ConstraintSet, Projected};
 use crate::constraints::{Constraint, Evaluation, VisitPair};
-use crate::projection::{PairCorrection, Rule, pair_correction_lanes};
+use crate::projection::{PairCorrection, Rule, SkipCounts, pair_correction_lanes};
 use glam::DVec3;
 
 /// What the pair is projected with: the two families' constraints, the particles and the rules.
@@ -15,6 +15,8 @@ pub(super) struct Pair<'a> {
     pub rest_positions: &'a [DVec3],
     pub inverse_masses: &'a [f64],
     pub rules: [Rule<f64>; 2],
+    /// [`crate::solver::Settings::reach`].
+    pub reach: f64,
 }
 
 impl Pair<'_> {
@@ -41,9 +43,10 @@ impl Pair<'_> {
         };
         let weights = idx.map(|i| self.inverse_masses[i as usize]);
         let lambda = [self.first.lambda()[c], self.second.lambda()[c]];
+        let reach = self.reach * self.first.size()[c];
         (
             idx,
-            pair_correction_lanes(a, b, weights, lambda, self.rules),
+            pair_correction_lanes(a, b, weights, lambda, self.rules, reach),
         )
     }
 }
@@ -53,12 +56,16 @@ impl Pair<'_> {
 pub(super) struct PairSweep<'a> {
     pub first: &'a mut ConstraintSet,
     pub second: &'a mut ConstraintSet,
+    /// Where each family's skipped projections are counted.
+    pub skipped: [&'a mut SkipCounts; 2],
     pub positions: &'a mut [DVec3],
     pub rest_positions: &'a [DVec3],
     pub inverse_masses: &'a [f64],
     pub rules: [Rule<f64>; 2],
     /// Which constraints, in the first family's order.
     pub which: Projected,
+    /// [`crate::solver::Settings::reach`].
+    pub reach: f64,
 }
 
 impl VisitPair for PairSweep<'_> {
@@ -66,7 +73,7 @@ impl VisitPair for PairSweep<'_> {
 
     #[inline]
     fn visit_pair<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
-        self,
+        mut self,
         first: &A,
         second: &B,
     ) {
@@ -79,8 +86,12 @@ impl VisitPair for PairSweep<'_> {
                 rest_positions: self.rest_positions,
                 inverse_masses: self.inverse_masses,
                 rules: self.rules,
+                reach: self.reach,
             };
             let (idx, correction) = pair.correction_at::<N, A, M, B>(first, second, c);
+            for (counts, skipped) in self.skipped.iter_mut().zip(correction.skipped) {
+                counts.add(skipped);
+            }
             self.first.add_lambda(c, correction.delta_lambda[0]);
             self.second.add_lambda(c, correction.delta_lambda[1]);
             for (&i, dx) in idx.iter().zip(correction.delta_x) {
@@ -110,6 +121,7 @@ impl VisitPair for PairAt<'_> {
         PairCorrection {
             delta_lambda: correction.delta_lambda,
             delta_x,
+            skipped: correction.skipped,
         }
     }
 }

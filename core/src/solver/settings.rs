@@ -82,6 +82,15 @@ pub struct Settings {
     /// on the order of the projections; `tetlab run --ensemble N` counts how often it holds.
     #[serde(default)]
     pub order_seed: Option<u64>,
+    /// How far one projection may move a particle, in longest rest edges of its element: a
+    /// longer step is skipped and counted ([`crate::projection::DEFAULT_REACH`] says why, and
+    /// why 100 is the default).
+    #[serde(default = "default_reach")]
+    pub reach: f64,
+}
+
+fn default_reach() -> f64 {
+    crate::projection::DEFAULT_REACH
 }
 
 impl Settings {
@@ -123,6 +132,7 @@ impl Settings {
         limits::DT.check(self.dt)?;
         limits::GRAVITY.check(self.gravity)?;
         limits::DAMPING.check(self.damping)?;
+        limits::REACH.check(self.reach)?;
         self.material.check()?;
         limits::COMPLIANCE
             .check(self.grab_compliance)
@@ -202,6 +212,7 @@ impl Default for Settings {
             material: Material::default(),
             engine: Engine::Auto,
             order_seed: None,
+            reach: crate::projection::DEFAULT_REACH,
         };
         settings.set_material(Material::default());
         settings

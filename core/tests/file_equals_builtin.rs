@@ -1,0 +1,257 @@
+//! One family, two routes: the source note's edge, height and volume written as constraint files
+//! (`assets/constraints/`) against the built-in families, projection by projection and outcome
+//! by outcome.
+//!
+//! - **Per projection.** At every constraint of the states a mirrored cube and a flattened bunny
+//!   pass through on their way back, C and ∇C of each file (its gradient by automatic
+//!   differentiation, and its own with `use_gradient = true`) equal the built-in's to 10⁻¹²
+//!   relative in f64 and to 10⁻⁵ in f32, the fast engine's precision.
+//! - **The same outcome.** Simulated, the files recover a mirrored cube and a flattened bunny
+//!   where the built-ins do, on both engines.
+
+use glam::{DVec3, Vec3};
+use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
+use tetlab_core::constraint_file::ConstraintFile;
+use tetlab_core::constraints::{Constraint, Family, PerFamily, Visit};
+use tetlab_core::material::Material;
+use tetlab_core::mesh::TetMesh;
+use tetlab_core::metrics::Metrics;
+use tetlab_core::outcome::Outcome;
+use tetlab_core::scene::{Builtin, Perturbation, Scene};
+use tetlab_core::shared_meshes;
+use tetlab_core::solver::{Engine, Settings, Simulation};
+
+fn asset(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/constraints")
+        .join(name)
+}
+
+/// A built-in family and the same family read from a file, by AD and by its own gradient.
+struct Route {
+    builtin: Family,
+    by_ad: Family,
+    own: Family,
+}
+
+static ROUTES: LazyLock<Vec<Route>> = LazyLock::new(|| {
+    [
+        (Family::EDGES, "edge.toml"),
+        (Family::HEIGHT, "height.toml"),
+        (Family::VOLUME, "volume.toml"),
+    ]
+    .into_iter()
+    .map(|(builtin, file)| {
+        let text = std::fs::read_to_string(asset(file)).unwrap();
+        let name = text
+            .lines()
+            .find_map(|l| l.strip_prefix("name = "))
+            .unwrap()
+            .to_string();
+        let own = text.replacen(
+            &format!("name = {name}"),
+            &format!(
+                "name = {}\nuse_gradient = true",
+                name.replace("my-", "own-")
+            ),
+            1,
+        );
+        let parse = |text: &str, path: &str| {
+            Family::register(ConstraintFile::parse(Path::new(path), text).unwrap()).unwrap()
+        };
+        Route {
+            builtin,
+            by_ad: parse(&text, file),
+            own: parse(&own, &format!("own-{file}")),
+        }
+    })
+    .collect()
+});
+
+/// C and ∇C of constraint `points` of `family` in f64 and in f32 (as f64).
+struct Both<'a> {
+    points: &'a [DVec3],
+    rest: f64,
+    shape: &'a [DVec3],
+}
+
+type Values = (f64, [DVec3; 4], bool);
+
+impl Visit for Both<'_> {
+    type Output = [Values; 2];
+    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
+        let p: [DVec3; N] = std::array::from_fn(|k| self.points[k]);
+        let q: [DVec3; N] = std::array::from_fn(|k| self.shape[k]);
+        let e = c.evaluate(&p, self.rest, &q);
+        let mut g64 = [DVec3::ZERO; 4];
+        g64[..N].copy_from_slice(&e.gradients);
+        let e32 = c.evaluate(
+            &p.map(|v| v.as_vec3()),
+            self.rest as f32,
+            &q.map(|v| v.as_vec3()),
+        );
+        let mut g32 = [DVec3::ZERO; 4];
+        for (g, v) in g32.iter_mut().zip(e32.gradients.iter()) {
+            *g = Vec3::as_dvec3(v);
+        }
+        [
+            (e.value, g64, e.degenerate),
+            (e32.value as f64, g32, e32.degenerate),
+        ]
+    }
+}
+
+/// The largest relative differences, f64 and f32, over every constraint of `route` at
+/// `positions`, and the constraints compared.
+fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2], [f64; 2], usize) {
+    let family = route.builtin;
+    let arity = family.arity();
+    let particles = family.row().binding.particles(mesh);
+    let mut worst = [0.0f64; 2];
+    let mut worst_own = [0.0f64; 2];
+    let mut compared = 0;
+    for constraint in particles.chunks(arity) {
+        let shape: Vec<DVec3> = constraint
+            .iter()
+            .map(|&i| mesh.positions[i as usize])
+            .collect();
+        let points: Vec<DVec3> = constraint.iter().map(|&i| positions[i as usize]).collect();
+        let rest = family.rest_value(&shape, &Material::default());
+        let at = |f: Family| {
+            f.visit(Both {
+                points: &points,
+                rest,
+                shape: &shape,
+            })
+        };
+        let builtin = at(family);
+        if builtin[0].2 {
+            continue;
+        }
+        compared += 1;
+        for (file, worst) in [(route.by_ad, &mut worst), (route.own, &mut worst_own)] {
+            let file = at(file);
+            for precision in 0..2 {
+                let (c, g, _) = builtin[precision];
+                let (fc, fg, _) = file[precision];
+                // C relative to the constraint's own size (|C|, its rest value, ∇C times an
+                // edge); ∇C relative to its largest particle's.
+                let reach = g.iter().map(|v| v.length()).fold(0.0, f64::max);
+                let size = shape[0].distance(shape[1]);
+                let c_scale = c.abs().max(rest.abs()).max(reach * size);
+                let gap = ((c - fc).abs() / c_scale).max(
+                    g.iter()
+                        .zip(&fg)
+                        .map(|(a, b)| (*a - *b).length() / reach)
+                        .fold(0.0, f64::max),
+                );
+                worst[precision] = worst[precision].max(gap);
+            }
+        }
+    }
+    (worst, worst_own, compared)
+}
+
+/// The states a body passes through on its way back: the positions after each of `frames`
+/// frames of the built-in edges, heights and volume (the command line's settings).
+fn states(scene: &Scene, perturbation: Perturbation, frames: &[u64]) -> Vec<Vec<DVec3>> {
+    let settings = Settings {
+        active: PerFamily::parse_list("edges,height,volume").unwrap(),
+        engine: Engine::Reference,
+        settle_edits: true,
+        ..Settings::default()
+    };
+    let mut simulation = Simulation::new(scene, settings);
+    simulation.perturb(perturbation);
+    let mut out = Vec::new();
+    for frame in 0..=*frames.iter().max().unwrap() {
+        if frames.contains(&frame) {
+            out.push(simulation.positions().to_vec());
+        }
+        simulation.step();
+    }
+    out
+}
+
+fn scenes() -> Vec<(Scene, Perturbation)> {
+    let mut scenes = vec![(
+        Scene::builtin(Builtin::Cube, 4).unwrap(),
+        Perturbation::Mirror,
+    )];
+    if let Some(bunny) = shared_meshes::for_test("bunny.node") {
+        scenes.push((Scene::load(&bunny).unwrap(), Perturbation::Flatten));
+    }
+    scenes
+}
+
+#[test]
+fn every_projection_of_a_file_is_the_built_ins() {
+    for (scene, perturbation) in scenes() {
+        for positions in states(&scene, perturbation, &[0, 1, 2, 5, 20, 60]) {
+            for route in ROUTES.iter() {
+                let (ad, own, compared) = differences(route, &scene.mesh, &positions);
+                println!(
+                    "{} {perturbation:?}, {}: {compared} constraints; by AD {:.1e} (f64) {:.1e} (f32), its own gradient {:.1e} {:.1e}",
+                    scene.name,
+                    route.builtin.name(),
+                    ad[0],
+                    ad[1],
+                    own[0],
+                    own[1]
+                );
+                assert!(compared > 0);
+                for (what, [f64s, f32s]) in [("by AD", ad), ("its own gradient", own)] {
+                    assert!(
+                        f64s <= 1e-12,
+                        "{}: {what}: f64 {f64s:e}",
+                        route.builtin.name()
+                    );
+                    assert!(
+                        f32s <= 1e-5,
+                        "{}: {what}: f32 {f32s:e}",
+                        route.builtin.name()
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_file_recovers_where_the_built_in_does_on_both_engines() {
+    let routes = &*ROUTES;
+    for (scene, perturbation) in scenes() {
+        for engine in [Engine::Reference, Engine::Fast] {
+            let mut recovered = Vec::new();
+            for pick in [
+                |r: &Route| r.builtin,
+                |r: &Route| r.by_ad,
+                |r: &Route| r.own,
+            ] {
+                let families: Vec<Family> = routes.iter().map(pick).collect();
+                let settings = Settings {
+                    active: PerFamily::from_fn(|f| families.contains(&f)),
+                    engine,
+                    settle_edits: true,
+                    ..Settings::default()
+                };
+                let mut simulation = Simulation::new(&scene, settings);
+                simulation.perturb(perturbation);
+                let start = Metrics::measure(&simulation);
+                let mut outcome = Outcome::start(&simulation, &start);
+                for _ in 0..60 {
+                    simulation.step();
+                    outcome.observe(&simulation, &Metrics::measure_sound(&simulation).unwrap());
+                }
+                println!(
+                    "{} {engine:?} {families:?}: {}",
+                    scene.name,
+                    outcome.describe()
+                );
+                recovered.push(outcome.recovered() && !outcome.thrown());
+            }
+            assert_eq!(recovered, [true; 3], "{} on {engine:?}", scene.name);
+        }
+    }
+}
