@@ -8,8 +8,9 @@
 # Usage: scripts/reach-battery.sh   (needs the shared meshes in ../shared/meshes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-tetlab=${TETLAB:-target/release/tetlab}
-[ -x "$tetlab" ] || cargo build --release --quiet
+# TETLAB names a binary to use; without it, tetlab is built first.
+[ -n "${TETLAB:-}" ] || cargo build --release --quiet
+tetlab=${TETLAB:-${CARGO_TARGET_DIR:-target}/release/tetlab}
 meshes=../shared/meshes
 scenes="cube $meshes/bunny.node $meshes/armadillo_4k.node $meshes/ball_v41.msh"
 perturbations="none mirror flatten scramble:1"

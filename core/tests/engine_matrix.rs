@@ -114,7 +114,7 @@ const CLAIMS: &[Claim] = &[
         orderings: 0,
     },
     Claim {
-        source: "docs/experiments.md: the headline, the same + heights",
+        source: "docs/experiments.md: the headline, the same + heights (recovers in 2 of 16 orderings on the reference engine, 0 of 16 on the fast one)",
         scene: Where::Shared("bunny.node"),
         families: "edges,height,volume",
         tweak: |s| {
@@ -123,8 +123,8 @@ const CLAIMS: &[Claim] = &[
         },
         perturbation: Some(Perturbation::Flatten),
         frames: 600,
-        recovers: true,
-        orderings: 0,
+        recovers: false,
+        orderings: 4,
     },
     Claim {
         source: "docs/experiments.md: the headline, rigid edges + heights + volume",

@@ -13,7 +13,9 @@
 //! The four heights of a tet are four elements, coloured apart (they share their particles), not
 //! one element projected four times in a row: projected back to back, they snap each inverted tet
 //! to its own rest shape before its neighbours move, and a mirrored cube recovered in a third of
-//! the orders (docs/performance.md, "Engines").
+//! the orders (docs/performance.md, "Engines"). For the same reason the colouring visits them
+//! role by role ([`Layout::new_visiting`]): visited tet by tet, a tet's four heights took four
+//! colours in a row, and the colour order projected them back to back after all.
 
 use crate::lanes::{F32x8, LANES};
 use crate::vector::Real;
@@ -74,8 +76,23 @@ impl Layout {
         inverse_masses: &[f32],
         rest_positions: &[glam::Vec3A],
     ) -> Layout {
+        Self::new_visiting(
+            elements,
+            (0..elements.len()).collect(),
+            inverse_masses,
+            rest_positions,
+        )
+    }
+
+    /// [`Layout::new`], the greedy colouring visiting the elements in the order `visit`.
+    pub(crate) fn new_visiting<const N: usize>(
+        elements: &[[u32; N]],
+        visit: Vec<usize>,
+        inverse_masses: &[f32],
+        rest_positions: &[glam::Vec3A],
+    ) -> Layout {
         let mut colour_of = vec![usize::MAX; elements.len()];
-        let mut remaining: Vec<usize> = (0..elements.len()).collect();
+        let mut remaining: Vec<usize> = visit;
         let mut base = 0;
         // 64 colours per pass, one bit each per particle; elements that find none wait for the
         // next pass.

@@ -293,7 +293,12 @@ impl FastSimulation {
             let flat = Binding::TetVertices.particles(&mesh);
             let (constraints, _) = flat.as_chunks::<4>();
             let constraints = renumbered(constraints);
-            layouts.tet_vertices = Layout::new(&constraints, &inverse_masses, &rest_positions);
+            // Role by role: every tet's first height, then every tet's second, …, so that a
+            // tet's four heights take colours far apart (see `batches`).
+            let n = constraints.len();
+            let visit: Vec<usize> = (0..4).flat_map(|k| (k..n).step_by(4)).collect();
+            layouts.tet_vertices =
+                Layout::new_visiting(&constraints, visit, &inverse_masses, &rest_positions);
         }
         let sets = PerFamily::build(|family| {
             if !active[family] {
