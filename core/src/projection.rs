@@ -171,7 +171,7 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
     rule: Rule<V::Real>,
     reach: V::Real,
 ) -> (Skipped<<V::Real as Real>::Mask>, Correction<N, V>) {
-    let (skipped, degenerate, weighted_norm) = skipped_lanes(&evaluation, &weights);
+    let (skipped, degenerate, weighted_norm, largest) = skipped_lanes(&evaluation, &weights);
     let delta_lambda = match rule {
         Rule::Xpbd { alpha_tilde } => {
             (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
@@ -179,17 +179,14 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
         Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
         Rule::CompliantPbd { alpha_tilde } => -evaluation.value / (weighted_norm + alpha_tilde),
     };
-    let mut delta_x = [V::ZERO; N];
-    let mut step = V::Real::ZERO;
-    for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
-        *dx = *g * (w * delta_lambda);
-        let squared = dx.length_squared();
-        step = V::Real::select(squared.gt(step), squared, step);
-    }
-    let too_long = !skipped & !step.le(reach * reach);
+    // The longest step, max |Δxᵢ|² = Δλ² max wᵢ²|∇ᵢC|², from the norms already taken. A step
+    // that is not a number is not "too long": it reaches the positions, and the divergence check
+    // names it.
+    let too_long = !skipped & (delta_lambda * delta_lambda * largest).gt(reach * reach);
     let skipped = skipped | too_long;
-    for dx in &mut delta_x {
-        *dx = V::select(skipped, V::ZERO, *dx);
+    let mut delta_x = [V::ZERO; N];
+    for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
+        *dx = V::select(skipped, V::ZERO, *g * (w * delta_lambda));
     }
     (
         Skipped {
@@ -204,23 +201,31 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
     )
 }
 
+/// What [`skipped_lanes`] finds: whether each lane is skipped, which of those are counted as
+/// degenerate, Σ wᵢ|∇ᵢC|², and max wᵢ²|∇ᵢC|².
+type Norms<R> = (<R as Real>::Mask, <R as Real>::Mask, R, R);
+
 /// Whether a projection skips the constraint (degenerate, every particle fixed, or [`LOCKED`]);
-/// of those, the degenerate ones where some particle is free (the ones counted); and
-/// Σ wᵢ|∇ᵢC|².
+/// of those, the degenerate ones where some particle is free (the ones counted);
+/// Σ wᵢ|∇ᵢC|²; and max wᵢ²|∇ᵢC|², the longest step per unit Δλ, squared.
 #[inline(always)]
 fn skipped_lanes<V: Vector3, const N: usize>(
     evaluation: &Evaluation<V, N>,
     weights: &[V::Real; N],
-) -> (<V::Real as Real>::Mask, <V::Real as Real>::Mask, V::Real) {
-    // Σ wᵢ|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
+) -> Norms<V::Real> {
+    // Σ wᵢ|∇ᵢC|², max wᵢ²|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
     let mut weighted_norm = V::Real::ZERO;
     let mut norm = V::Real::ZERO;
     let mut heaviest = V::Real::ZERO;
+    let mut largest = V::Real::ZERO;
     for (w, g) in weights.iter().zip(&evaluation.gradients) {
         let squared = g.length_squared();
-        weighted_norm += *w * squared;
+        let weighted = *w * squared;
+        weighted_norm += weighted;
         norm += squared;
         heaviest = V::Real::select(w.gt(heaviest), *w, heaviest);
+        let reach = *w * weighted;
+        largest = V::Real::select(reach.gt(largest), reach, largest);
     }
     let locked = weighted_norm.le(V::Real::from_f64(LOCKED) * heaviest * norm);
     let undefined = evaluation.degenerate | !weighted_norm.finite();
@@ -229,6 +234,7 @@ fn skipped_lanes<V: Vector3, const N: usize>(
         skipped,
         undefined & heaviest.gt(V::Real::ZERO),
         weighted_norm,
+        largest,
     )
 }
 
@@ -269,7 +275,7 @@ pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
     let zero = V::Real::ZERO;
     let one = V::Real::ONE;
     let part = |e: &Evaluation<V, N>, lambda: V::Real, rule: Rule<V::Real>| {
-        let (skipped, degenerate, weighted_norm) = skipped_lanes(e, &weights);
+        let (skipped, degenerate, weighted_norm, _) = skipped_lanes(e, &weights);
         let (alpha, rhs) = match rule {
             Rule::Xpbd { alpha_tilde } => (alpha_tilde, -e.value - alpha_tilde * lambda),
             Rule::CompliantPbd { alpha_tilde } => (alpha_tilde, -e.value),
