@@ -144,7 +144,7 @@ impl Layout {
                     .push(std::array::from_fn(|k| element(k) as u32));
                 layout.size.push(F32x8::new(std::array::from_fn(|k| {
                     let corners = elements[element(k)].map(|i| rest_positions[i as usize]);
-                    crate::solver::longest_edge(corners.iter().map(|p| p.as_dvec3())) as f32
+                    crate::mesh::longest_edge(corners.iter().map(|p| p.as_dvec3())) as f32
                 })));
             }
             layout.colours.push(Colour {

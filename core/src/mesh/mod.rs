@@ -91,7 +91,7 @@ impl TetMesh {
         for tet in &mut tets {
             let corners = tet.map(|i| kept[i as usize]);
             let volume = signed_volume(&corners);
-            let longest = longest_edge(&corners);
+            let longest = longest_edge(corners.iter().copied());
             if volume.abs() <= 1e-12 * longest * longest * longest {
                 report.degenerate_tets += 1;
             } else if volume < 0.0 {
@@ -184,9 +184,14 @@ fn sorted(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
-fn longest_edge(p: &[DVec3; 4]) -> f64 {
-    TET_EDGES
-        .iter()
-        .map(|&(a, b)| p[a].distance(p[b]))
-        .fold(0.0, f64::max)
+/// The longest distance between two of `points` (an edge's length, a tet's longest edge): the
+/// size of an element.
+pub(crate) fn longest_edge(points: impl Iterator<Item = DVec3> + Clone) -> f64 {
+    let mut longest: f64 = 0.0;
+    for (k, a) in points.clone().enumerate() {
+        for b in points.clone().skip(k + 1) {
+            longest = longest.max(a.distance(b));
+        }
+    }
+    longest
 }

@@ -33,7 +33,7 @@ impl ConstraintSet {
         let particles = family.row().binding.particles(mesh);
         let size = particles
             .chunks_exact(family.arity())
-            .map(|idx| longest_edge(idx.iter().map(|&i| mesh.positions[i as usize])))
+            .map(|idx| crate::mesh::longest_edge(idx.iter().map(|&i| mesh.positions[i as usize])))
             .collect();
         let mut set = ConstraintSet {
             generation: Some(family.generation()),
@@ -160,16 +160,4 @@ impl ConstraintSet {
             + (self.rest.capacity() + self.lambda.capacity() + self.size.capacity())
                 * size_of::<f64>()
     }
-}
-
-/// The longest distance between two of `points` (an edge's length, a tet's longest edge): the
-/// size of an element.
-pub(crate) fn longest_edge(points: impl Iterator<Item = DVec3> + Clone) -> f64 {
-    let mut longest: f64 = 0.0;
-    for (k, a) in points.clone().enumerate() {
-        for b in points.clone().skip(k + 1) {
-            longest = longest.max(a.distance(b));
-        }
-    }
-    longest
 }

@@ -34,7 +34,6 @@ mod pair;
 mod settings;
 
 pub use constraint_set::ConstraintSet;
-pub(crate) use constraint_set::longest_edge;
 pub use engine::{Engine, FAST_FROM_TETS};
 pub use masses::DENSITY;
 pub use settings::{DEFAULT_SUBSTEPS, Method, Settings};
