@@ -22,16 +22,19 @@ pub(crate) struct Residuals<'a, V> {
 }
 
 /// What a substep's prediction needs to know: gravity g (m/s², along −y), the substep's length
-/// h (s), and the ground's height, if there is one.
+/// h (s), the ground's height, if there is one, and whether every particle keeps its z
+/// (plane strain, [`hold_plane`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Substep {
     pub gravity: f64,
     pub h: f64,
     pub ground: Option<f64>,
+    pub plane_strain: bool,
 }
 
 /// The prediction of a substep of length `h`: x_prev = x, and for every free particle (w > 0)
-/// v += g h, x += v h with gravity g along −y. With a ground (at height `ground` in the
+/// v += (g + w fᵢ) h, x += v h with gravity g along −y and `forces` fᵢ the external force on
+/// particle i in N (a load lumped onto the nodes; empty: none). With plane strain, v_z = 0. With a ground (at height `ground` in the
 /// positions' frame: 0, or where y = 0 lies for the fast engine, which keeps positions relative
 /// to an origin near the body), a particle predicted below it is put back at its previous
 /// position, on the ground (sticking friction).
@@ -43,12 +46,18 @@ pub(crate) fn predict<V: Vector3>(
     previous: &mut [V],
     velocities: &mut [V],
     inverse_masses: &[V::Real],
+    forces: &[V],
     substep: Substep,
     mut residuals: Option<Residuals<'_, V>>,
 ) where
     V::Real: PartialOrd,
 {
-    let Substep { gravity, h, ground } = substep;
+    let Substep {
+        gravity,
+        h,
+        ground,
+        plane_strain,
+    } = substep;
     let pull = V::from_f64s(0.0, -gravity, 0.0) * V::Real::from_f64(h);
     let h = V::Real::from_f64(h);
     let floor = ground.map(V::Real::from_f64);
@@ -61,6 +70,13 @@ pub(crate) fn predict<V: Vector3>(
             continue;
         }
         velocities[i] += pull;
+        if let Some(&force) = forces.get(i) {
+            velocities[i] += force * (inverse_masses[i] * h);
+        }
+        if plane_strain {
+            let [x, y, _] = velocities[i].to_array();
+            velocities[i] = V::from_array([x, y, V::Real::ZERO]);
+        }
         let step = velocities[i] * h;
         match &mut residuals {
             None => positions[i] += step,
@@ -97,6 +113,16 @@ pub(crate) fn project_ground<V: Vector3>(
         if w > V::Real::ZERO && p.y() < floor {
             p.set_y(floor);
         }
+    }
+}
+
+/// Plane strain: every particle back at the z it had at the start of the substep (`previous`),
+/// after a sweep's projections moved it. The prediction keeps v_z = 0, so each particle keeps
+/// its starting z for the whole run: the extruded panel of a plane problem held in z.
+pub(crate) fn hold_plane<V: Vector3>(positions: &mut [V], previous: &[V]) {
+    for (p, q) in positions.iter_mut().zip(previous) {
+        let [x, y, _] = p.to_array();
+        *p = V::from_array([x, y, q.to_array()[2]]);
     }
 }
 

@@ -42,6 +42,7 @@ pub mod shared_meshes;
 pub mod solver;
 pub mod stepper;
 pub mod text_file;
+pub mod validation;
 pub mod vector;
 pub mod verify;
 pub mod visual;

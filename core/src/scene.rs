@@ -158,11 +158,19 @@ impl Scene {
         let (mesh, pinned) = match builtin {
             Builtin::Tet => (regular_tet(), Vec::new()),
             Builtin::Cube => (
-                lattice([n, n, n], DVec3::new(-0.5, 0.0, -0.5), 1.0 / n as f64),
+                lattice(
+                    [n, n, n],
+                    DVec3::new(-0.5, 0.0, -0.5),
+                    DVec3::splat(1.0 / n as f64),
+                ),
                 Vec::new(),
             ),
             Builtin::Beam => {
-                let mesh = lattice([4 * n, n, n], DVec3::new(0.0, 1.0, -0.25), 0.5 / n as f64);
+                let mesh = lattice(
+                    [4 * n, n, n],
+                    DVec3::new(0.0, 1.0, -0.25),
+                    DVec3::splat(0.5 / n as f64),
+                );
                 let pinned = (0..mesh.positions.len() as u32)
                     .filter(|&i| mesh.positions[i as usize].x == 0.0)
                     .collect();
@@ -227,9 +235,22 @@ fn regular_tet() -> TetMesh {
     positively_oriented(positions, vec![[0, 1, 2, 3]])
 }
 
-/// A block of `cells` cubes of side `size` with its low corner at `origin`, each cube split into
+/// A block of `cells` boxes of sides `size` with its low corner at `origin`, each box split into
 /// six tets around its main diagonal (Kuhn's subdivision), so neighbouring cells share faces.
-fn lattice(cells: [usize; 3], origin: DVec3, size: f64) -> TetMesh {
+/// Particle (i, j, k) is number (i (ny + 1) + j)(nz + 1) + k.
+///
+/// ```
+/// use glam::DVec3;
+/// use tetlab_core::constraints::volume::signed_volume;
+/// use tetlab_core::scene::lattice;
+/// let block = lattice([2, 1, 1], DVec3::ZERO, DVec3::new(0.5, 0.1, 0.1));
+/// assert_eq!((block.positions.len(), block.tets.len()), (12, 12));
+/// // Every tet positively oriented, and together they fill the block: 1 × 0.1 × 0.1.
+/// let volumes: Vec<f64> = (0..12).map(|t| signed_volume(&block.corners(t))).collect();
+/// assert!(volumes.iter().all(|&v| v > 0.0));
+/// assert!((volumes.iter().sum::<f64>() - 0.01).abs() < 1e-15);
+/// ```
+pub fn lattice(cells: [usize; 3], origin: DVec3, size: DVec3) -> TetMesh {
     let [nx, ny, nz] = cells;
     let index = |i: usize, j: usize, k: usize| ((i * (ny + 1) + j) * (nz + 1) + k) as u32;
     let mut positions = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
@@ -273,7 +294,11 @@ fn lattice(cells: [usize; 3], origin: DVec3, size: f64) -> TetMesh {
 /// A lattice cube of `cells` cells across [−1, 1]³, each point pushed radially onto the ball of
 /// radius 0.5 at (0, 0.5, 0): q = p · |p|∞ / |p|₂, which maps every cube shell onto a sphere.
 fn ball(cells: usize) -> TetMesh {
-    let mut mesh = lattice([cells; 3], DVec3::splat(-1.0), 2.0 / cells as f64);
+    let mut mesh = lattice(
+        [cells; 3],
+        DVec3::splat(-1.0),
+        DVec3::splat(2.0 / cells as f64),
+    );
     for p in &mut mesh.positions {
         let length = p.length();
         let radial = if length > 0.0 {

@@ -15,6 +15,8 @@ mod lesson;
 mod record;
 mod run;
 mod simulation_args;
+#[cfg(not(target_arch = "wasm32"))]
+mod validate;
 mod workbench_frame;
 
 use clap::{Parser, Subcommand};
@@ -51,6 +53,10 @@ enum Command {
     /// Run a lesson headless: its steps, their text and checked observations (--record to log it).
     #[cfg(not(target_arch = "wasm32"))]
     Lesson(lesson::Args),
+    /// Check the physics against theory: patch test, bars against beam theory, stretch, large
+    /// deformations, Cook's membrane, on both engines (exit 1 when a check fails).
+    #[cfg(not(target_arch = "wasm32"))]
+    Validate(validate::Args),
 }
 
 /// An error caused by the user's input: printed as `error: <message>`, exit status 2.
@@ -110,6 +116,16 @@ pub fn main() -> ExitCode {
             lesson::Outcome::NotObserved => success = ExitCode::FAILURE,
             lesson::Outcome::Interrupted => success = ExitCode::from(crate::record::INTERRUPTED),
         }),
+        #[cfg(not(target_arch = "wasm32"))]
+        Command::Validate(args) => {
+            validate::main(&args, &mut stdout).map(|outcome| match outcome {
+                validate::Outcome::Passed => {}
+                validate::Outcome::Failed => success = ExitCode::FAILURE,
+                validate::Outcome::Interrupted => {
+                    success = ExitCode::from(crate::record::INTERRUPTED)
+                }
+            })
+        }
     };
     let flushed = outcome.and_then(|()| stdout.flush().map_err(UsageError::stdout));
     match flushed {

@@ -56,17 +56,6 @@ fn scatter_add(positions: Particles, indices: [u32; LANES], delta: Vec3x8) {
     }
 }
 
-/// Puts particle `indices[k]` at lane k of `value`, the last lane first: a padding lane repeats
-/// an element of a lower lane with zero weights (its particles unmoved), so the real lane is
-/// written last.
-#[inline(always)]
-fn scatter_set(positions: Particles, indices: [u32; LANES], value: Vec3x8) {
-    let rows = value.rows();
-    for k in (0..LANES).rev() {
-        positions.set(indices[k], rows[k]);
-    }
-}
-
 /// Where the kernels read and write: the positions (or their rest shape, for a family that reads
 /// it), and where corrections go: the same positions for Gauss–Seidel, the sums for Jacobi.
 #[derive(Clone, Copy)]
@@ -143,7 +132,7 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
     layout: &Layout,
     order: &[u32],
     batches: &mut Batches,
-    positions: &mut [Vec3A],
+    (positions, residuals): (&mut [Vec3A], &mut [Vec3A]),
     rest_positions: &mut [Vec3A],
     sums: Option<&mut [Vec3A]>,
     (rule, reach): (Rule<f64>, f64),
@@ -160,7 +149,7 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
     } = layout.typed::<N>();
     let (rest, lambda) = batches.rows();
     let access = Access {
-        read: Particles::new(positions, particle_count),
+        read: Particles::compensated(positions, residuals, particle_count),
         rest_shape: Particles::new(rest_positions, particle_count),
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
@@ -264,7 +253,7 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
         for (i, &indices) in indices.iter().enumerate() {
             match access.sums {
                 Some(sums) => scatter_add(sums, indices, d.delta_x[i]),
-                None => scatter_set(access.read, indices, p[i] + d.delta_x[i]),
+                None => scatter_add(access.read, indices, d.delta_x[i]),
             }
         }
     }
@@ -281,7 +270,7 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
     layout: &Layout,
     order: &[u32],
     (first, second): (&mut Batches, &mut Batches),
-    positions: &mut [Vec3A],
+    (positions, residuals): (&mut [Vec3A], &mut [Vec3A]),
     rest_positions: &mut [Vec3A],
     sums: Option<&mut [Vec3A]>,
     (rules, reach): ([Rule<f64>; 2], f64),
@@ -299,7 +288,7 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
     let (rest_a, lambda_a) = first.rows();
     let (rest_b, lambda_b) = second.rows();
     let access = Access {
-        read: Particles::new(positions, particle_count),
+        read: Particles::compensated(positions, residuals, particle_count),
         rest_shape: Particles::new(rest_positions, particle_count),
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };

@@ -106,6 +106,10 @@ pub struct FastSimulation {
     /// Δp of the last substep and its sum over the frame, when a frame asks for them
     /// ([`FrameInputs`]); the predicted positions they are measured from. Empty until then.
     corrections: Corrections,
+    /// The external forces in N by new number ([`Simulation::set_forces`]); empty: none.
+    forces: Vec<Vec3A>,
+    /// Whether every particle keeps its z ([`Simulation::set_plane_strain`]).
+    plane_strain: bool,
 }
 
 /// What a frame of the fast solver is asked to do beyond the settings: hold a grabbed particle,
@@ -256,6 +260,11 @@ impl FastSimulation {
             .map(|&i| simulation.inverse_masses()[i as usize] as f32)
             .collect();
         let rest_positions = take(simulation.rest_positions());
+        let forces = if simulation.forces().is_empty() {
+            Vec::new()
+        } else {
+            take(simulation.forces())
+        };
         // Only the families in use are built: the settings do not change after this.
         let active = simulation.settings().active;
         let uses =
@@ -348,6 +357,8 @@ impl FastSimulation {
             skipped: PerFamily::default(),
             frame: 0,
             corrections: Corrections::default(),
+            forces,
+            plane_strain: simulation.plane_strain(),
         }
     }
 
@@ -721,10 +732,12 @@ impl FastSimulation {
                 &mut self.previous,
                 &mut self.velocities,
                 &self.inverse_masses,
+                &self.forces,
                 integrate::Substep {
                     gravity: settings.gravity,
                     h,
                     ground,
+                    plane_strain: self.plane_strain,
                 },
                 Some(integrate::Residuals {
                     now: &mut self.residuals,
@@ -811,7 +824,7 @@ impl FastSimulation {
                     layout: &'a Layout,
                     order: &'a [u32],
                     batches: (&'a mut Batches, &'a mut Batches),
-                    positions: &'a mut [Vec3A],
+                    positions: (&'a mut [Vec3A], &'a mut [Vec3A]),
                     rest_positions: &'a mut [Vec3A],
                     sums: Option<&'a mut [Vec3A]>,
                     rules: [Rule<f64>; 2],
@@ -851,7 +864,7 @@ impl FastSimulation {
                         layout: self.layouts.of(family.row().binding),
                         order: &self.colour_orders[family],
                         batches: self.sets.pair_mut(family, partner),
-                        positions: &mut self.positions,
+                        positions: (&mut self.positions, &mut self.residuals),
                         rest_positions: &mut self.rest_positions,
                         sums,
                         rules,
@@ -873,7 +886,7 @@ impl FastSimulation {
                 layout: &'a Layout,
                 order: &'a [u32],
                 batches: &'a mut Batches,
-                positions: &'a mut [Vec3A],
+                positions: (&'a mut [Vec3A], &'a mut [Vec3A]),
                 rest_positions: &'a mut [Vec3A],
                 sums: Option<&'a mut [Vec3A]>,
                 rule: Rule<f64>,
@@ -905,7 +918,7 @@ impl FastSimulation {
                 layout: self.layouts.of(family.row().binding),
                 order: &self.colour_orders[family],
                 batches: &mut self.sets[family],
-                positions: &mut self.positions,
+                positions: (&mut self.positions, &mut self.residuals),
                 rest_positions: &mut self.rest_positions,
                 sums,
                 rule,
@@ -935,6 +948,9 @@ impl FastSimulation {
         }
         if let Some(ground) = self.ground() {
             integrate::project_ground(&mut self.positions, &self.inverse_masses, ground);
+        }
+        if self.plane_strain {
+            integrate::hold_plane(&mut self.positions, &self.previous);
         }
     }
 }

@@ -108,6 +108,10 @@ pub struct Simulation {
     threads: usize,
     /// Projections skipped for a counted reason since the start (or the last reset), per family.
     skipped: PerFamily<SkipCounts>,
+    /// External forces per particle in N, besides gravity (empty: none).
+    forces: Vec<DVec3>,
+    /// Whether every particle keeps its z (plane strain).
+    plane_strain: bool,
 }
 
 impl Simulation {
@@ -151,6 +155,8 @@ impl Simulation {
             fast: engine::FastEngine::default(),
             threads: 1,
             skipped: PerFamily::default(),
+            forces: Vec::new(),
+            plane_strain: false,
         };
         simulation.update_inverse_masses();
         simulation.apply_orders();
@@ -396,6 +402,38 @@ impl Simulation {
             + self.fast.solver.as_ref().map_or(0, |f| f.heap_bytes())
     }
 
+    /// The external forces on the particles in N, besides gravity: empty when there are none.
+    pub fn forces(&self) -> &[DVec3] {
+        &self.forces
+    }
+
+    /// Sets the external forces, one per particle in N (a traction lumped onto the nodes it
+    /// acts on), or none with an empty vector. Each substep adds w fᵢ h to a free particle's
+    /// velocity, on either engine; pinned particles feel nothing.
+    ///
+    /// # Panics
+    /// If `forces` is neither empty nor one per particle.
+    pub fn set_forces(&mut self, forces: Vec<DVec3>) {
+        assert!(
+            forces.is_empty() || forces.len() == self.positions.len(),
+            "one force per particle, or none"
+        );
+        self.forces = forces;
+        self.fast.solver = None;
+    }
+
+    /// Whether every particle keeps its z coordinate ([`Simulation::set_plane_strain`]).
+    pub fn plane_strain(&self) -> bool {
+        self.plane_strain
+    }
+
+    /// Holds every particle at its current z (on) or frees z again (off): a plane problem
+    /// extruded into one layer of tets, held in z, is in plane strain (ε_zz = 0).
+    pub fn set_plane_strain(&mut self, on: bool) {
+        self.plane_strain = on;
+        self.fast.solver = None;
+    }
+
     /// Whether particle `i` is pinned.
     pub fn is_pinned(&self, i: usize) -> bool {
         self.pinned[i]
@@ -579,6 +617,9 @@ impl Simulation {
         if self.settings.ground {
             integrate::project_ground(&mut self.positions, &self.inverse_masses, 0.0);
         }
+        if self.plane_strain {
+            integrate::hold_plane(&mut self.positions, &self.previous);
+        }
     }
 
     /// The last part of a substep: Δp = x − predicted x, then velocities from the positions.
@@ -759,10 +800,12 @@ impl Simulation {
             &mut self.previous,
             &mut self.velocities,
             &self.inverse_masses,
+            &self.forces,
             integrate::Substep {
                 gravity: self.settings.gravity,
                 h,
                 ground: self.settings.ground.then_some(0.0),
+                plane_strain: self.plane_strain,
             },
             None,
         );
@@ -776,7 +819,8 @@ impl Simulation {
         Rule::for_settings(&self.settings, family, h)
     }
 
-    /// One Gauss–Seidel sweep over the active families, then the grab, then the ground.
+    /// One Gauss–Seidel sweep over the active families, then the grab, the ground and the
+    /// plane-strain hold.
     fn sweep(&mut self, h: f64) {
         let active = self.settings.active;
         for family in Family::all() {
