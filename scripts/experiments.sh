@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs every experiment of docs/experiments.md and prints its tables in Markdown.
-# Each row is one `tetlab run` command, shown in the row; the numbers are its last frame. Every
-# row runs on the reference engine (f64, one constraint at a time): the recoveries it measures
-# depend on the order of the projections, which the fast engine changes.
+# Each row is one `tetlab run` command, shown in the row; the numbers are its last frame, on the
+# reference engine (f64, one constraint at a time). The last column is the same command on the
+# fast engine (`--engine fast`): a recovery that hangs on the order of the projections can differ
+# there, since the fast engine projects in colours (scripts/orderings.sh counts k of N).
 # Usage: scripts/experiments.sh > /tmp/tables.md   (needs the shared meshes in ../shared/meshes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,14 +15,23 @@ header() {
   echo
   echo "### $1"
   echo
-  echo "| constraints | substeps × iterations | inverted at the end | last frame with an inverted tet | min V/V₀ | volume error | max edge strain | command |"
-  echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
+  echo "| constraints | substeps × iterations | inverted at the end | last frame with an inverted tet | min V/V₀ | volume error | max edge strain | command | fast engine: inverted at the end, min V/V₀, max edge strain |"
+  echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+}
+
+# fast_cell ARGS...: the last frame of `tetlab run ARGS --engine fast`, as one table cell.
+fast_cell() {
+  "$tetlab" run "$@" --engine fast --json | python3 -c '
+import json, sys
+last = [json.loads(line) for line in sys.stdin][-1]
+print("{}, {:.3g}, {:.2e}".format(last["inverted_tets"], last["min_volume_ratio"] + 0.0, last["max_edge_strain"]))
+'
 }
 
 # row ARGS...: runs `tetlab run ARGS --json` and prints one table row.
 row() {
-  local args="$* --engine reference"
-  "$tetlab" run $args --json | python3 -c '
+  local args="$* --engine reference" line
+  line=$("$tetlab" run $args --json | python3 -c '
 import json, sys
 args = sys.argv[1]
 frames = [json.loads(line) for line in sys.stdin]
@@ -36,7 +46,8 @@ print("| {} | {} | {} of {} | {} | {:.3g} | {:.2e} | {:.2e} | `tetlab run {}` |"
     constraints, steps, last["inverted_tets"], first["tets"],
     inverted[-1] if inverted else "none", last["min_volume_ratio"] + 0.0, last["volume_error"],
     last["max_edge_strain"], args))
-' "$args"
+' "$args")
+  echo "$line $(fast_cell "$@") |"
 }
 
 families="edges height volume edges,volume edges,height height,volume edges,height,volume"
@@ -80,8 +91,8 @@ materials="edges,volume edges,height,volume neohookean neohookean,height"
 
 # inversion_row ARGS...: one row of table 11, with the inverted tets over time.
 inversion_row() {
-  local args="$* --engine reference"
-  "$tetlab" run $args --json | python3 -c '
+  local args="$* --engine reference" line
+  line=$("$tetlab" run $args --json | python3 -c '
 import json, sys
 args = sys.argv[1]
 frames = [json.loads(line) for line in sys.stdin]
@@ -94,14 +105,15 @@ curve = " / ".join(str(frames[m]["inverted_tets"]) for m in marks)
 print("| {} | {} | {} | {} | {:.3g} | {:.2e} | `tetlab run {}` |".format(
     constraints, first["tets"], curve, inverted[-1] if inverted else "none",
     last["min_volume_ratio"] + 0.0, last["max_edge_strain"], args))
-' "$args"
+' "$args")
+  echo "$line $(fast_cell "$@") |"
 }
 
 echo
 echo "### 11. Inversion: the neo-Hookean family (E = 1 MPa, ν = 0.3, the default material) against the geometric ones, 30 substeps"
 echo
-echo "| constraints | tets | inverted at frames 1 / 3 / 10 / 30 / 100 / 300 (/ 600) | last frame with an inverted tet | min V/V₀ at the end | max edge strain at the end | command |"
-echo "| --- | --- | --- | --- | --- | --- | --- |"
+echo "| constraints | tets | inverted at frames 1 / 3 / 10 / 30 / 100 / 300 (/ 600) | last frame with an inverted tet | min V/V₀ at the end | max edge strain at the end | command | fast engine: inverted at the end, min V/V₀, max edge strain |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
 for c in $materials; do inversion_row --scene cube --perturb mirror --constraints $c --substeps 30; done
 for c in $materials; do inversion_row --scene cube --perturb flatten --constraints $c --substeps 30; done
 for c in $materials; do inversion_row --scene $bunny --perturb flatten --gravity 10 --constraints $c --substeps 30; done
@@ -120,8 +132,8 @@ done; done; done
 
 # beam_row ARGS...: a cantilever run, its tip deflection against Euler–Bernoulli.
 beam_row() {
-  local args="$* --engine reference"
-  "$tetlab" run $args --json | python3 -c '
+  local args="$* --engine reference" line
+  line=$("$tetlab" run $args --json | python3 -c '
 import json, sys
 args = sys.argv[1]
 frames = [json.loads(line) for line in sys.stdin]
@@ -137,14 +149,20 @@ print("| {} | {} | {} | {} × {} | {:.4f} | {:.4f} | {:.3f} | `tetlab run {}` |"
     option("--resolution", "4"), first["tets"], option("--solver", "xpbd"),
     option("--substeps", "100"), option("--iterations", "1"),
     last["max_displacement"], theory, last["max_displacement"] / theory, args))
-' "$args"
+' "$args")
+  local fast
+  fast=$("$tetlab" run "$@" --engine fast --json | python3 -c '
+import json, sys
+print("{:.4f}".format([json.loads(line) for line in sys.stdin][-1]["max_displacement"]))
+')
+  echo "$line $fast |"
 }
 
 echo
 echo "### 14. A cantilever under gravity against Euler–Bernoulli: the beam (2 m × 0.5 m × 0.5 m, clamped at x = 0), E = 10 MPa, ν = 0.3, damped to rest (damping 10, 5 s)"
 echo
-echo "| resolution | tets | solver | substeps × iterations | tip deflection (m) | Euler–Bernoulli (m) | ratio | command |"
-echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
+echo "| resolution | tets | solver | substeps × iterations | tip deflection (m) | Euler–Bernoulli (m) | ratio | command | fast engine: tip deflection (m) |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 beam="--scene beam --constraints neohookean --material E=1e7,nu=0.3 --damping 10 --frames 300"
 for r in 1 2 4; do beam_row $beam --resolution $r --substeps 40 --iterations 4; done
 for m in xpbd pbd; do for i in 1 4 16; do beam_row $beam --resolution 2 --substeps 20 --iterations $i --solver $m; done; done
@@ -152,8 +170,8 @@ for s in 10 20 40; do beam_row $beam --resolution 2 --substeps $s --iterations 4
 
 # defaults_row ARGS...: a scene under the defaults (or the substeps given), 10 s.
 defaults_row() {
-  local args="$* --engine reference"
-  "$tetlab" run $args --frames 600 --json | python3 -c '
+  local args="$* --engine reference" line
+  line=$("$tetlab" run $args --frames 600 --json | python3 -c '
 import json, sys
 args = sys.argv[1]
 frames = [json.loads(line) for line in sys.stdin]
@@ -166,14 +184,15 @@ worst = max(frames, key=lambda f: f["max_edge_strain"])
 print("| {} | {} | {} | {} | {} | {:.3f} (frame {}) | {:.4f} | `tetlab run {} --frames 600` |".format(
     scene, first["tets"], steps, last["inverted_tets"], inverted[-1] if inverted else "none",
     worst["max_edge_strain"], worst["frame"], last["max_edge_strain"], args))
-' "$args"
+' "$args")
+  echo "$line $(fast_cell "$@" --frames 600) |"
 }
 
 echo
 echo "### 15. Every scene under the defaults (edges + volume, rigid, gravity 9.81, 100 substeps), 10 s; then fewer substeps"
 echo
-echo "| scene | tets | substeps | inverted at the end | last frame with an inverted tet | largest edge strain during the run | edge strain at the end | command |"
-echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
+echo "| scene | tets | substeps | inverted at the end | last frame with an inverted tet | largest edge strain during the run | edge strain at the end | command | fast engine: inverted at the end, min V/V₀, max edge strain |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 for s in tet cube beam ball $bunny $armadillo ../shared/meshes/ball_v41.msh ../shared/meshes/ball_v22.msh ../shared/meshes/beam_v41.msh; do
   defaults_row --scene $s
 done
