@@ -81,4 +81,6 @@ fn a_case_that_does_not_exist_is_refused_with_the_list() {
     assert!(stderr(&output).contains("patch, hanging-bar, cantilever"));
     let output = tetlab(&["validate", "--engine", "auto"]);
     assert_usage_error(&output, "--engine");
+    let output = tetlab(&["validate", "--threads", "100000"]);
+    assert_usage_error(&output, "--threads");
 }

@@ -26,9 +26,9 @@ pub struct Args {
     /// The engines to run on: both (the default), reference or fast.
     #[arg(long, default_value = "both", value_name = "ENGINE")]
     engine: String,
-    /// Threads for the fast engine (the same bits for any count); 0: every core.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
+    /// Threads for the fast engine (1..=256; the same bits for any count) [default: every core].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    threads: Option<u64>,
     /// Also write the checks to this file as JSON.
     #[arg(long, value_name = "FILE.json")]
     json: Option<PathBuf>,
@@ -88,10 +88,10 @@ pub fn main(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
         std::fs::write(path, "")
             .map_err(|e| UsageError(format!("--json {}: {e}", path.display())))?;
     }
-    let threads = match args.threads {
-        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        n => n,
-    };
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |n| n as usize,
+    );
     let session = match &args.record {
         Some(path) => Some(Session::open(
             Destination::File {
