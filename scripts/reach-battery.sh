@@ -42,14 +42,15 @@ total=${#jobs[@]}
 echo
 echo "### The reach rule: built-in families on every scene and perturbation ($total runs of 120 frames, settled and launched)"
 echo
-echo "| reach (longest rest edges) | runs where it skips a step | runs whose inverted count at the end differs from no rule (10⁹) |"
-echo "| --- | --- | --- |"
+echo "| reach (longest rest edges) | runs where it skips a step | runs whose inverted count at the end differs from no rule (10⁹) | runs whose outcome (0 inverted at the end, or not) differs |"
+echo "| --- | --- | --- | --- |"
 for reach in $reaches; do
   fired=$(awk -F'|' '{split($2, a, " "); if (a[1] > 0) n++} END {print n + 0}' "$work/$reach")
   changed=$(paste -d'#' "$work/$reach" "$work/1e9" | awk -F'#' '{split($1, a, "|"); split($2, b, "|"); split(a[2], x, " "); split(b[2], y, " "); if (x[2] != y[2]) n++} END {print n + 0}')
-  echo "| $reach | $fired of $total | $changed of $total |"
+  flipped=$(paste -d'#' "$work/$reach" "$work/1e9" | awk -F'#' '{split($1, a, "|"); split($2, b, "|"); split(a[2], x, " "); split(b[2], y, " "); if ((x[2] == 0) != (y[2] == 0)) n++} END {print n + 0}')
+  echo "| $reach | $fired of $total | $changed of $total | $flipped of $total |"
 done
 echo
 echo "Runs where the default reach (100) skips a step:"
 echo
-awk -F'|' '{split($2, a, " "); if (a[1] > 0) print "- `tetlab run " $1 "`: " a[1] " steps skipped, " a[2] " inverted at the end"}' "$work/100"
+paste -d'#' "$work/100" "$work/1e9" | awk -F'#' '{split($1, a, "|"); split($2, b, "|"); split(a[2], x, " "); split(b[2], y, " "); if (x[1] > 0) print "- `tetlab run " a[1] "`: " x[1] " steps skipped, " x[2] " inverted at the end (" y[2] " with no rule)"}'
