@@ -63,6 +63,14 @@ for c in edges,volume edges,height height,volume edges,height,volume; do
   claim 4 "table 3: the mirrored cube, ${c//,/ + }, 10 substeps" \
     --scene cube --perturb mirror --constraints $c --substeps 10 --no-settle-edits
 done
+claim 4 "table 4: the flattened cube, edges + height, 10 substeps" \
+  --scene cube --perturb flatten --constraints edges,height --substeps 10 --no-settle-edits
+claim 4 "table 5: the cube at rest under volume alone, 10 substeps" \
+  --scene cube --constraints volume --substeps 10
+for c in edges,volume edges,height height,volume edges,height,volume; do
+  claim 4 "table 7: the mirrored bunny, rigid ${c//,/ + }, 10 substeps" \
+    --scene $bunny --perturb mirror --gravity 10 --constraints $c --substeps 10 --no-settle-edits
+done
 for c in edges,volume edges,height,volume; do
   claim 4 "table 6: the flattened bunny, rigid ${c//,/ + }, 10 substeps" \
     --scene $bunny --perturb flatten --gravity 10 --constraints $c --substeps 10 --no-settle-edits
