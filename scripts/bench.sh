@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet
-tetlab=target/release/tetlab
+tetlab=${CARGO_TARGET_DIR:-target}/release/tetlab
 bunny=../shared/meshes/bunny.node
 
 echo "| scene | tets | constraints | engine, threads | projections per frame | ms per frame | frames per second | ns per projection (by family) | bytes per tet | error at the end (by family) | command |"
