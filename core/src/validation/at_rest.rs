@@ -69,11 +69,22 @@ impl AtRest {
     ///
     /// That floor is why the stop speed is at least [`AtRest::stop_speed_for`]'s.
     pub fn run(&self, trial: &mut Trial, simulation: &mut Simulation) -> Result<Rest, Stop> {
+        self.run_watching(trial, simulation, |_| {})
+    }
+
+    /// [`AtRest::run`], with `on_frame` shown the simulation after every frame.
+    pub fn run_watching(
+        &self,
+        trial: &mut Trial,
+        simulation: &mut Simulation,
+        mut on_frame: impl FnMut(&Simulation),
+    ) -> Result<Rest, Stop> {
         let mut before = simulation.positions().to_vec();
         let stop_speed = self.stop_speed_for(simulation);
         let mut speed = f64::INFINITY;
         for frame in 1..=self.max_frames {
             trial.step(simulation)?;
+            on_frame(simulation);
             speed = frame_speed(simulation, &before);
             before.copy_from_slice(simulation.positions());
             if frame >= 10 && speed < stop_speed {
@@ -165,4 +176,26 @@ pub fn frame_speed(simulation: &Simulation, before: &[glam::DVec3]) -> f64 {
 pub fn lattice_index(cells: [usize; 3], i: usize, j: usize, k: usize) -> usize {
     let [_, ny, nz] = cells;
     (i * (ny + 1) + j) * (nz + 1) + k
+}
+
+/// The particles of the plane `axis` = `index` of a [`crate::scene::lattice`] of `cells`
+/// (axis 0, 1, 2 for x, y, z), in lattice order.
+pub fn lattice_plane(cells: [usize; 3], axis: usize, index: usize) -> Vec<usize> {
+    let mut plane = Vec::new();
+    for i in 0..=cells[0] {
+        for j in 0..=cells[1] {
+            for k in 0..=cells[2] {
+                if [i, j, k][axis] == index {
+                    plane.push(lattice_index(cells, i, j, k));
+                }
+            }
+        }
+    }
+    plane
+}
+
+/// The mean of `values` (NaN when there are none).
+pub fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    sum / n as f64
 }

@@ -14,7 +14,7 @@
 //!   deflection therefore converges from below, and slowly: the coarse meshes are far from the
 //!   asymptotic rate of linear elements (h² for displacements).
 
-use super::at_rest::{AtRest, lattice_index};
+use super::at_rest::{AtRest, lattice_plane, mean};
 use super::{Case, Check, Stop, Trial, observed_order};
 use crate::material::Material;
 use crate::scene::{Builtin, Scene, lattice};
@@ -77,7 +77,7 @@ fn hanging_bar(trial: &mut Trial) -> Result<Vec<Check>, Stop> {
         let cells = [n, 4 * n, n];
         let size = 0.5 / n as f64;
         let mesh = lattice(cells, DVec3::new(-0.25, 1.0, -0.25), DVec3::splat(size));
-        let (top, bottom) = planes(cells, 1);
+        let (top, bottom) = (lattice_plane(cells, 1, 4 * n), lattice_plane(cells, 1, 0));
         let rest = mesh.positions.clone();
         let scene = Scene {
             name: format!("hanging bar {n}"),
@@ -136,7 +136,7 @@ fn cantilever(trial: &mut Trial) -> Result<Vec<Check>, Stop> {
     for &n in resolutions(trial) {
         let scene = Scene::builtin(Builtin::Beam, n as u32).expect("the beam is within limits");
         let cells = [4 * n, n, n];
-        let (_, tip) = planes_x(cells);
+        let tip = lattice_plane(cells, 0, 4 * n);
         let rest = scene.mesh.positions.clone();
         let settings = BENDING.settings(material, GRAVITY, side / n as f64);
         let mut simulation = trial.simulation(&format!("resolution-{n}"), &scene, settings);
@@ -191,35 +191,4 @@ fn cantilever(trial: &mut Trial) -> Result<Vec<Check>, Stop> {
         ));
     }
     Ok(checks)
-}
-
-/// The particles of the first and the last plane across axis `axis` of a lattice of `cells`.
-fn planes(cells: [usize; 3], axis: usize) -> (Vec<usize>, Vec<usize>) {
-    let mut last = Vec::new();
-    let mut first = Vec::new();
-    for i in 0..=cells[0] {
-        for j in 0..=cells[1] {
-            for k in 0..=cells[2] {
-                let c = [i, j, k][axis];
-                if c == cells[axis] {
-                    last.push(lattice_index(cells, i, j, k));
-                } else if c == 0 {
-                    first.push(lattice_index(cells, i, j, k));
-                }
-            }
-        }
-    }
-    (last, first)
-}
-
-/// The particles of the planes x = 0 and x = L of a lattice of `cells`.
-fn planes_x(cells: [usize; 3]) -> (Vec<usize>, Vec<usize>) {
-    let (last, first) = planes(cells, 0);
-    (first, last)
-}
-
-/// The mean of `values` (NaN when there are none).
-pub(super) fn mean(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    sum / n as f64
 }

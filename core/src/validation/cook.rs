@@ -20,8 +20,7 @@
 //! displacement falls further below the continuum's, which changes only a little with ν. These
 //! rows report the displacement relative to the ν = 1/4 run on the same mesh.
 
-use super::at_rest::{AtRest, lattice_index};
-use super::bars::mean;
+use super::at_rest::{AtRest, lattice_index, lattice_plane, mean};
 use super::{Case, Check, Stop, Trial, observed_order};
 use crate::material::Material;
 use crate::scene::{Scene, lattice};
@@ -126,12 +125,11 @@ fn membrane(trial: &mut Trial, n: usize, nu: f64, load: f64) -> Result<(f64, Vec
         *p = DVec3::new(48.0 * xi, 44.0 * xi + eta * (44.0 - 28.0 * xi), 0.0) * 1e-3
             + DVec3::Z * p.z * THICKNESS;
     }
-    let left: Vec<u32> = (0..=n)
-        .flat_map(|j| (0..=1).map(move |k| lattice_index(cells, 0, j, k) as u32))
+    let left: Vec<u32> = lattice_plane(cells, 0, 0)
+        .iter()
+        .map(|&i| i as u32)
         .collect();
-    let right: Vec<usize> = (0..=n)
-        .flat_map(|j| (0..=1).map(move |k| lattice_index(cells, n, j, k)))
-        .collect();
+    let right = lattice_plane(cells, 0, n);
     let tip: Vec<usize> = (0..=1).map(|k| lattice_index(cells, n, n, k)).collect();
     // The traction lumped onto the right edge: each boundary triangle carries the load in
     // proportion to its area, a third at each corner (exact for linear elements).

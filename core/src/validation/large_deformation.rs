@@ -12,7 +12,7 @@
 //! And a damped passive body can never move with more kinetic energy than it started with, in
 //! elastic or in potential energy: a kinetic energy above that is a blow-up.
 
-use super::at_rest::{AtRest, Rest, frame_speed, neohookean};
+use super::at_rest::{AtRest, neohookean};
 use super::{Case, Check, Stop, Trial};
 use crate::material::Material;
 use crate::scene::{Scene, lattice};
@@ -133,26 +133,9 @@ fn recover(
     simulation.set_positions(start);
     let budget = elastic_energy(&simulation) + potential_energy(&simulation, gravity);
     let mut most_kinetic: f64 = 0.0;
-    let mut before = simulation.positions().to_vec();
-    let stop_speed = RECOVERY.stop_speed_for(&simulation);
-    let mut rest_state = Rest {
-        frames: RECOVERY.max_frames,
-        speed: f64::INFINITY,
-        stop_speed,
-        at_rest: false,
-    };
-    for frame in 1..=RECOVERY.max_frames {
-        trial.step(&mut simulation)?;
-        most_kinetic = most_kinetic.max(kinetic_energy(&simulation));
-        let speed = frame_speed(&simulation, &before);
-        before.copy_from_slice(simulation.positions());
-        rest_state.speed = speed;
-        if frame >= 10 && speed < stop_speed {
-            rest_state.frames = frame;
-            rest_state.at_rest = true;
-            break;
-        }
-    }
+    let rest_state = RECOVERY.run_watching(trial, &mut simulation, |simulation| {
+        most_kinetic = most_kinetic.max(kinetic_energy(simulation));
+    })?;
     let metrics = crate::metrics::Metrics::measure(&simulation);
     Ok(vec![
         Check::at_most(

@@ -53,6 +53,27 @@ pub struct Check {
 }
 
 impl Check {
+    /// A row of `case` and `engine` still unnamed ([`run`] names them).
+    fn row(
+        quantity: impl Into<String>,
+        (reference, source): (f64, impl Into<String>),
+        (measured, error): (f64, f64),
+        criterion: String,
+        passed: Option<bool>,
+    ) -> Check {
+        Check {
+            case: "",
+            engine: "",
+            quantity: quantity.into(),
+            reference,
+            source: source.into(),
+            measured,
+            error,
+            criterion,
+            passed,
+        }
+    }
+
     /// Passes when the relative error |measured − reference| / |reference| is at most
     /// `tolerance`.
     pub fn relative(
@@ -63,17 +84,14 @@ impl Check {
         tolerance: f64,
     ) -> Check {
         let error = ((measured - reference) / reference).abs();
-        Check {
-            case: "",
-            engine: "",
-            quantity: quantity.into(),
-            reference,
-            source: source.into(),
-            measured,
-            error,
-            criterion: format!("relative error ≤ {}", percent(tolerance)),
-            passed: Some(error <= tolerance),
-        }
+        let criterion = format!("relative error ≤ {}", percent(tolerance));
+        Check::row(
+            quantity,
+            (reference, source),
+            (measured, error),
+            criterion,
+            Some(error <= tolerance),
+        )
     }
 
     /// Passes when |measured − reference| is at most `tolerance`.
@@ -85,17 +103,14 @@ impl Check {
         tolerance: f64,
     ) -> Check {
         let error = (measured - reference).abs();
-        Check {
-            case: "",
-            engine: "",
-            quantity: quantity.into(),
-            reference,
-            source: source.into(),
-            measured,
-            error,
-            criterion: format!("error ≤ {tolerance:.3e}"),
-            passed: Some(error <= tolerance),
-        }
+        let criterion = format!("error ≤ {tolerance:.3e}");
+        Check::row(
+            quantity,
+            (reference, source),
+            (measured, error),
+            criterion,
+            Some(error <= tolerance),
+        )
     }
 
     /// Passes when `measured` is at most `limit` (an upper bound theory gives: no energy
@@ -106,17 +121,15 @@ impl Check {
         source: impl Into<String>,
         measured: f64,
     ) -> Check {
-        Check {
-            case: "",
-            engine: "",
-            quantity: quantity.into(),
-            reference: limit,
-            source: source.into(),
-            measured,
-            error: (measured - limit).max(0.0),
-            criterion: format!("≤ {limit:.4e}"),
-            passed: Some(measured <= limit),
-        }
+        let error = (measured - limit).max(0.0);
+        let criterion = format!("≤ {limit:.4e}");
+        Check::row(
+            quantity,
+            (limit, source),
+            (measured, error),
+            criterion,
+            Some(measured <= limit),
+        )
     }
 
     /// A row that reports a number and checks nothing (how far linear tets lock, say).
@@ -131,32 +144,25 @@ impl Check {
         } else {
             f64::NAN
         };
-        Check {
-            case: "",
-            engine: "",
-            quantity: quantity.into(),
-            reference,
-            source: source.into(),
-            measured,
-            error,
-            criterion: "reported".into(),
-            passed: None,
-        }
+        Check::row(
+            quantity,
+            (reference, source),
+            (measured, error),
+            "reported".into(),
+            None,
+        )
     }
 
     /// A failed row: the run diverged or did not come to rest.
     pub fn failed(quantity: impl Into<String>, why: impl Into<String>) -> Check {
-        Check {
-            case: "",
-            engine: "",
-            quantity: quantity.into(),
-            reference: f64::NAN,
-            source: why.into(),
-            measured: f64::NAN,
-            error: f64::NAN,
-            criterion: "the run stays finite and comes to rest".into(),
-            passed: Some(false),
-        }
+        let criterion = "the run stays finite and comes to rest".into();
+        Check::row(
+            quantity,
+            (f64::NAN, why),
+            (f64::NAN, f64::NAN),
+            criterion,
+            Some(false),
+        )
     }
 }
 

@@ -9,8 +9,7 @@
 //!   P₂₂ = μ t + λ (J − γ) J / t = 0 with J = s t², so J = γ − μ / (λ s). At s = 1 this is 1,
 //!   and dJ/ds = μ/λ = 1 − 2ν, linear elasticity's volume change.
 
-use super::at_rest::{AtRest, lattice_index};
-use super::bars::mean;
+use super::at_rest::{AtRest, lattice_plane, mean};
 use super::{Case, Check, Stop, Trial};
 use crate::constraints::volume::signed_volume;
 use crate::material::Material;
@@ -46,12 +45,7 @@ fn run(trial: &mut Trial) -> Result<Vec<Check>, Stop> {
     let (width, length) = (0.2, 1.0);
     let size = width / n as f64;
     let mesh = lattice(cells, DVec3::new(0.0, 0.5, -0.1), DVec3::splat(size));
-    let plane = |i: usize| -> Vec<usize> {
-        (0..=n)
-            .flat_map(|j| (0..=n).map(move |k| (j, k)))
-            .map(|(j, k)| lattice_index(cells, i, j, k))
-            .collect()
-    };
+    let plane = |i: usize| lattice_plane(cells, 0, i);
     let (left, right) = (plane(0), plane(5 * n));
     let rest = mesh.positions.clone();
     let middle_tets: Vec<usize> = (0..mesh.tets.len())
