@@ -6,7 +6,7 @@ mod support;
 
 use serde_json::Value;
 use support::{assert_usage_error, asset, stderr, stdout, tetlab};
-use tetlab_core::solver::DEFAULT_SUBSTEPS;
+use tetlab_core::simulation::DEFAULT_SUBSTEPS;
 
 fn bench_json(args: &[&str]) -> Value {
     let mut all = vec!["bench", "--json"];

@@ -10,7 +10,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use gui_support::{click_at, open_lesson_file, pixels_like, workbench};
 use tetlab::gui::{Preferences, TetlabApp, viewport};
-use tetlab_core::visual;
+use tetlab_core::teaching::visual;
 
 #[test]
 fn the_initial_scene_shows_the_body_in_the_3d_view() {
@@ -249,7 +249,7 @@ fn the_neo_hookean_family_is_switched_on_with_its_material() {
     assert_eq!(harness.state().bench.metrics.inverted_tets, 0, "recovered");
     // Steel in ten substeps: the readouts say how many it needs.
     let mut steel = settings;
-    steel.set_material(tetlab_core::material::Material {
+    steel.set_material(tetlab_core::constraints::material::Material {
         young: 2e11,
         poisson: 0.3,
     });
@@ -266,7 +266,7 @@ fn the_controls_switch_solver_and_families() {
     harness.get_all_by_label("heights").next().unwrap().click();
     harness.run_steps(2);
     let settings = *harness.state().bench.simulation.settings();
-    assert_eq!(settings.method, tetlab_core::solver::Method::Pbd);
+    assert_eq!(settings.method, tetlab_core::simulation::Method::Pbd);
     assert!(settings.active[tetlab_core::constraints::Family::HEIGHT]);
     harness.snapshot("controls_pbd_heights");
 }
@@ -367,7 +367,7 @@ fn readme_screenshot() {
 /// press (highlighted in the view with its arrows), then closes the sweep; K finishes a substep.
 #[test]
 fn step_by_step_projects_one_constraint_per_key_press() {
-    use tetlab_core::stepper::{Advanced, StepByStep};
+    use tetlab_core::teaching::stepper::{Advanced, StepByStep};
     let mut harness = workbench("tet", 1);
     harness.key_press(egui::Key::I);
     harness.run_steps(1);
@@ -544,8 +544,12 @@ fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
         app.bench.simulation.settings(),
         app.comparison.as_ref().unwrap().bench.simulation.settings(),
     );
-    assert_eq!(left.method, tetlab_core::solver::Method::Pbd);
-    assert_eq!(right.method, tetlab_core::solver::Method::Pbd, "both sides");
+    assert_eq!(left.method, tetlab_core::simulation::Method::Pbd);
+    assert_eq!(
+        right.method,
+        tetlab_core::simulation::Method::Pbd,
+        "both sides"
+    );
     assert_eq!(left.active.describe(), "edges+height+volume");
     assert_eq!(families(&harness), "height+volume", "its own families");
     harness.get_by_label("XPBD").click();
@@ -668,5 +672,5 @@ fn each_panel_is_drawn_on_its_own_and_asks_through_requests() {
         Request::Settings(settings) => Some(settings.method),
         _ => None,
     });
-    assert_eq!(asked, Some(tetlab_core::solver::Method::Pbd));
+    assert_eq!(asked, Some(tetlab_core::simulation::Method::Pbd));
 }

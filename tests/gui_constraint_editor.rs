@@ -15,7 +15,7 @@ use gui_support::{pixels_like, workbench};
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::Family;
-use tetlab_core::visual::{self, Quantity};
+use tetlab_core::teaching::visual::{self, Quantity};
 
 /// The example families these tests use, registered once, in this order, before any test draws:
 /// the solver panel lists every family of the table, so that the snapshots do not depend on which

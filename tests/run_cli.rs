@@ -5,7 +5,7 @@ mod support;
 
 use serde_json::Value;
 use support::{assert_usage_error, asset, stderr, stdout, tetlab};
-use tetlab_core::shared_meshes;
+use tetlab_core::input::shared_meshes;
 
 fn json_lines(args: &[&str]) -> Vec<Value> {
     let output = tetlab(args);

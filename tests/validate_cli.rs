@@ -26,7 +26,10 @@ fn the_quick_subset_passes_on_both_engines_and_writes_json() {
     assert_eq!(document["suite"], "quick");
     assert_eq!(document["passed"], true);
     let checks = document["checks"].as_array().unwrap();
-    for case in tetlab_core::validation::CASES.iter().filter(|c| c.quick) {
+    for case in tetlab_core::measures::validation::CASES
+        .iter()
+        .filter(|c| c.quick)
+    {
         for engine in ["reference", "fast"] {
             let of = |c: &&Value| c["case"] == case.name && c["engine"] == engine;
             let passed = checks

@@ -3,6 +3,8 @@
 //! run time). The console says `tetlab ready` once the first frame is drawn.
 
 use crate::gui::TetlabApp;
+use crate::gui::platform::Platform;
+use crate::gui::report::Report;
 use wasm_bindgen::JsCast;
 
 /// The id of the canvas the workbench draws on.
@@ -27,7 +29,9 @@ pub fn start() {
             .start(
                 canvas,
                 eframe::WebOptions::default(),
-                Box::new(|cc| Ok(Box::new(TetlabApp::new(cc)?) as Box<dyn eframe::App>)),
+                Box::new(|cc| {
+                    Ok(Box::new(TetlabApp::new(cc, Box::new(Page))?) as Box<dyn eframe::App>)
+                }),
             )
             .await;
         if let Err(error) = started {
@@ -42,11 +46,11 @@ pub const MESHES: &str = "meshes/";
 
 /// Fetches the mesh files of the built-in lessons whose mesh is not built in (lesson 6's bunny,
 /// a `.node` and its `.ele`) from [`MESHES`] and hands them to the library
-/// ([`tetlab_core::text_file::provide`]), so that those lessons open as on the desktop. A file
+/// ([`tetlab_core::input::text_file::provide`]), so that those lessons open as on the desktop. A file
 /// the site does not have leaves its lesson greyed out in the picker, its note saying why.
 async fn fetch_lesson_meshes() {
     let mut files: Vec<String> = Vec::new();
-    for lesson in tetlab_core::lesson::BUILTIN {
+    for lesson in tetlab_core::teaching::lesson::BUILTIN {
         let Some(mesh) = lesson
             .header()
             .ok()
@@ -72,7 +76,7 @@ async fn fetch_lesson_meshes() {
         match fetch_text(&url).await {
             Ok(text) => {
                 log(&format!("tetlab: fetched {url} ({} bytes)", text.len()));
-                tetlab_core::text_file::provide(&name, text);
+                tetlab_core::input::text_file::provide(&name, text);
             }
             Err(why) => log(&format!("tetlab: {url} is not on this site ({why})")),
         }
@@ -119,10 +123,31 @@ thread_local! {
     static STATE: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) };
 }
 
-/// Keeps `report` for [`tetlab_state`].
-pub fn publish(report: &crate::gui::report::Report) {
-    let json = serde_json::to_string(report).unwrap_or_default();
-    STATE.with(|state| *state.borrow_mut() = json);
+/// The page, as the workbench sees it ([`Platform`]).
+struct Page;
+
+impl Platform for Page {
+    fn log(&self, line: &str) {
+        log(line);
+    }
+
+    fn fragment(&self) -> String {
+        fragment()
+    }
+
+    fn page_address(&self) -> String {
+        page_address()
+    }
+
+    fn publishes(&self) -> bool {
+        true
+    }
+
+    /// Keeps `report` for [`tetlab_state`].
+    fn publish(&self, report: &Report) {
+        let json = serde_json::to_string(report).unwrap_or_default();
+        STATE.with(|state| *state.borrow_mut() = json);
+    }
 }
 
 /// The workbench's state after its last frame, as JSON ([`crate::gui::report::Report`]); empty

@@ -10,11 +10,11 @@ use std::hint::black_box;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::constraints::{distance, height, volume};
-use tetlab_core::fast::{FastSimulation, Order};
-use tetlab_core::lanes::{F32x8, LANES, Vec3x8};
-use tetlab_core::projection::project_kernel;
+use tetlab_core::numbers::lanes::{F32x8, LANES, Vec3x8};
 use tetlab_core::scene::{Builtin, Scene};
-use tetlab_core::solver::{Settings, Simulation};
+use tetlab_core::simulation::fast::{FastSimulation, Order};
+use tetlab_core::simulation::projection::project_kernel;
+use tetlab_core::simulation::{Settings, Simulation};
 
 fn kernels(c: &mut Criterion) {
     let tet = [
@@ -137,7 +137,7 @@ fn constraint_file(c: &mut Criterion) {
 /// Jacobi. The same work as `tetlab bench`, here so that builds for other CPUs are quick to
 /// compare (`RUSTFLAGS="-C target-cpu=x86-64" cargo bench -p tetlab-core -- frame`).
 fn frame(c: &mut Criterion) {
-    let bunny = tetlab_core::shared_meshes::folder().join("bunny.node");
+    let bunny = tetlab_core::input::shared_meshes::folder().join("bunny.node");
     let (name, scene) = match Scene::load(&bunny) {
         Ok(scene) => ("bunny", scene),
         Err(_) => (
@@ -156,7 +156,7 @@ fn frame(c: &mut Criterion) {
         (Order::GaussSeidel, "Gauss-Seidel"),
         (Order::Jacobi { relaxation: 1.0 }, "Jacobi"),
     ] {
-        let mut fast = FastSimulation::new(&simulation, 1);
+        let mut fast = FastSimulation::new(simulation.fast_start(), 1);
         fast.set_order(order);
         group.bench_function(format!("{name}, fast, {label}"), |b| b.iter(|| fast.step()));
     }
@@ -164,7 +164,7 @@ fn frame(c: &mut Criterion) {
     // frame runs them (every batch of eight of each family, padding included, every substep),
     // on particles already in registers. The frame's time over this one is what moving the
     // particles (gathering, transposing, writing back) and the rest of the frame cost on top.
-    let fast = FastSimulation::new(&simulation, 1);
+    let fast = FastSimulation::new(simulation.fast_start(), 1);
     let batches = |family| -> usize {
         let batches = fast.batches(family);
         batches.colours().iter().map(|c| c.batches.len()).sum()

@@ -1,7 +1,7 @@
 //! Abuse runs: both engines driven through 10⁴ frames each of random edits (drags held and
 //! thrown, particles placed anywhere in an arena three times the body's size around the body,
 //! tets inverted, mirror, flatten, scramble, pins, resets) and random settings anywhere within
-//! their ranges of `tetlab_core::limits` (substeps × iterations kept to at most 400 so that a
+//! their ranges of `tetlab_core::input::limits` (substeps × iterations kept to at most 400 so that a
 //! run takes seconds).
 //!
 //! The run is a sequence of stretches. Each starts afresh (the rest shape, nothing pinned or
@@ -25,13 +25,13 @@
 
 use glam::DVec3;
 use tetlab_core::constraints::Family;
-use tetlab_core::fast::FastSimulation;
-use tetlab_core::limits::{self, Bounds};
-use tetlab_core::material::{self, Material};
-use tetlab_core::metrics::Metrics;
-use tetlab_core::random::SplitMix64;
+use tetlab_core::constraints::material::{self, Material};
+use tetlab_core::input::limits::{self, Bounds};
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::numbers::random::SplitMix64;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
-use tetlab_core::solver::{DENSITY, Method, Settings, Simulation};
+use tetlab_core::simulation::fast::FastSimulation;
+use tetlab_core::simulation::{DENSITY, Method, Settings, Simulation};
 
 /// Frames per engine.
 const FRAMES: usize = 10_000;
@@ -442,7 +442,7 @@ fn the_fast_engine_survives_random_edits_and_settings() {
             watch.held_apart += 1;
         }
         let threads = 1 + (rng.next_u64() % 2) as usize;
-        let mut fast = FastSimulation::new(&simulation, threads);
+        let mut fast = FastSimulation::new(simulation.fast_start(), threads);
         let mut motion = Motion::of(&fast.positions(), &fast.velocities(), &w);
         for _ in 0..QUIET {
             watch.put_in(&settings, &arena, 0.0, &motion);

@@ -188,7 +188,7 @@ fn every_mistake_names_file_line_and_column() {
 
 /// Random well-conditioned configurations of `n` points.
 fn configurations(n: usize, count: usize, seed: u64) -> Vec<Vec<glam::DVec3>> {
-    let mut rng = tetlab_core::random::SplitMix64::new(seed);
+    let mut rng = tetlab_core::numbers::random::SplitMix64::new(seed);
     let mut out = Vec::new();
     while out.len() < count {
         let points: Vec<glam::DVec3> = (0..n).map(|_| rng.in_cube(1.0)).collect();
@@ -203,8 +203,8 @@ fn configurations(n: usize, count: usize, seed: u64) -> Vec<Vec<glam::DVec3>> {
 #[test]
 fn the_same_program_evaluates_in_f64_f32_and_lanes() {
     use glam::{DVec3, Vec3A};
-    use tetlab_core::lanes::{F32x8, Vec3x8};
-    use tetlab_core::vector::{Real, Vector3};
+    use tetlab_core::numbers::lanes::{F32x8, Vec3x8};
+    use tetlab_core::numbers::vector::{Real, Vector3};
     let file = load("height.toml");
     let configs = configurations(4, 8, 11);
     let mut lanes = [[[0.0f32; 8]; 3]; 4];

@@ -5,10 +5,10 @@
 //! far from converged the rigid constraints are; docs/experiments.md table 15 lists the same runs.
 
 use std::io::Write;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::input::shared_meshes;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Scene};
-use tetlab_core::shared_meshes;
-use tetlab_core::solver::{Settings, Simulation};
+use tetlab_core::simulation::{Settings, Simulation};
 
 /// 10 s at the default Δt of 1/60 s.
 const FRAMES: u64 = 600;

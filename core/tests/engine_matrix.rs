@@ -20,12 +20,12 @@
 
 use glam::DVec3;
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::ensemble::Ensemble;
-use tetlab_core::metrics::Metrics;
-use tetlab_core::outcome::Outcome;
+use tetlab_core::input::shared_meshes;
+use tetlab_core::measures::ensemble::Ensemble;
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::measures::outcome::Outcome;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::shared_meshes;
-use tetlab_core::solver::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{Engine, Settings, Simulation};
 
 /// One claim: a scene, how it is run, and what the docs say it comes to.
 struct Claim {
@@ -429,7 +429,7 @@ fn compare_orderings(claim: &Claim, scene: &Scene) -> Option<String> {
 /// of length h from rest, x + v h with v += g h moves every particle by g h² n (n + 1) / 2.
 /// The reference engine (f64) meets it to 10⁻¹⁰ relative, the fast one (f32) to 10⁻³: at 100
 /// substeps a substep's motion is a few f32 ulps of the position, and the fast engine keeps what
-/// the rounding leaves out ([`tetlab_core::fast`]'s residuals). Without them its ball fell 5.5 %
+/// the rounding leaves out ([`tetlab_core::simulation::fast`]'s residuals). Without them its ball fell 5.5 %
 /// too far in 8 frames.
 #[test]
 fn a_body_in_free_fall_falls_as_far_on_both_engines() {

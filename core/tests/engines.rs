@@ -4,10 +4,10 @@
 
 use glam::DVec3;
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{Engine, Settings, Simulation};
-use tetlab_core::stepper::StepByStep;
+use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::teaching::stepper::StepByStep;
 
 fn simulation(builtin: Builtin, resolution: u32, families: &str, engine: Engine) -> Simulation {
     let scene = Scene::builtin(builtin, resolution).unwrap();

@@ -7,7 +7,7 @@
 use std::path::Path;
 use tetlab_core::constraint_file::grade::{self, Grade, Verdict};
 use tetlab_core::constraint_file::{ConstraintFile, EXAMPLES};
-use tetlab_core::lesson::{BUILTIN, Lesson, LessonRun};
+use tetlab_core::teaching::lesson::{BUILTIN, Lesson, LessonRun};
 
 /// An exercise: its lesson, the file the student starts from, and two answers made from it.
 struct Exercise {

@@ -13,14 +13,14 @@ use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 use tetlab_core::constraint_file::ConstraintFile;
+use tetlab_core::constraints::material::Material;
 use tetlab_core::constraints::{Constraint, Family, PerFamily, Visit};
-use tetlab_core::material::Material;
-use tetlab_core::mesh::TetMesh;
-use tetlab_core::metrics::Metrics;
-use tetlab_core::outcome::Outcome;
+use tetlab_core::input::shared_meshes;
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::measures::outcome::Outcome;
+use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::shared_meshes;
-use tetlab_core::solver::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{Engine, Settings, Simulation};
 
 fn asset(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

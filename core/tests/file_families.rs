@@ -10,10 +10,10 @@ use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::{Binding, Family, PerFamily};
-use tetlab_core::fast::FastSimulation;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{Method, Settings, Simulation};
+use tetlab_core::simulation::fast::FastSimulation;
+use tetlab_core::simulation::{Method, Settings, Simulation};
 
 fn asset(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -205,7 +205,7 @@ fn the_fast_solver_projects_a_file_family_in_lanes() {
     let f = families();
     let mut reference = cube(with(&[Family::EDGES, f.height]), 10);
     reference.perturb(Perturbation::Mirror);
-    let mut fast = FastSimulation::new(&reference, 1);
+    let mut fast = FastSimulation::new(reference.fast_start(), 1);
     assert_eq!(fast.batches(f.height).len(), 4 * reference.tets().len());
     for _ in 0..120 {
         fast.step();

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 use tetlab_core::constraints::Family;
-use tetlab_core::verify::{analytic_and_numeric, random_check, relative_error};
+use tetlab_core::teaching::verify::{analytic_and_numeric, random_check, relative_error};
 
 const SAMPLES: usize = 10_000;
 const BOUND: f64 = 1e-6;

@@ -3,10 +3,10 @@
 //! edge + volume setup leaves some.
 
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::metrics::Metrics;
+use tetlab_core::input::shared_meshes;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
-use tetlab_core::shared_meshes;
-use tetlab_core::solver::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{Engine, Settings, Simulation};
 
 /// The bunny's metrics after `perturbation` and 300 frames; `None` when `../shared/meshes` is
 /// absent (the test then skips).

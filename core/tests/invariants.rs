@@ -2,8 +2,8 @@
 
 use glam::{DVec3, Vec3, Vec3A};
 use tetlab_core::constraints::{Family, distance, height, volume};
-use tetlab_core::random::SplitMix64;
-use tetlab_core::verify::well_conditioned;
+use tetlab_core::numbers::random::SplitMix64;
+use tetlab_core::teaching::verify::well_conditioned;
 
 const TRIALS: usize = 2_000;
 

@@ -3,9 +3,9 @@
 
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::lesson::{BUILTIN, Expectation, Lesson, LessonRun};
-use tetlab_core::shared_meshes;
-use tetlab_core::solver::Engine;
+use tetlab_core::input::shared_meshes;
+use tetlab_core::simulation::Engine;
+use tetlab_core::teaching::lesson::{BUILTIN, Expectation, Lesson, LessonRun};
 
 #[test]
 fn there_are_at_least_six_lessons_in_order() {

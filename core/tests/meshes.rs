@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 use tetlab_core::constraints::volume::signed_volume;
-use tetlab_core::mesh::{MeshError, TetMesh};
-use tetlab_core::shared_meshes;
+use tetlab_core::input::shared_meshes;
+use tetlab_core::scene::mesh::{MeshError, TetMesh};
 
 /// A reference mesh of `../shared/meshes`, loaded and checked; `None` when the folder is absent
 /// (the test then skips, see [`shared_meshes::for_test`]).

@@ -1,13 +1,13 @@
 //! The neo-Hookean family: what its constraints and material mean, on both engines.
 
 use glam::DVec3;
+use tetlab_core::constraints::material::Material;
 use tetlab_core::constraints::neohookean::{deviatoric, hydrostatic};
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::fast::FastSimulation;
-use tetlab_core::material::Material;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{Settings, Simulation};
+use tetlab_core::simulation::fast::FastSimulation;
+use tetlab_core::simulation::{Settings, Simulation};
 
 fn cube_with(material: Material, substeps: u32, gravity: f64) -> Simulation {
     let scene = Scene::builtin(Builtin::Cube, 4).unwrap();
@@ -57,7 +57,7 @@ fn the_sag_under_gravity_scales_with_one_over_e() {
         settings.damping = 20.0;
         settings.iterations = 4;
         reference.set_settings(settings);
-        let mut fast = FastSimulation::new(&reference, 1);
+        let mut fast = FastSimulation::new(reference.fast_start(), 1);
         for _ in 0..300 {
             reference.step();
             fast.step();
@@ -93,7 +93,7 @@ fn max_edge_strain(simulation: &Simulation, positions: &[DVec3]) -> f64 {
 fn a_mirrored_cube_recovers_on_both_engines() {
     let mut reference = cube_with(rubber(1e6), 10, 9.81);
     reference.perturb(Perturbation::Mirror);
-    let mut fast = FastSimulation::new(&reference, 1);
+    let mut fast = FastSimulation::new(reference.fast_start(), 1);
     for _ in 0..120 {
         reference.step();
         fast.step();
@@ -207,18 +207,18 @@ fn the_inspector_shows_f_and_its_determinant() {
     let mut simulation = cube_with(rubber(1e6), 10, 0.0);
     simulation.perturb(Perturbation::Mirror);
     let projection = simulation.projection(Family::NEOHOOKEAN_HYDROSTATIC, 0);
-    let lines = tetlab_core::inspector::state_lines(&simulation, &projection);
+    let lines = tetlab_core::teaching::inspector::state_lines(&simulation, &projection);
     assert!(lines[0].starts_with("F = ["), "{lines:?}");
     assert!(lines[1].starts_with("J = det F = -1.0000"), "{lines:?}");
     let edges = simulation.projection(Family::EDGES, 0);
-    assert!(tetlab_core::inspector::state_lines(&simulation, &edges).is_empty());
+    assert!(tetlab_core::teaching::inspector::state_lines(&simulation, &edges).is_empty());
 }
 
 /// XPBD's stiffness does not depend on the iterations once they converge; PBD's grows with
 /// them (docs/experiments.md, tables 13 and 14): a clamped beam's tip deflection.
 #[test]
 fn xpbd_stiffness_is_the_same_for_any_iteration_count_and_pbd_is_not() {
-    use tetlab_core::solver::Method;
+    use tetlab_core::simulation::Method;
     let tip = |method: Method, iterations: u32| {
         let scene = Scene::builtin(Builtin::Beam, 1).unwrap();
         let mut settings = Settings {

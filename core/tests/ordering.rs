@@ -4,7 +4,7 @@
 
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{Engine, Settings, Simulation};
 
 /// FNV-1a over the bits of every coordinate.
 fn hash(simulation: &Simulation) -> u64 {
@@ -55,10 +55,10 @@ fn weightless(engine: Engine, families: &str) -> Simulation {
 /// and a body that travels far from the origin is followed by its f32 coordinates
 /// (`FastSimulation::recentre`); neither changes these. The fast engine's two hashes were taken
 /// again when it came to keep what f32 rounding leaves out of each position (its residuals, in
-/// `core/src/integrate.rs`), which changes its arithmetic and not its order: with the residuals
+/// `core/src/simulation/integrate.rs`), which changes its arithmetic and not its order: with the residuals
 /// left out, edges + volume gives b91899e's 0x71460353a638923d again. They were taken a third
 /// time when the corrections of the projections came to be added with their residuals too
-/// (`Particles::compensated` in `core/src/fast/particles.rs`), again arithmetic, not order.
+/// (`Particles::compensated` in `core/src/simulation/fast/particles.rs`), again arithmetic, not order.
 #[test]
 fn without_an_order_seed_the_order_is_the_tables_bit_for_bit() {
     let cases = [

@@ -6,9 +6,9 @@ use glam::DVec3;
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::projection::SkipCounts;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{Engine, Settings, Simulation};
+use tetlab_core::simulation::projection::SkipCounts;
+use tetlab_core::simulation::{Engine, Settings, Simulation};
 
 /// A tet squeezed to 10⁻⁴ of its size under its volume constraint alone: ∇V (its face areas)
 /// all but vanishes while V − V₀ does not, so a projection would move its corners by about

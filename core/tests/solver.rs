@@ -9,10 +9,10 @@ use glam::DVec3;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::mesh::TetMesh;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::solver::{DEFAULT_SUBSTEPS, DENSITY, Engine, Method, Settings, Simulation};
+use tetlab_core::simulation::{DEFAULT_SUBSTEPS, DENSITY, Engine, Method, Settings, Simulation};
 
 /// Counts the allocations of each thread, to check that a step makes none. Per thread, because
 /// the other tests of this binary run (and allocate) at the same time.
@@ -595,7 +595,7 @@ fn a_constraint_its_free_particles_can_barely_change_is_skipped() {
     let mut positions = simulation.positions().to_vec();
     positions[0] = DVec3::new(0.0, 1e-3, 1.0);
     simulation.set_positions(&positions);
-    let fast = tetlab_core::fast::FastSimulation::new(&simulation, 1);
+    let fast = tetlab_core::simulation::fast::FastSimulation::new(simulation.fast_start(), 1);
     simulation.step();
     let moved = simulation.positions()[0].distance(positions[0]);
     assert!(moved < 2.0, "the free corner was flung {moved} m");

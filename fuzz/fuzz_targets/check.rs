@@ -2,13 +2,13 @@
 //! (or none), and a mesh is one the solver can take.
 
 use std::path::Path;
-use tetlab_core::limits::MAX_COORDINATE;
-use tetlab_core::mesh::gmsh;
-use tetlab_core::mesh::{MeshError, TetMesh};
-use tetlab_core::metrics::Metrics;
+use tetlab_core::input::limits::MAX_COORDINATE;
+use tetlab_core::input::text_file::decode;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::{Settings, Simulation};
-use tetlab_core::text_file::decode;
+use tetlab_core::scene::mesh::gmsh;
+use tetlab_core::scene::mesh::{MeshError, TetMesh};
+use tetlab_core::simulation::{Settings, Simulation};
 
 /// An error's line is one of the file's (or one past its end, where it ended too soon).
 pub fn error(e: &MeshError, text: &str) {

@@ -9,7 +9,7 @@ use glam::DVec3;
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::text_file::decode;
+use tetlab_core::input::text_file::decode;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = decode(data) else {

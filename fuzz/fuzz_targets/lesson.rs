@@ -7,10 +7,10 @@
 
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
-use tetlab_core::lesson::{Lesson, LessonRun};
-use tetlab_core::limits::{MAX_TETS, RESOLUTION};
+use tetlab_core::input::limits::{MAX_TETS, RESOLUTION};
+use tetlab_core::input::text_file::decode;
 use tetlab_core::scene::{Builtin, Scene, SceneError};
-use tetlab_core::text_file::decode;
+use tetlab_core::teaching::lesson::{Lesson, LessonRun};
 
 /// Built-in scenes of up to 500 tets are built; larger ones that are valid are refused here (not
 /// built, to keep each run fast); out-of-range ones go to `Scene::builtin`, which refuses them

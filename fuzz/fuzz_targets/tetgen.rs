@@ -7,9 +7,9 @@
 
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
-use tetlab_core::mesh::{TetMesh, tetgen};
+use tetlab_core::input::text_file::decode;
 use tetlab_core::scene::Scene;
-use tetlab_core::text_file::decode;
+use tetlab_core::scene::mesh::{TetMesh, tetgen};
 
 mod check;
 

@@ -6,7 +6,7 @@
 use eframe::egui;
 use egui_kittest::Harness;
 use tetlab::gui::{Preferences, TetlabApp};
-use tetlab_core::visual;
+use tetlab_core::teaching::visual;
 
 /// The workbench on built-in `scene` at `resolution`, with the default preferences, rendered on
 /// wgpu (1280 × 800), after three frames.
@@ -18,7 +18,8 @@ pub fn workbench(scene: &str, resolution: u32) -> Harness<'static, TetlabApp> {
         .with_size(egui::vec2(1280.0, 800.0))
         .wgpu()
         .build_eframe(move |cc| {
-            let mut app = TetlabApp::new(cc).expect("the wgpu renderer is there");
+            let mut app = TetlabApp::new(cc, Box::new(tetlab::gui::platform::Desktop))
+                .expect("the wgpu renderer is there");
             let builtin = tetlab_core::scene::Builtin::from_name(&preferences.scene.builtin)
                 .expect("a built-in scene");
             app.load_builtin(builtin, resolution).unwrap();

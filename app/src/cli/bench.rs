@@ -8,12 +8,12 @@ use serde::Serialize;
 use std::io::Write;
 use std::time::{Duration, Instant};
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::fast::Order;
-use tetlab_core::lanes::{LANES, REGISTERS};
-use tetlab_core::limits;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::input::limits;
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::numbers::lanes::{LANES, REGISTERS};
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::{Engine, Simulation};
+use tetlab_core::simulation::fast::Order;
+use tetlab_core::simulation::{Engine, Simulation};
 
 /// Options of `tetlab bench`.
 #[derive(Debug, clap::Args)]

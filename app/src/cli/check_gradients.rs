@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraint_file::check::{AGREEMENT, Reflection, Report, check};
 use tetlab_core::constraints::Family;
-use tetlab_core::verify::{CONDITIONING, random_check};
+use tetlab_core::teaching::verify::{CONDITIONING, random_check};
 
 /// Options of `tetlab check-gradients`.
 #[derive(Debug, clap::Args)]

@@ -10,8 +10,8 @@ use std::ops::ControlFlow;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::Family;
-use tetlab_core::lesson::{Action, BUILTIN, Lesson, LessonRun};
-use tetlab_core::solver::Engine;
+use tetlab_core::simulation::Engine;
+use tetlab_core::teaching::lesson::{Action, BUILTIN, Lesson, LessonRun};
 
 /// Options of `tetlab lesson`.
 #[derive(Debug, clap::Args)]
@@ -40,8 +40,8 @@ pub struct Args {
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256), conflicts_with = "list")]
     threads: Option<u64>,
     /// The neo-Hookean material instead of the lesson's: E=PA,nu=N, as for `tetlab run`.
-    #[arg(long, value_name = "E=PA,nu=N", value_parser = tetlab_core::material::Material::parse, conflicts_with = "list")]
-    material: Option<tetlab_core::material::Material>,
+    #[arg(long, value_name = "E=PA,nu=N", value_parser = tetlab_core::constraints::material::Material::parse, conflicts_with = "list")]
+    material: Option<tetlab_core::constraints::material::Material>,
     /// Project each family's constraints in an order drawn from this seed, as for `tetlab run`
     /// [default: the mesh's order].
     #[arg(long, value_name = "S", conflicts_with = "list")]

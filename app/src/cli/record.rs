@@ -9,9 +9,9 @@ use rerun::RecordingStream;
 use std::io::Write;
 use std::path::PathBuf;
 use tetlab_core::constraints::Family;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::Simulation;
+use tetlab_core::simulation::Simulation;
 
 /// The viewer address `--connect` uses when given no value.
 pub const DEFAULT_VIEWER: &str = "rerun+http://127.0.0.1:9876/proxy";

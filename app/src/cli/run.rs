@@ -8,11 +8,11 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write;
 use tetlab_core::constraints::Family;
-use tetlab_core::ensemble::{Ensemble, Member, Tally};
-use tetlab_core::limits;
-use tetlab_core::metrics::Metrics;
-use tetlab_core::outcome::Outcome;
-use tetlab_core::solver::{Engine, Simulation};
+use tetlab_core::input::limits;
+use tetlab_core::measures::ensemble::{Ensemble, Member, Tally};
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::measures::outcome::Outcome;
+use tetlab_core::simulation::{Engine, Simulation};
 
 /// Options of `tetlab run`.
 #[derive(Debug, clap::Args)]
@@ -51,7 +51,7 @@ pub struct FrameRecord {
     residuals: BTreeMap<String, f64>,
     /// `skipped_degenerate_<family>` and `skipped_too_long_<family>` for each active family:
     /// its projections skipped so far because ∇C was undefined, or because the step was beyond
-    /// the reach (`tetlab_core::projection::DEFAULT_REACH`).
+    /// the reach (`tetlab_core::simulation::projection::DEFAULT_REACH`).
     #[serde(flatten)]
     skipped: BTreeMap<String, u64>,
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -6,11 +6,11 @@ use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::Family;
 use tetlab_core::constraints::PerFamily;
-use tetlab_core::limits::{self, Number};
-use tetlab_core::material::Material;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::constraints::material::Material;
+use tetlab_core::input::limits::{self, Number};
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
-use tetlab_core::solver::{Engine, Method, Settings, Simulation};
+use tetlab_core::simulation::{Engine, Method, Settings, Simulation};
 
 /// Scene and solver options.
 #[derive(Debug, Clone, clap::Args)]
@@ -43,7 +43,7 @@ pub struct SimulationArgs {
 }
 
 /// The solver's options, the same for every subcommand that simulates (`run`, `record`,
-/// `bench`); each range is [`tetlab_core::limits`]'s, and the ground follows gravity
+/// `bench`); each range is [`tetlab_core::input::limits`]'s, and the ground follows gravity
 /// ([`Settings::set_gravity`]). Family names are read once the constraint files are loaded, so
 /// that `--constraints` and `--compliance` can name a file's family in any order.
 #[derive(Debug, Clone, clap::Args)]
@@ -160,7 +160,7 @@ impl SolverArgs {
             ("--stiffness", &self.stiffness),
         ] {
             for NamedValue { name, value } in values {
-                let family = limits::settable_family(name)
+                let family = tetlab_core::simulation::settable_family(name)
                     .map_err(|e| UsageError(format!("{option} {name}={value}: {e}")))?;
                 if option == "--compliance" {
                     settings.compliance.set(family, *value);

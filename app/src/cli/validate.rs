@@ -1,4 +1,4 @@
-//! `tetlab validate`: the physics against theory ([`tetlab_core::validation`]). Each case runs on
+//! `tetlab validate`: the physics against theory ([`tetlab_core::measures::validation`]). Each case runs on
 //! the reference engine and on the fast one; the checks go to stdout as a Markdown table, to a
 //! JSON file with `--json`, and every run to a Rerun recording with `--record`. Exit status 0
 //! when every check passes, 1 when one fails.
@@ -8,10 +8,10 @@ use crate::record::{ArrowsMode, Destination, Recorder, Session};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::measures::validation::{self, Case, Check, Trial, Unwatched, Watch};
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::{Engine, Simulation};
-use tetlab_core::validation::{self, Case, Check, Trial, Unwatched, Watch};
+use tetlab_core::simulation::{Engine, Simulation};
 
 /// Options of `tetlab validate`.
 #[derive(Debug, clap::Args)]

@@ -12,7 +12,7 @@ use serde::Serialize;
 use std::io::Write;
 use std::time::{Duration, Instant};
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::Settings;
+use tetlab_core::simulation::Settings;
 
 /// The time of each part of a frame, summed over the frames timed.
 #[derive(Clone, Copy, Debug, Default, Serialize)]

@@ -3,8 +3,8 @@
 //! `applies_to`, and a lesson otherwise; anything else a mesh.
 
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::lesson::Lesson;
 use tetlab_core::scene::Scene;
+use tetlab_core::teaching::lesson::Lesson;
 
 /// What a file held.
 pub enum Opened {
@@ -79,7 +79,7 @@ impl Inbox {
 /// Opens a file given by name and contents: a lesson (.toml) or a Gmsh mesh (.msh). A TetGen mesh
 /// is two files, which a browser hands over one by one.
 fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
-    let text = tetlab_core::text_file::decode(bytes).map_err(|e| {
+    let text = tetlab_core::input::text_file::decode(bytes).map_err(|e| {
         let line = e.line.map(|l| format!(":{l}")).unwrap_or_default();
         format!("{}{line}: {}", name.display(), e.message)
     })?;
@@ -94,7 +94,7 @@ fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
             .map_err(|e| e.to_string()),
         "msh" => {
             let (mesh, report) =
-                tetlab_core::mesh::gmsh::parse(name, text).map_err(|e| e.to_string())?;
+                tetlab_core::scene::mesh::gmsh::parse(name, text).map_err(|e| e.to_string())?;
             let stem = name
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -129,14 +129,14 @@ mod tests {
     /// What a browser hands over (a name and the bytes) opens as on the desktop.
     #[test]
     fn dropped_bytes_open_meshes_and_lessons_and_explain_what_they_cannot() {
-        if let Some(path) = tetlab_core::shared_meshes::for_test("ball_v41.msh") {
+        if let Some(path) = tetlab_core::input::shared_meshes::for_test("ball_v41.msh") {
             let ball = std::fs::read(path).unwrap();
             assert_eq!(
                 opened_name(open_bytes(Path::new("ball_v41.msh"), &ball)),
                 "scene ball_v41"
             );
         }
-        let lesson = tetlab_core::lesson::BUILTIN[0];
+        let lesson = tetlab_core::teaching::lesson::BUILTIN[0];
         assert!(
             opened_name(open_bytes(Path::new(lesson.file), lesson.text.as_bytes()))
                 .starts_with("lesson 1.")

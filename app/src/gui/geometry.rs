@@ -1,16 +1,16 @@
 //! What the 3D view draws, as triangles and lines, with the colours and arrows of
-//! `tetlab_core::visual` (the same the recorder logs). The view keeps them between frames
+//! `tetlab_core::teaching::visual` (the same the recorder logs). The view keeps them between frames
 //! ([`ViewGeometry`]) and brings them up to date only when something it shows changed: a frame
 //! played, an edit, the selection, the pointer, the options. A paused view builds and uploads
 //! nothing.
 
-use super::render::{Geometry, Vertex};
+use super::vertices::{Geometry, Vertex};
 use super::workbench::Workbench;
 use glam::{DVec3, Vec3};
 use tetlab_core::constraints::Family;
 use tetlab_core::constraints::volume::signed_volume;
-use tetlab_core::mesh::TetMesh;
-use tetlab_core::visual::{self, Arrow, Rgba};
+use tetlab_core::scene::mesh::TetMesh;
+use tetlab_core::teaching::visual::{self, Arrow, Rgba};
 
 /// Display options of the 3D view.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -302,7 +302,7 @@ pub fn update(
     }
     if let Some(tet) = bench.selected_tet {
         let corners = tets[tet];
-        for (a, b) in tetlab_core::mesh::TET_EDGES {
+        for (a, b) in tetlab_core::scene::mesh::TET_EDGES {
             line(
                 &mut geometry.lines,
                 positions[corners[a] as usize].as_vec3(),
@@ -459,7 +459,7 @@ fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow) {
 
 /// Grid lines on y = 0 around the rest body, 20 cells across three times its size.
 fn ground_grid(out: &mut Vec<Vertex>, rest: &[DVec3], size: f64) {
-    let (lo, hi) = visual::bounds(rest);
+    let (lo, hi) = tetlab_core::scene::mesh::bounds(rest);
     let centre = (lo + hi) * 0.5;
     let half = 1.5 * size;
     let cells = 20;
@@ -478,7 +478,7 @@ fn ground_grid(out: &mut Vec<Vertex>, rest: &[DVec3], size: f64) {
 mod tests {
     use super::*;
     use tetlab_core::scene::Builtin;
-    use tetlab_core::solver::Settings;
+    use tetlab_core::simulation::Settings;
 
     #[test]
     fn an_inverted_selected_tet_gets_arrows_and_the_geometry_is_well_formed() {

@@ -15,10 +15,10 @@ use super::camera::OrbitCamera;
 use super::workbench::Edit;
 use glam::Vec3;
 use std::fmt;
+use tetlab_core::constraints::material::Material;
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::material::Material;
 use tetlab_core::scene::{Builtin, Perturbation};
-use tetlab_core::solver::{Engine, Method, Settings};
+use tetlab_core::simulation::{Engine, Method, Settings};
 
 /// The address the desktop workbench puts before a fragment: where `scripts/web.sh` says to serve
 /// the page. `TETLAB_PAGE_URL` replaces it (e.g. the address a class uses).
@@ -300,7 +300,7 @@ impl Link {
         link.scene = match (builtin, resolution) {
             (Some(builtin), resolution) => {
                 let resolution = resolution.unwrap_or(3);
-                tetlab_core::limits::RESOLUTION
+                tetlab_core::input::limits::RESOLUTION
                     .check(resolution)
                     .map_err(|message| LinkError {
                         key: "resolution".into(),
@@ -318,7 +318,7 @@ impl Link {
         };
         link.lesson = match (lesson, step) {
             (Some(lesson), step) => {
-                let count = tetlab_core::lesson::BUILTIN.len();
+                let count = tetlab_core::teaching::lesson::BUILTIN.len();
                 if !(1..=count).contains(&lesson) {
                     return Err(LinkError {
                         key: "lesson".into(),
@@ -350,7 +350,7 @@ impl Link {
 /// workbench opens it), or the workbench's defaults.
 fn base_settings(lesson: Option<usize>) -> Settings {
     lesson
-        .and_then(|number| tetlab_core::lesson::Lesson::builtin(number).ok())
+        .and_then(|number| tetlab_core::teaching::lesson::Lesson::builtin(number).ok())
         .map_or(super::Preferences::default().settings, |lesson| {
             lesson.settings
         })
@@ -423,7 +423,7 @@ mod tests {
     /// hand-written one opens the lesson as it sets itself up.
     #[test]
     fn a_lesson_link_starts_from_the_lesson_settings() {
-        let lesson = tetlab_core::lesson::Lesson::builtin(3).unwrap();
+        let lesson = tetlab_core::teaching::lesson::Lesson::builtin(3).unwrap();
         let link = Link::parse("#lesson=3&step=2").unwrap();
         assert_eq!(link.settings, lesson.settings);
         assert_eq!(link.lesson, Some((3, 1)));

@@ -2,12 +2,11 @@
 //! carries them out in one loop once every panel is drawn (the pattern of egui's demo library),
 //! so that no panel changes what another is still drawing.
 
-use super::panels::controls::SceneRequest;
-use super::panels::lesson::LessonRequest;
 use super::shortcuts::Action;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::PerFamily;
-use tetlab_core::solver::Settings;
+use tetlab_core::scene::Builtin;
+use tetlab_core::simulation::Settings;
 
 /// One thing the user asked for in a panel.
 #[derive(Debug)]
@@ -24,4 +23,28 @@ pub enum Request {
     Settings(Box<Settings>),
     /// A constraint file the editor compiled: its family is (re)defined and switched on.
     Constraint(Box<ConstraintFile>),
+}
+
+/// A scene the user asked for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneRequest {
+    /// A built-in scene at a resolution.
+    Builtin(Builtin, u32),
+    /// A mesh file.
+    File(String),
+}
+
+/// What the user asked of the lesson panel.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LessonRequest {
+    /// Open built-in lesson k (from 1).
+    Builtin(usize),
+    /// Open a lesson file.
+    File(String),
+    /// Do the step's actions and play its frames.
+    Do,
+    /// The next step.
+    Next,
+    /// The previous step.
+    Previous,
 }

@@ -78,7 +78,7 @@ impl Viewport {
             CameraChange::Frame => bench.simulation.positions(),
             CameraChange::Reset => bench.simulation.rest_positions(),
         };
-        let (lo, hi) = tetlab_core::visual::bounds(positions);
+        let (lo, hi) = tetlab_core::scene::mesh::bounds(positions);
         if change == CameraChange::Reset {
             self.camera = OrbitCamera::default();
         }
@@ -212,7 +212,7 @@ fn to_glam(v: Vec2) -> GVec2 {
 /// The colour key in the view's corner.
 fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
     use tetlab_core::constraints::Family;
-    use tetlab_core::visual;
+    use tetlab_core::teaching::visual;
     let painter = ui.painter_at(rect);
     let mut y = rect.min.y + 10.0;
     let font = egui::FontId::proportional(13.0);

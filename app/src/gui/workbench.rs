@@ -4,12 +4,12 @@
 use glam::DVec3;
 use std::collections::VecDeque;
 use tetlab_core::constraints::PerFamily;
-use tetlab_core::divergence::Divergence;
-use tetlab_core::lesson::Action as LessonAction;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
-use tetlab_core::solver::{Settings, Simulation};
-use tetlab_core::stepper::{Advanced, StepByStep};
+use tetlab_core::simulation::divergence::Divergence;
+use tetlab_core::simulation::{Settings, Simulation};
+use tetlab_core::teaching::lesson::Action as LessonAction;
+use tetlab_core::teaching::stepper::{Advanced, StepByStep};
 
 /// The threads the fast engine runs on: every core (one in a browser).
 pub fn threads() -> usize {

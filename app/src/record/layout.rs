@@ -1,7 +1,7 @@
 //! The viewer's layout for a recording: the blueprint sent at the start.
 
 use rerun::RecordingStream;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
 
 /// The default layout: a 3D view per root (side by side) on the left, the four metrics stacked on
 /// the right (each plot shows the metric of every root).

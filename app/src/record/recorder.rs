@@ -1,14 +1,14 @@
 //! What a simulation looks like in a recording: the entities [`Recorder`] logs, static data once
-//! and what changes every frame, all derived from [`tetlab_core::visual`] like the workbench's
+//! and what changes every frame, all derived from [`tetlab_core::teaching::visual`] like the workbench's
 //! view.
 
 use glam::Vec3;
 use rerun::RecordingStream;
 use tetlab_core::constraints::Family;
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
-use tetlab_core::solver::Simulation;
-use tetlab_core::visual::{self, Arrow, Quantity, Rgba};
+use tetlab_core::simulation::Simulation;
+use tetlab_core::teaching::visual::{self, Arrow, Quantity, Rgba};
 
 /// Which gradient arrows to log.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -376,9 +376,9 @@ impl Progress {
 mod tests {
     use super::*;
     use crate::record::{ArrowsMode, Recorder};
-    use tetlab_core::metrics::Metrics;
+    use tetlab_core::measures::metrics::Metrics;
     use tetlab_core::scene::{Builtin, Scene};
-    use tetlab_core::solver::{Settings, Simulation};
+    use tetlab_core::simulation::{Settings, Simulation};
 
     /// A run that fails part way (it diverged) keeps the frames recorded before, checked, and
     /// says so in its one-line error; nothing goes to stdout (it used to print "wrote …" first).

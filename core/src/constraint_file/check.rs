@@ -4,9 +4,9 @@
 //! --constraint-file` prints this report.
 
 use super::ConstraintFile;
-use crate::finite_difference::central_difference;
-use crate::random::SplitMix64;
-use crate::verify::{CONDITIONING, relative_error};
+use crate::numbers::finite_difference::central_difference;
+use crate::numbers::random::SplitMix64;
+use crate::teaching::verify::{CONDITIONING, relative_error};
 use glam::DVec3;
 
 /// The largest relative error (against AD) at which a gradient agrees.

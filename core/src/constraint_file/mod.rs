@@ -1,6 +1,6 @@
 //! A constraint written by a user in a file: C as an expression of the particles p0…p3, bound to a
 //! mesh like a built-in family (per edge, per tet, per tet vertex), its gradient by automatic
-//! differentiation ([`crate::dual`]) and, optionally, the user's own derivation of it, checked
+//! differentiation ([`crate::numbers::dual`]) and, optionally, the user's own derivation of it, checked
 //! against that ([`check`]).
 //!
 //! # The file
@@ -27,9 +27,9 @@ pub mod grade;
 pub mod program;
 
 use crate::constraints::Binding;
-use crate::dual::Tangent;
-use crate::text_file;
-use crate::vector::{Real, Vector3};
+use crate::input::text_file;
+use crate::numbers::dual::Tangent;
+use crate::numbers::vector::{Real, Vector3};
 use arrayvec::ArrayVec;
 use glam::DVec3;
 use program::{CompileError, Program, Tape, Type};

@@ -4,10 +4,10 @@
 //!
 //! Running a tape allocates nothing (its registers live on the stack, at most
 //! [`MAX_REGISTERS`]) and is generic over the scalar type ([`Real`]): f64, f32, SIMD lanes, or
-//! the dual numbers of forward-mode automatic differentiation ([`crate::dual::Tangent`]).
+//! the dual numbers of forward-mode automatic differentiation ([`crate::numbers::dual::Tangent`]).
 //!
 //! # Gradients, two ways
-//! - **Forward mode** ([`Tape::run`] over [`crate::dual::Tangent`] numbers): one pass per
+//! - **Forward mode** ([`Tape::run`] over [`crate::numbers::dual::Tangent`] numbers): one pass per
 //!   coordinate, 3N passes for N particles. Independent of everything below; `tetlab
 //!   check-gradients` checks your gradient against it.
 //! - **Reverse mode** ([`Tape::gradient`]): one pass forward for the values, one backward that
@@ -16,7 +16,7 @@
 //!   what a simulation uses. The two agree to rounding (`core/tests/constraint_files.rs`).
 
 use super::expression::{BinaryOp, Expr, Span};
-use crate::vector::Real;
+use crate::numbers::vector::Real;
 use arrayvec::ArrayVec;
 use std::collections::HashMap;
 

@@ -10,7 +10,7 @@
 //! particles have no edge direction: the evaluation is flagged degenerate.
 
 use super::{Constraint, Evaluation};
-use crate::vector::{Real, Vector3};
+use crate::numbers::vector::{Real, Vector3};
 
 /// The constraint and its gradients as lines of math, for display (the inspector, lessons).
 pub const FORMULA: &[&str] = &[

@@ -7,169 +7,18 @@
 //!
 //! Per-family data has one shape, [`PerFamily`], indexed by [`Family`].
 
+pub use super::table::{Binding, Family, MAX_FAMILIES, Row, TABLE};
+
 use super::file::FileConstraint;
 use super::neohookean::{Deviatoric, Hydrostatic};
+use super::registry;
+use super::table::Kind;
 use super::{Constraint, Evaluation, distance::Distance, height::Height, volume::Volume};
-use crate::material::Material;
-use crate::mesh::{TET_EDGES, TetMesh};
+use crate::constraints::material::Material;
+use crate::scene::mesh::{TET_EDGES, TetMesh};
 use glam::DVec3;
 use std::fmt;
 use std::ops::{Index, IndexMut};
-
-/// How many families the table can hold: the built-in ones and those read from constraint files
-/// ([`super::file`]).
-pub const MAX_FAMILIES: usize = 16;
-
-/// A constraint family: a row of [`TABLE`].
-#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Family(u8);
-
-/// How a family's constraints bind to a tet mesh, and so how many it has.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Binding {
-    /// One constraint per edge of the mesh: (p0, p1), the edge's ends, smaller index first; in the
-    /// order of [`TetMesh::edges`].
-    Edges,
-    /// One per tet: (p0, p1, p2, p3), the tet's corners in its own order.
-    Tets,
-    /// Four per tet, one per corner k: (p0, p1, p2, p3) with p1 = corner k, in the orders of
-    /// [`super::height::tet_vertex_order`]; tet t's are constraints 4t..4t+4.
-    TetVertices,
-}
-
-/// A family as people see it, and as the code reaches it.
-pub struct Row {
-    /// Its name on the command line, in files, JSON keys and recordings' entity paths.
-    pub name: &'static str,
-    /// Other spellings the command line and files accept.
-    pub aliases: &'static [&'static str],
-    /// A title for headings: "Edge distance".
-    pub title: &'static str,
-    /// A short label for legends and buttons: "edges".
-    pub label: &'static str,
-    /// The colour of its gradient arrows (sRGB and alpha), the same in the workbench and in
-    /// recordings.
-    pub colour: [u8; 4],
-    /// The constraint and its gradients as lines of math (the inspector, lessons).
-    pub formula: &'static [&'static str],
-    /// What the rest value is called in the formula: d or V.
-    pub rest_symbol: &'static str,
-    /// How many particles one constraint touches.
-    pub arity: usize,
-    /// How it binds to a mesh.
-    pub binding: Binding,
-    /// Whether its gradient needs the face (p0, p2, p3) to span a plane: the gradient check then
-    /// leaves out random configurations where that face is nearly a line (the height's gradient
-    /// grows without bound there).
-    pub needs_face_p0_p2_p3: bool,
-    /// The name of the group it belongs to on the command line and in the workbench: its own
-    /// name, or that of the families it comes with (`neohookean` names both neo-Hookean ones).
-    pub group: &'static str,
-    /// Its XPBD compliance, when a [`Material`] gives it (per unit rest volume: the constraint is
-    /// scaled by √V₀); otherwise the compliance is set per family.
-    pub compliance_from_material: Option<fn(&Material) -> f64>,
-    /// The family its constraints are projected together with, constraint by constraint (the
-    /// same binding, so constraint c of each has the same particles), when both are active:
-    /// [`crate::projection::pair_correction_lanes`]. The first of the two in the table leads.
-    pub projected_with: Option<Family>,
-    pub(super) kind: Kind,
-}
-
-/// Which [`Constraint`] type evaluates a family: the one `match` over families.
-#[derive(Clone, Copy)]
-pub(super) enum Kind {
-    Distance,
-    Height,
-    Volume,
-    Deviatoric,
-    Hydrostatic,
-    /// A constraint file's compiled program ([`super::file::FileConstraint`]).
-    File,
-}
-
-/// The families, in projection order (edges, heights, volumes, then the neo-Hookean pair).
-pub static TABLE: [Row; 5] = [
-    Row {
-        name: "edges",
-        aliases: &["edge", "distance"],
-        title: "Edge distance",
-        label: "edges",
-        colour: [240, 150, 20, 255],
-        formula: super::distance::FORMULA,
-        rest_symbol: "d",
-        arity: 2,
-        binding: Binding::Edges,
-        needs_face_p0_p2_p3: false,
-        group: "edges",
-        compliance_from_material: None,
-        projected_with: None,
-        kind: Kind::Distance,
-    },
-    Row {
-        name: "height",
-        aliases: &["heights", "plane"],
-        title: "Heights above the opposite face",
-        label: "heights",
-        colour: [40, 170, 60, 255],
-        formula: super::height::FORMULA,
-        rest_symbol: "d",
-        arity: 4,
-        binding: Binding::TetVertices,
-        needs_face_p0_p2_p3: true,
-        group: "height",
-        compliance_from_material: None,
-        projected_with: None,
-        kind: Kind::Height,
-    },
-    Row {
-        name: "volume",
-        aliases: &[],
-        title: "Signed volume",
-        label: "volume",
-        colour: [50, 100, 230, 255],
-        formula: super::volume::FORMULA,
-        rest_symbol: "V",
-        arity: 4,
-        binding: Binding::Tets,
-        needs_face_p0_p2_p3: false,
-        group: "volume",
-        compliance_from_material: None,
-        projected_with: None,
-        kind: Kind::Volume,
-    },
-    Row {
-        name: "neohookean-deviatoric",
-        aliases: &["deviatoric"],
-        title: "Neo-Hookean, deviatoric",
-        label: "neo-Hookean dev.",
-        colour: [160, 95, 40, 255],
-        formula: super::neohookean::DEVIATORIC_FORMULA,
-        rest_symbol: "0",
-        arity: 4,
-        binding: Binding::Tets,
-        needs_face_p0_p2_p3: false,
-        group: "neohookean",
-        compliance_from_material: Some(|m| 1.0 / m.mu()),
-        projected_with: Some(Family::NEOHOOKEAN_HYDROSTATIC),
-        kind: Kind::Deviatoric,
-    },
-    Row {
-        name: "neohookean-hydrostatic",
-        aliases: &["hydrostatic"],
-        title: "Neo-Hookean, hydrostatic",
-        label: "neo-Hookean hyd.",
-        colour: [135, 80, 225, 255],
-        formula: super::neohookean::HYDROSTATIC_FORMULA,
-        rest_symbol: "s γ",
-        arity: 4,
-        binding: Binding::Tets,
-        needs_face_p0_p2_p3: false,
-        group: "neohookean",
-        compliance_from_material: Some(|m| 1.0 / m.lambda()),
-        projected_with: Some(Family::NEOHOOKEAN_DEVIATORIC),
-        kind: Kind::Hydrostatic,
-    },
-];
 
 /// Code that works on one family's constraints with the family's [`Constraint`] type known at
 /// compile time (so that the formula is inlined into the loop, and into SIMD lanes).
@@ -198,45 +47,23 @@ pub trait VisitPair {
 }
 
 impl Family {
-    /// Edge distance ([`super::distance`]).
-    pub const EDGES: Family = Family(0);
-    /// The four heights of each tet ([`super::height`]).
-    pub const HEIGHT: Family = Family(1);
-    /// Signed volume ([`super::volume`]).
-    pub const VOLUME: Family = Family(2);
-    /// The deviatoric half of a neo-Hookean tet ([`super::neohookean`]).
-    pub const NEOHOOKEAN_DEVIATORIC: Family = Family(3);
-    /// The hydrostatic half of a neo-Hookean tet ([`super::neohookean`]).
-    pub const NEOHOOKEAN_HYDROSTATIC: Family = Family(4);
-
     /// Every family of the table, in projection order: the built-in ones, then those read from
     /// constraint files ([`Family::register`]).
     pub fn all() -> impl DoubleEndedIterator<Item = Family> + Clone {
-        (0..super::file::count() as u8).map(Family)
-    }
-
-    /// The family in place `index` of the table.
-    pub(super) fn from_index(index: usize) -> Family {
-        debug_assert!(index < MAX_FAMILIES);
-        Family(index as u8)
-    }
-
-    /// The family's place in the table: what [`PerFamily`] is indexed by.
-    pub fn index(self) -> usize {
-        self.0 as usize
+        (0..registry::count()).map(Family::from_index)
     }
 
     /// Its row of the table.
     pub fn row(self) -> &'static Row {
         match TABLE.get(self.index()) {
             Some(row) => row,
-            None => super::file::row(self.index() - TABLE.len()),
+            None => registry::row(self.index() - TABLE.len()),
         }
     }
 
     /// The constraint file it was read from, for a family that was.
     pub fn file(self) -> Option<std::sync::Arc<crate::constraint_file::ConstraintFile>> {
-        (self.index() >= TABLE.len()).then(|| super::file::file(self.index() - TABLE.len()))
+        (self.index() >= TABLE.len()).then(|| registry::file(self.index() - TABLE.len()))
     }
 
     /// Which definition of the family is in force: 0 for a built-in family, a number that
@@ -244,7 +71,7 @@ impl Family {
     /// built from an older definition are rebuilt.
     pub fn generation(self) -> u64 {
         match self.index().checked_sub(TABLE.len()) {
-            Some(slot) => super::file::generation(slot),
+            Some(slot) => registry::generation(slot),
             None => 0,
         }
     }
@@ -569,8 +396,8 @@ impl<T> PerFamily<T> {
         T: Default,
     {
         PerFamily(std::array::from_fn(|i| {
-            if i < super::file::count() {
-                f(Family(i as u8))
+            if i < registry::count() {
+                f(Family::from_index(i))
             } else {
                 T::default()
             }
@@ -739,7 +566,7 @@ impl PerFamily<bool> {
 impl<T: serde::Serialize + Copy> serde::Serialize for PerFamily<T> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
-        let mut map = serializer.serialize_map(Some(super::file::count()))?;
+        let mut map = serializer.serialize_map(Some(registry::count()))?;
         for (family, value) in self.iter() {
             map.serialize_entry(family.name(), &value)?;
         }

@@ -20,7 +20,7 @@
 //! evaluation is flagged degenerate, with C = −d.
 
 use super::{Constraint, Evaluation, first_from_rest};
-use crate::vector::{Vector3, spans_no_plane};
+use crate::numbers::vector::{Vector3, spans_no_plane};
 
 /// The constraint and its gradients as lines of math, for display (the inspector, lessons).
 pub const FORMULA: &[&str] = &[
@@ -45,7 +45,7 @@ pub const fn tet_vertex_order() -> [[usize; 4]; 4] {
 /// e₁·n, the signed height of p1 above the plane of (p0, p2, p3); zero for a degenerate face.
 #[inline(always)]
 pub fn rest_value<V: Vector3>(p: &[V; 4]) -> V::Real {
-    let e = evaluate(p, <V::Real as crate::vector::Real>::ZERO);
+    let e = evaluate(p, <V::Real as crate::numbers::vector::Real>::ZERO);
     e.value
 }
 

@@ -14,7 +14,8 @@
 //! | [`neohookean`] hydrostatic | p0, p1, p2, p3 | √V₀ (det F − γ), γ = 1 + μ/λ |
 //!
 //! Each is a [`Constraint`] type; [`family`] holds the table of families that everything else
-//! reads, and [`file`] adds the families of constraint files to it at run time.
+//! reads, and [`file`] adds the families of constraint files to it at run time. [`material`]
+//! turns Young's modulus and Poisson's ratio into the compliances of the families that take them.
 //!
 //! When a gradient is undefined (coincident points, a face of zero area) the evaluation is
 //! flagged ([`Evaluation::degenerate`]), its gradients are zero and its value stays finite.
@@ -23,13 +24,16 @@ pub mod distance;
 pub mod family;
 pub mod file;
 pub mod height;
+pub mod material;
 pub mod neohookean;
+pub mod registry;
+mod table;
 pub mod volume;
 
 pub use family::{Binding, Family, PerFamily, Row, TABLE, Visit, VisitPair};
 
-use crate::material::Material;
-use crate::vector::{Real, Vector3};
+use crate::constraints::material::Material;
+use crate::numbers::vector::{Real, Vector3};
 use glam::DVec3;
 
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or

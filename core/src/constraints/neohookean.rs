@@ -42,8 +42,8 @@
 //! ```
 
 use super::{Constraint, Evaluation, first_from_rest};
-use crate::material::Material;
-use crate::vector::{Real, Vector3};
+use crate::constraints::material::Material;
+use crate::numbers::vector::{Real, Vector3};
 use glam::{DMat3, DVec3};
 
 /// The deviatoric constraint and its gradients as lines of math (the inspector, lessons).

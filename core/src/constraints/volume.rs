@@ -18,7 +18,7 @@
 //! flagged degenerate.
 
 use super::{Constraint, Evaluation, first_from_rest};
-use crate::vector::{Mask, Real, Vector3, spans_no_plane};
+use crate::numbers::vector::{Mask, Real, Vector3, spans_no_plane};
 
 /// The constraint and its gradients as lines of math, for display (the inspector, lessons).
 pub const FORMULA: &[&str] = &[

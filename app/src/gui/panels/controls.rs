@@ -1,24 +1,15 @@
 //! Playback, step-by-step mode and the scene.
 
 use super::{Context, Panel};
-use crate::gui::request::Request;
+use crate::gui::request::{Request, SceneRequest};
 use crate::gui::shortcuts::Action;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
 use tetlab_core::scene::Builtin;
-use tetlab_core::stepper::{Advanced, Next};
+use tetlab_core::teaching::stepper::{Advanced, Next};
 
 /// The largest resolution the scene panel offers (a cube of 196 608 tets).
 const MAX_RESOLUTION: u32 = 32;
-
-/// A scene the user asked for.
-#[derive(Clone, Debug, PartialEq)]
-pub enum SceneRequest {
-    /// A built-in scene at a resolution.
-    Builtin(Builtin, u32),
-    /// A mesh file.
-    File(String),
-}
 
 /// What the scene section edits between frames.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

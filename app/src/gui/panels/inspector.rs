@@ -8,8 +8,8 @@ use crate::gui::workbench::Workbench;
 use eframe::egui;
 use glam::DVec3;
 use tetlab_core::constraints::Family;
-use tetlab_core::inspector::{Inspection, inspect, inspect_tet, state_lines};
-use tetlab_core::solver::{Method, Simulation};
+use tetlab_core::simulation::{Method, Simulation};
+use tetlab_core::teaching::inspector::{Inspection, inspect, inspect_tet, state_lines};
 
 /// The inspector window.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -150,7 +150,7 @@ fn constraint(
                                     .map(|g| g.length())
                                     .fold(0.0, f64::max);
                                 let differs = (yours - file.automatic[k]).length()
-                                    > tetlab_core::visual::DISAGREEMENT * scale;
+                                    > tetlab_core::teaching::visual::DISAGREEMENT * scale;
                                 let text = egui::RichText::new(vector(yours)).monospace();
                                 ui.label(if differs {
                                     text.color(egui::Color32::from_rgb(220, 60, 60))

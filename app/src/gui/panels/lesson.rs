@@ -3,10 +3,10 @@
 //! classroom mode (larger).
 
 use super::{Context, Panel};
-use crate::gui::request::Request;
+use crate::gui::request::{LessonRequest, Request};
 use eframe::egui;
-use tetlab_core::lesson::{BUILTIN, Lesson, Step};
-use tetlab_core::metrics::Metrics;
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::teaching::lesson::{BUILTIN, Lesson, Step};
 
 /// A lesson in progress in the workbench.
 pub struct LessonState {
@@ -25,21 +25,6 @@ impl LessonState {
     }
 }
 
-/// What the user asked of the lesson panel.
-#[derive(Clone, Debug, PartialEq)]
-pub enum LessonRequest {
-    /// Open built-in lesson k (from 1).
-    Builtin(usize),
-    /// Open a lesson file.
-    File(String),
-    /// Do the step's actions and play its frames.
-    Do,
-    /// The next step.
-    Next,
-    /// The previous step.
-    Previous,
-}
-
 /// The lesson panel: a picker, and the current step of the lesson in progress. It owns the
 /// typed path of a lesson file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -54,7 +39,7 @@ pub struct LessonPanel {
 /// without `../shared/meshes`), or `None` when it can be opened.
 pub fn missing_mesh_note(
     number: usize,
-    header: &tetlab_core::lesson::LessonHeader,
+    header: &tetlab_core::teaching::lesson::LessonHeader,
 ) -> Option<String> {
     let mesh = header.missing_mesh()?;
     let name = std::path::Path::new(mesh)
@@ -264,7 +249,7 @@ fn describe(step: &Step) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tetlab_core::lesson::LessonHeader;
+    use tetlab_core::teaching::lesson::LessonHeader;
 
     /// A lesson whose mesh is not here is named in the panel, by the mesh's file name; one on a
     /// built-in scene is not.

@@ -5,9 +5,9 @@ use super::{Context, Panel};
 use crate::gui::request::Request;
 use crate::gui::shortcuts::Action;
 use eframe::egui;
+use tetlab_core::constraints::material::{MAX_POISSON, YOUNG};
 use tetlab_core::constraints::{Family, PerFamily};
-use tetlab_core::material::{MAX_POISSON, YOUNG};
-use tetlab_core::solver::{Engine, FAST_FROM_TETS, Method, Settings};
+use tetlab_core::simulation::{Engine, FAST_FROM_TETS, Method, Settings};
 
 /// The solver panel: it edits a copy of the simulation's settings and asks for the copy when
 /// the user changed it. "Write a constraint" asks for the constraint editor, whose family joins

@@ -1,0 +1,951 @@
+//! The workbench application: the panels drawn, the requests they add carried out in one loop,
+//! and the 3D view, on one [`super::workbench::Workbench`] or two side by side.
+
+#[cfg(not(target_arch = "wasm32"))]
+use super::browser;
+use super::files::Opened;
+use super::fonts::install_fonts;
+use super::geometry::SceneCache;
+use super::link::Link;
+use super::panels::compare::ComparePanel;
+use super::panels::constraint_editor::ConstraintEditor;
+use super::panels::controls::Controls;
+use super::panels::display::DisplayPanel;
+use super::panels::help::Help;
+use super::panels::inspector::Inspector;
+use super::panels::lesson::{LessonPanel, LessonState};
+use super::panels::readouts::Readouts;
+use super::panels::solver::SolverPanel;
+use super::panels::tools::Tools;
+use super::panels::{Context, Panel};
+use super::platform::{Desktop, Platform};
+use super::preferences::Preferences;
+use super::request::Request;
+use super::request::{LessonRequest, SceneRequest};
+use super::shortcuts::{Action, SHORTCUTS};
+use super::viewport::Viewport;
+use super::workbench::Workbench;
+use super::{files, render};
+use eframe::egui;
+use std::time::Duration;
+use tetlab_core::constraints::PerFamily;
+use tetlab_core::scene::{Builtin, Perturbation, Scene};
+use tetlab_core::simulation::Settings;
+use tetlab_core::teaching::lesson::{Action as LessonAction, Lesson};
+use web_time::Instant;
+
+/// The right half of a side-by-side comparison: the same scene with other constraint families.
+pub struct Comparison {
+    /// Its simulation and selection.
+    pub bench: Workbench,
+    /// Its view.
+    pub viewport: Viewport,
+}
+
+/// The workbench application.
+pub struct TetlabApp {
+    /// The simulation and selection.
+    pub bench: Workbench,
+    cache: SceneCache,
+    /// The 3D view.
+    pub viewport: Viewport,
+    /// The last error to show (a mesh that did not load, …).
+    pub error: Option<String>,
+    step_time: Duration,
+    /// The time between the last two frames drawn, smoothed.
+    frame_time: Duration,
+    /// When the last frame was drawn.
+    last_frame: Option<Instant>,
+    /// Timings shown instead of the measured ones ([`TetlabApp::freeze_timings`]).
+    frozen_timings: Option<(Duration, Duration)>,
+    /// Whether the lesson window is open.
+    pub show_lesson: bool,
+    /// The lesson in progress.
+    pub lesson: Option<LessonState>,
+    /// The second simulation shown beside the first, if any.
+    pub comparison: Option<Comparison>,
+    /// Classroom mode: large, the 3D view and the lesson only.
+    pub classroom: bool,
+    /// Playback, step by step and the scene.
+    pub controls: Controls,
+    /// The solver settings.
+    pub solver: SolverPanel,
+    /// Deformations and the selection.
+    pub tools: Tools,
+    /// Side by side with other families.
+    pub compare: ComparePanel,
+    /// The metrics, engine and timings.
+    pub readouts: Readouts,
+    /// What the views draw.
+    pub display: DisplayPanel,
+    /// The lesson picker and the current step.
+    pub lesson_panel: LessonPanel,
+    /// The constraint editor.
+    pub editor: ConstraintEditor,
+    /// The inspector window.
+    pub inspector: Inspector,
+    /// The help window.
+    pub help: Help,
+    /// Frames drawn so far (the first one is announced in a browser).
+    frames_drawn: u64,
+    /// The built-in scene shown and its resolution (`None` for a mesh file or a lesson's scene):
+    /// what a link names.
+    builtin_shown: Option<(Builtin, u32)>,
+    /// The built-in lesson open (its number, from 1): what a link names.
+    lesson_number: Option<usize>,
+    /// A link just made, to copy to the clipboard on this frame.
+    link_to_copy: Option<String>,
+    /// The last thing done that is worth a line (a link copied); not an error.
+    pub notice: Option<String>,
+    /// Dropped files read in the background.
+    #[cfg(target_arch = "wasm32")]
+    inbox: files::Inbox,
+    /// "Open mesh file…" while it is open.
+    #[cfg(not(target_arch = "wasm32"))]
+    browser: Option<browser::FileBrowser>,
+    /// Where it runs: a desktop window or a page.
+    platform: Box<dyn Platform>,
+}
+
+/// How much larger everything is in classroom mode.
+pub const CLASSROOM_ZOOM: f32 = 1.5;
+
+impl TetlabApp {
+    /// Sets up the renderer and restores the last session's preferences (or, when the page was
+    /// opened by a link, the link's state), for `platform`.
+    pub fn new(
+        cc: &eframe::CreationContext<'_>,
+        platform: Box<dyn Platform>,
+    ) -> Result<Self, String> {
+        let render_state = cc
+            .wgpu_render_state
+            .as_ref()
+            .ok_or("tetlab's 3D view needs the wgpu renderer")?;
+        render::Renderer::install(render_state);
+        platform.log(&format!(
+            "tetlab: drawing with {:?}",
+            render_state.adapter.get_info().backend
+        ));
+        install_fonts(&cc.egui_ctx);
+        let preferences = cc.storage.map(Preferences::load).unwrap_or_default();
+        // A page opened by a link shows the link's state, from the defaults.
+        let fragment = platform.fragment();
+        if !fragment.trim_start_matches('#').is_empty() {
+            let mut app = TetlabApp::with_preferences(Preferences::default());
+            app.open_fragment(&fragment);
+            match &app.error {
+                Some(error) => platform.log(&format!("tetlab: link not opened: {error}")),
+                None => platform.log("tetlab: link opened"),
+            }
+            app.platform = platform;
+            return Ok(app);
+        }
+        let mut app = TetlabApp::with_preferences(preferences);
+        app.platform = platform;
+        Ok(app)
+    }
+
+    /// The workbench on the scene and settings of `preferences` (the renderer must be installed).
+    /// Settings that are out of range (remembered settings come from a file on disk, which may
+    /// be old or edited by hand) are replaced by the defaults, and the error says so.
+    pub fn with_preferences(mut preferences: Preferences) -> Self {
+        let refused = preferences.settings.check().err();
+        if refused.is_some() {
+            preferences.settings = Preferences::default().settings;
+        }
+        let builtin = Builtin::from_name(&preferences.scene.builtin).unwrap_or(Builtin::Cube);
+        let bench = Workbench::builtin(builtin, preferences.scene.resolution, preferences.settings);
+        let shown_resolution = preferences.scene.resolution.clamp(1, 16);
+        let cache = SceneCache::new(&bench.scene.mesh);
+        let viewport = Viewport::default();
+        TetlabApp {
+            bench,
+            cache,
+            viewport,
+            error: refused.map(|why| {
+                format!("the remembered solver settings were refused ({why}); using the defaults")
+            }),
+            step_time: Duration::ZERO,
+            frame_time: Duration::ZERO,
+            last_frame: None,
+            frozen_timings: None,
+            show_lesson: false,
+            lesson: None,
+            comparison: None,
+            classroom: false,
+            controls: Controls {
+                scene: preferences.scene,
+            },
+            solver: SolverPanel,
+            tools: Tools,
+            compare: ComparePanel::default(),
+            readouts: Readouts,
+            display: DisplayPanel {
+                options: preferences.view,
+            },
+            lesson_panel: LessonPanel::default(),
+            editor: ConstraintEditor::default(),
+            inspector: Inspector::default(),
+            help: Help::default(),
+            frames_drawn: 0,
+            builtin_shown: Some((builtin, shown_resolution)),
+            lesson_number: None,
+            link_to_copy: None,
+            notice: None,
+            #[cfg(target_arch = "wasm32")]
+            inbox: files::Inbox::default(),
+            #[cfg(not(target_arch = "wasm32"))]
+            browser: None,
+            platform: Box::new(Desktop),
+        }
+    }
+
+    /// Shows these step and frame times in the readouts instead of the measured ones: for
+    /// screenless tests, whose snapshots must not depend on how fast the machine is.
+    pub fn freeze_timings(&mut self, step: Duration, frame: Duration) {
+        self.frozen_timings = Some((step, frame));
+    }
+
+    /// What the workbench remembers between runs: the scene section, the solver settings and
+    /// the display options, as they are now.
+    pub fn preferences(&self) -> Preferences {
+        Preferences {
+            scene: self.controls.scene.clone(),
+            settings: *self.bench.simulation.settings(),
+            view: self.display.options,
+        }
+    }
+
+    /// Replaces the scene; keeps settings and view (but particle handles and arrows, which
+    /// [`ViewOptions::fit_size`] sets for the scene's size); ends a comparison.
+    pub fn load(&mut self, scene: Scene) {
+        self.bench.load(scene);
+        self.cache = SceneCache::new(&self.bench.scene.mesh);
+        // A big mesh is shown as a body: its particle handles and arrows start off.
+        let tets = self.bench.simulation.tets().len();
+        self.display.options.fit_size(tets);
+        self.viewport.frame();
+        self.comparison = None;
+        self.error = None;
+        self.builtin_shown = None;
+    }
+
+    /// Opens a lesson at its first step: its scene, settings and tet. A lesson that brings
+    /// constraint files puts the first in the editor, where its exercise is done.
+    pub fn open_lesson(&mut self, lesson: Lesson) {
+        self.lesson_number = None;
+        if let Some(&family) = lesson.families.first()
+            && let Some(file) = family.file()
+        {
+            self.editor.set_text(&file.path, &file.source);
+            self.editor.family = Some(family);
+        }
+        self.load(lesson.scene());
+        self.bench.set_settings(lesson.settings);
+        self.bench.select_tet(lesson.tet);
+        self.viewport.reset_camera();
+        self.lesson = Some(LessonState {
+            lesson,
+            step: 0,
+            frames_left: 0,
+        });
+        self.show_lesson = true;
+    }
+
+    /// Does the current lesson step: its actions (on both simulations when comparing), then
+    /// plays its frames.
+    pub fn do_step(&mut self) {
+        let Some(step) = self.lesson.as_ref().map(|state| state.current().clone()) else {
+            return;
+        };
+        for action in step.actions {
+            match action {
+                LessonAction::Compare(families) => self.compare(families),
+                action => {
+                    self.bench.apply_lesson_action(action);
+                    if let Some(comparison) = &mut self.comparison
+                        && action.applies_to_comparison()
+                    {
+                        comparison.bench.apply_lesson_action(action);
+                    }
+                }
+            }
+        }
+        if let Some(state) = &mut self.lesson {
+            state.frames_left = step.frames;
+        }
+        if step.frames > 0 {
+            self.set_playing(true);
+        }
+    }
+
+    /// Changes the solver settings of the simulation, and of the comparison beside it (as a
+    /// lesson's actions do): everything but its own families.
+    pub fn set_settings(&mut self, settings: Settings) {
+        self.bench.set_settings(settings);
+        if let Some(comparison) = &mut self.comparison {
+            let active = comparison.bench.simulation.settings().active;
+            comparison
+                .bench
+                .set_settings(Settings { active, ..settings });
+        }
+    }
+
+    /// Starts comparing side by side with a twin of the current state using `families`, or
+    /// stops (`None`).
+    pub fn compare(&mut self, families: Option<PerFamily<bool>>) {
+        self.comparison = families.map(|active| {
+            let bench = self.bench.twin(active);
+            let mut viewport = Viewport::default();
+            viewport.view = 1;
+            viewport.camera = self.viewport.camera;
+            viewport.frame();
+            Comparison { bench, viewport }
+        });
+        // The main view changes width: frame it once laid out.
+        self.viewport.frame();
+    }
+
+    /// Opens "Open mesh file…" in the folder of the last file, or the current folder.
+    fn open_browser(&mut self) {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let last = std::path::Path::new(&self.controls.scene.path);
+            let folder = last
+                .parent()
+                .filter(|p| p.is_dir())
+                .map(std::path::Path::to_path_buf)
+                .unwrap_or_else(|| std::path::PathBuf::from("."));
+            self.browser = Some(browser::FileBrowser::new(&folder));
+        }
+    }
+
+    fn go_to_step(&mut self, forward: bool) {
+        if let Some(state) = &mut self.lesson {
+            let last = state.lesson.steps.len() - 1;
+            state.step = if forward {
+                (state.step + 1).min(last)
+            } else {
+                state.step.saturating_sub(1)
+            };
+            state.frames_left = 0;
+        }
+    }
+
+    fn set_playing(&mut self, playing: bool) {
+        self.bench.set_playing(playing);
+        if let Some(comparison) = &mut self.comparison {
+            comparison.bench.set_playing(playing);
+        }
+    }
+
+    fn request(&mut self, request: SceneRequest) {
+        match request {
+            SceneRequest::Builtin(builtin, resolution) => {
+                if let Err(why) = self.load_builtin(builtin, resolution) {
+                    self.error = Some(why);
+                }
+            }
+            SceneRequest::File(path) => self.opened(files::open_path(&path)),
+        }
+    }
+
+    /// Loads a built-in scene ([`TetlabApp::load`]), which a link can then name.
+    pub fn load_builtin(&mut self, builtin: Builtin, resolution: u32) -> Result<(), String> {
+        let scene = Scene::builtin(builtin, resolution).map_err(|e| e.to_string())?;
+        self.load(scene);
+        self.builtin_shown = Some((builtin, resolution));
+        Ok(())
+    }
+
+    /// A link to the state shown: the built-in scene, the settings, the lesson and its step, the
+    /// camera, and the edits made since the scene was loaded.
+    pub fn link(&self) -> Link {
+        Link {
+            scene: self.builtin_shown,
+            settings: *self.bench.simulation.settings(),
+            lesson: self
+                .lesson_number
+                .zip(self.lesson.as_ref().map(|state| state.step)),
+            camera: Some(self.viewport.camera),
+            edits: self.bench.edits.clone(),
+        }
+    }
+
+    /// Shows the state a link describes: its lesson at its step (or its scene), its settings,
+    /// its edits made again, its camera. An edit that does not fit is reported and the rest
+    /// left out.
+    pub fn open_link(&mut self, link: Link) {
+        if let Some((number, step)) = link.lesson {
+            self.lesson_request(LessonRequest::Builtin(number));
+            self.show_lesson = true;
+            for _ in 0..step {
+                self.go_to_step(true);
+            }
+        } else if let Some((builtin, resolution)) = link.scene {
+            self.controls.scene.builtin = builtin.name().to_owned();
+            self.controls.scene.resolution = resolution;
+            self.request(SceneRequest::Builtin(builtin, resolution));
+        }
+        self.set_settings(link.settings);
+        for edit in link.edits {
+            if let Err(why) = self.bench.apply_edit(edit) {
+                self.error = Some(format!("the link's edits: {why}; the later ones left out"));
+                break;
+            }
+        }
+        if let Some(camera) = link.camera {
+            self.viewport.camera = camera;
+        }
+    }
+
+    /// Opens the state of a URL fragment; a fragment that cannot be read leaves the workbench
+    /// as it is, and says why.
+    pub fn open_fragment(&mut self, fragment: &str) {
+        match Link::parse(fragment) {
+            Ok(link) => self.open_link(link),
+            Err(error) => {
+                self.error = Some(format!("{error}; the workbench opened with its defaults"))
+            }
+        }
+    }
+
+    /// The whole link to the state shown: the page's address (in a browser, this page's;
+    /// on the desktop, [`link::page_url`]) and the fragment.
+    pub fn link_url(&self) -> String {
+        let page = self.platform.page_address();
+        format!("{page}#{}", self.link().fragment())
+    }
+
+    fn opened(&mut self, opened: Result<Opened, String>) {
+        match opened {
+            Ok(Opened::Scene(scene)) => self.load(scene),
+            Ok(Opened::Lesson(lesson)) => self.open_lesson(*lesson),
+            Ok(Opened::Constraint { path, text }) => {
+                self.editor.open = true;
+                self.error = None;
+                match self.editor.set_text(&path, &text) {
+                    Some(file) => self.define_constraint(file),
+                    None => self.error = self.editor.error.clone(),
+                }
+            }
+            Err(message) => self.error = Some(message),
+        }
+    }
+
+    /// Defines the family of a constraint file the editor compiled (replacing the one of the
+    /// same name), switches it on (and the editor's previous family off, when the name
+    /// changed), and rebuilds its constraints in every simulation shown.
+    pub fn define_constraint(&mut self, file: tetlab_core::constraint_file::ConstraintFile) {
+        let family = match tetlab_core::constraints::Family::define(file) {
+            Ok(family) => family,
+            Err(message) => {
+                self.editor.error = Some(format!("{}: {message}", self.editor.path.display()));
+                return;
+            }
+        };
+        let previous = self.editor.family.replace(family);
+        let mut settings = *self.bench.simulation.settings();
+        if previous != Some(family) {
+            if let Some(previous) = previous {
+                settings.active[previous] = false;
+            }
+            settings.active[family] = true;
+        }
+        self.bench.refresh_families();
+        if let Some(comparison) = &mut self.comparison {
+            comparison.bench.refresh_families();
+        }
+        self.set_settings(settings);
+    }
+
+    fn lesson_request(&mut self, request: LessonRequest) {
+        match request {
+            LessonRequest::Builtin(k) => match Lesson::builtin(k) {
+                Ok(lesson) => {
+                    self.open_lesson(lesson);
+                    self.lesson_number = Some(k);
+                }
+                Err(e) => self.error = Some(e.to_string()),
+            },
+            LessonRequest::File(path) => self.opened(files::open_path(&path)),
+            LessonRequest::Do => self.do_step(),
+            LessonRequest::Next => self.go_to_step(true),
+            LessonRequest::Previous => self.go_to_step(false),
+        }
+    }
+
+    /// Carries out what a panel asked for.
+    pub fn apply(&mut self, request: Request) {
+        match request {
+            Request::Act(action) => self.act(action),
+            Request::Scene(request) => self.request(request),
+            Request::Lesson(request) => self.lesson_request(request),
+            Request::Compare(families) => self.compare(families),
+            Request::Settings(settings) => self.set_settings(*settings),
+            Request::Constraint(file) => self.define_constraint(*file),
+        }
+    }
+
+    /// Does what a key or a button asks; actions on the simulation go to both halves of a
+    /// comparison.
+    pub fn act(&mut self, action: Action) {
+        match action {
+            Action::FrameView => self.viewport.frame(),
+            Action::ResetCamera => self.viewport.reset_camera(),
+            Action::CopyLink => {
+                let url = self.link_url();
+                // On the desktop the link is printed too, for a terminal or a script.
+                #[cfg(not(target_arch = "wasm32"))]
+                println!("{url}");
+                self.notice = Some(format!("link copied ({} characters)", url.len()));
+                self.link_to_copy = Some(url);
+            }
+            Action::Inspector => self.inspector.open = !self.inspector.open,
+            Action::Help => self.help.open = !self.help.open,
+            Action::Lesson => self.show_lesson = !self.show_lesson,
+            Action::ConstraintEditor => {
+                self.editor.open = !self.editor.open;
+                if self.editor.open && self.editor.text.is_empty() {
+                    let example = tetlab_core::constraint_file::EXAMPLES
+                        .iter()
+                        .find(|e| e.file == "height.toml")
+                        .unwrap_or(&tetlab_core::constraint_file::EXAMPLES[0]);
+                    if let Some(file) = self.editor.set_text(&example.shown(), example.text) {
+                        self.define_constraint(file);
+                    }
+                }
+            }
+            Action::OpenFile => self.open_browser(),
+            Action::Classroom => {
+                self.classroom = !self.classroom;
+                self.viewport.frame();
+                if let Some(comparison) = &mut self.comparison {
+                    comparison.viewport.frame();
+                }
+            }
+            Action::NextStep => self.go_to_step(true),
+            Action::PreviousStep => self.go_to_step(false),
+            Action::DoStep => self.do_step(),
+            Action::PlayPause => self.set_playing(!self.bench.playing),
+            simulation => {
+                act_on(&mut self.bench, simulation);
+                if let Some(comparison) = &mut self.comparison {
+                    comparison.bench.selected_particle = self.bench.selected_particle;
+                    comparison.bench.selected_tet = self.bench.selected_tet;
+                    act_on(&mut comparison.bench, simulation);
+                }
+            }
+        }
+    }
+
+    fn handle_input(&mut self, ctx: &egui::Context) {
+        if !ctx.egui_wants_keyboard_input() {
+            let pressed: Vec<Action> = ctx.input(|i| {
+                SHORTCUTS
+                    .iter()
+                    .filter(|(key, _, _)| i.key_pressed(*key))
+                    .map(|(_, action, _)| *action)
+                    .collect()
+            });
+            for action in pressed {
+                self.act(action);
+            }
+        }
+        let dropped = ctx.input(|i| i.raw.dropped_files.clone());
+        for file in dropped {
+            #[cfg(not(target_arch = "wasm32"))]
+            self.opened(files::open_dropped(file.as_ref()));
+            #[cfg(target_arch = "wasm32")]
+            files::open_dropped(file, &self.inbox);
+        }
+        #[cfg(target_arch = "wasm32")]
+        for opened in self.inbox.take() {
+            self.opened(opened);
+        }
+    }
+
+    /// The "Open mesh file…" window, when open; opens what is chosen in it.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn show_browser(&mut self, ctx: &egui::Context) {
+        let Some(browser) = &mut self.browser else {
+            return;
+        };
+        let mut open = true;
+        let chosen = browser.show(ctx, &mut open);
+        if !open {
+            self.browser = None;
+        }
+        if let Some(path) = chosen {
+            self.controls.scene.path = path.display().to_string();
+            self.opened(files::open_path(&path.to_string_lossy()));
+        }
+    }
+
+    /// Plays a frame of each simulation while playing, and counts down a lesson step's frames.
+    fn advance(&mut self, ctx: &egui::Context) {
+        if !self.bench.playing {
+            return;
+        }
+        let started = Instant::now();
+        self.bench.step_frame();
+        self.step_time = started.elapsed();
+        if let Some(comparison) = &mut self.comparison
+            && comparison.bench.playing
+        {
+            comparison.bench.step_frame();
+        }
+        if let Some(state) = &mut self.lesson
+            && state.frames_left > 0
+        {
+            state.frames_left -= 1;
+            if state.frames_left == 0 {
+                self.set_playing(false);
+            }
+        }
+        ctx.request_repaint();
+    }
+
+    /// A simulation that diverged (and went back to rest) is reported where errors are.
+    fn show_divergence(&mut self) {
+        let twin = self.comparison.as_mut().map(|c| &mut c.bench);
+        for (bench, which) in [(Some(&mut self.bench), ""), (twin, "right: ")] {
+            if let Some(divergence) = bench.and_then(|b| b.diverged.take()) {
+                self.error = Some(format!("{which}{divergence}; back to the rest shape"));
+            }
+        }
+    }
+
+    /// The 3D view, or two side by side when comparing, each titled with its families.
+    fn views(&mut self, ui: &mut egui::Ui) {
+        let view = self.display.options;
+        let Some(comparison) = &mut self.comparison else {
+            self.viewport.show(ui, &mut self.bench, &self.cache, &view);
+            return;
+        };
+        let size = if self.classroom { 20.0 } else { 14.0 };
+        ui.columns(2, |columns| {
+            let [left, right] = columns else {
+                unreachable!("two columns")
+            };
+            for (ui, bench, viewport) in [
+                (left, &mut self.bench, &mut self.viewport),
+                (right, &mut comparison.bench, &mut comparison.viewport),
+            ] {
+                let families = bench.simulation.settings().active.describe();
+                ui.add(
+                    egui::Label::new(egui::RichText::new(families).size(size).strong()).truncate(),
+                );
+                viewport.show(ui, bench, &self.cache, &view);
+            }
+        });
+    }
+}
+
+/// The top of the left panel: the name, the buttons that open what is not a side panel, and the
+/// last error.
+fn header(
+    ui: &mut egui::Ui,
+    error: Option<&str>,
+    notice: Option<&str>,
+    requests: &mut Vec<Request>,
+) {
+    ui.horizontal(|ui| {
+        ui.heading("tetlab");
+        for (label, action) in [
+            ("Help (H)", Action::Help),
+            ("Lessons (L)", Action::Lesson),
+            ("Classroom (F5)", Action::Classroom),
+        ] {
+            if ui.button(label).clicked() {
+                requests.push(Request::Act(action));
+            }
+        }
+    });
+    if let Some(error) = error {
+        ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
+    }
+    if let Some(notice) = notice {
+        ui.small(notice);
+    }
+}
+
+/// Does a simulation action on one workbench.
+fn act_on(bench: &mut Workbench, action: Action) {
+    match action {
+        Action::StepFrame => bench.step_frame(),
+        Action::StepSubstep => bench.step_substep(),
+        Action::StepProjection => bench.step_projection(),
+        Action::FinishSubstep => bench.finish_substep(),
+        Action::Reset => bench.reset(),
+        Action::InvertSelected => bench.invert_selected(),
+        Action::Mirror => bench.perturb(Perturbation::Mirror),
+        Action::Flatten => bench.perturb(Perturbation::Flatten),
+        Action::Scramble => bench.scramble(),
+        Action::TogglePin => bench.toggle_pin(),
+        Action::NextTet => bench.next_tet_of_selected(),
+        _ => {}
+    }
+}
+
+impl eframe::App for TetlabApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        let now = Instant::now();
+        if let Some(last) = self.last_frame {
+            // A running mean over about ten frames, so that the number can be read.
+            let elapsed = now - last;
+            self.frame_time = (self.frame_time * 9 + elapsed) / 10;
+        }
+        self.last_frame = Some(now);
+        self.handle_input(&ctx);
+        let zoom = if self.classroom { CLASSROOM_ZOOM } else { 1.0 };
+        if ctx.zoom_factor() != zoom {
+            ctx.set_zoom_factor(zoom);
+        }
+        self.advance(&ctx);
+        self.show_divergence();
+        let mut requests = Vec::new();
+        let context = Context {
+            bench: &self.bench,
+            comparison: self.comparison.as_ref().map(|c| &c.bench),
+            lesson: self.lesson.as_ref(),
+            step_time: self.frozen_timings.map_or(self.step_time, |t| t.0),
+            frame_time: self.frozen_timings.map_or(self.frame_time, |t| t.1),
+            classroom: self.classroom,
+        };
+        if self.classroom {
+            egui::Panel::right("classroom lesson")
+                .default_size(ui.available_width() * 0.36)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        self.lesson_panel.ui(ui, &context, &mut requests);
+                        ui.add_space(12.0);
+                        ui.label(
+                            "Left/Right: steps   Enter: do it   Space: play   F5: leave classroom",
+                        );
+                    });
+                });
+        } else {
+            egui::Panel::left("controls")
+                .default_size(300.0)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        header(
+                            ui,
+                            self.error.as_deref(),
+                            self.notice.as_deref(),
+                            &mut requests,
+                        );
+                        let panels: [&mut dyn Panel; 4] = [
+                            &mut self.controls,
+                            &mut self.solver,
+                            &mut self.tools,
+                            &mut self.compare,
+                        ];
+                        for (k, panel) in panels.into_iter().enumerate() {
+                            if k > 0 {
+                                ui.separator();
+                            }
+                            panel.ui(ui, &context, &mut requests);
+                        }
+                    });
+                });
+            egui::Panel::right("readouts")
+                .default_size(300.0)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        self.readouts.ui(ui, &context, &mut requests);
+                        ui.separator();
+                        self.display.ui(ui, &context, &mut requests);
+                    });
+                });
+            self.editor.ui(ui, &context, &mut requests);
+            if self.show_lesson {
+                egui::Panel::bottom("lesson")
+                    .resizable(true)
+                    .default_size(250.0)
+                    .min_size(120.0)
+                    .show(ui, |ui| {
+                        egui::ScrollArea::vertical()
+                            .auto_shrink([false, false])
+                            .show(ui, |ui| {
+                                ui.horizontal(|ui| {
+                                    ui.heading("Lesson");
+                                    if ui.button("Close (L)").clicked() {
+                                        requests.push(Request::Act(Action::Lesson));
+                                    }
+                                });
+                                self.lesson_panel.ui(ui, &context, &mut requests);
+                            });
+                    });
+            }
+            self.inspector.ui(ui, &context, &mut requests);
+        }
+        self.help.ui(ui, &context, &mut requests);
+        egui::CentralPanel::default_margins().show(ui, |ui| self.views(ui));
+        #[cfg(not(target_arch = "wasm32"))]
+        self.show_browser(&ctx);
+        for request in requests {
+            self.apply(request);
+        }
+        if let Some(url) = self.link_to_copy.take() {
+            ctx.copy_text(url);
+        }
+        self.frames_drawn += 1;
+        // The first frame is painted before the second runs: ask for a second, and announce then.
+        #[cfg(target_arch = "wasm32")]
+        if self.frames_drawn == 1 {
+            ctx.request_repaint();
+        }
+        // What a browser test reads (window.tetlab_state()).
+        if self.platform.publishes() {
+            self.platform.publish(&self.report());
+        }
+        if self.frames_drawn == 2 {
+            self.platform.log(&format!(
+                "tetlab ready: {} with {} tets drawn",
+                self.bench.scene.name,
+                self.bench.simulation.tets().len()
+            ));
+        }
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        self.preferences().save(storage);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tetlab_core::constraints::Family;
+    use tetlab_core::simulation::Method;
+
+    /// What `save` writes, `new` reads back: the preferences as JSON text.
+    #[test]
+    fn preferences_survive_a_save_and_load() {
+        let mut preferences = Preferences::default();
+        preferences.scene.builtin = "ball".into();
+        preferences.scene.resolution = 2;
+        preferences.settings.method = Method::Pbd;
+        preferences.settings.active[Family::HEIGHT] = true;
+        preferences.settings.substeps = 7;
+        preferences.view.see_through = true;
+        let text = serde_json::to_string(&preferences).unwrap();
+        let restored: Preferences = serde_json::from_str(&text).unwrap();
+        assert_eq!(restored, preferences);
+        let app = TetlabApp::with_preferences(restored);
+        assert_eq!(app.bench.scene.name, "ball");
+        assert_eq!(*app.bench.simulation.settings(), preferences.settings);
+    }
+
+    #[test]
+    fn missing_or_old_preferences_fall_back_to_defaults() {
+        let restored: Preferences =
+            serde_json::from_str(r#"{"scene": {"builtin": "tet"}}"#).unwrap();
+        assert_eq!(restored.scene.builtin, "tet");
+        assert_eq!(restored.settings, Preferences::default().settings);
+        assert!(restored.settings.settle_edits);
+    }
+
+    /// A link made on one workbench shows the same state on another: the scene, the settings,
+    /// the edits (the same positions, bit for bit), the camera; and a lesson at its step.
+    #[test]
+    fn a_link_shows_the_same_state_on_another_workbench() {
+        let mut teacher = TetlabApp::with_preferences(Preferences::default());
+        teacher.request(SceneRequest::Builtin(Builtin::Cube, 2));
+        let mut settings = *teacher.bench.simulation.settings();
+        settings.active[Family::HEIGHT] = true;
+        settings.substeps = 12;
+        teacher.set_settings(settings);
+        teacher.act(Action::Mirror);
+        teacher.bench.select_tet(5);
+        teacher.act(Action::InvertSelected);
+        teacher.viewport.camera.yaw = 2.0;
+        let url = teacher.link_url();
+        let (_, fragment) = url.split_once('#').unwrap();
+
+        let mut student = TetlabApp::with_preferences(Preferences::default());
+        student.open_fragment(fragment);
+        assert_eq!(student.error, None);
+        assert_eq!(student.bench.scene.name, "cube");
+        assert_eq!(student.bench.simulation.tets().len(), 48);
+        assert_eq!(
+            student.bench.simulation.settings(),
+            teacher.bench.simulation.settings()
+        );
+        assert_eq!(
+            student.bench.simulation.positions(),
+            teacher.bench.simulation.positions()
+        );
+        assert_eq!(student.viewport.camera, teacher.viewport.camera);
+        assert_eq!(student.link(), teacher.link());
+
+        teacher.lesson_request(LessonRequest::Builtin(2));
+        teacher.lesson_request(LessonRequest::Next);
+        let mut student = TetlabApp::with_preferences(Preferences::default());
+        student.open_fragment(&teacher.link().fragment());
+        let state = student.lesson.as_ref().expect("the lesson is open");
+        assert_eq!(state.step, 1);
+        assert_eq!(
+            state.lesson.title,
+            teacher.lesson.as_ref().unwrap().lesson.title
+        );
+    }
+
+    /// The report a browser test reads: the scene, the inversions, the lesson step and its
+    /// checks, the error.
+    #[test]
+    fn the_report_says_what_the_workbench_shows() {
+        let mut app = TetlabApp::with_preferences(Preferences::default());
+        app.lesson_request(LessonRequest::Builtin(3));
+        app.lesson_request(LessonRequest::Next);
+        let report = app.report();
+        assert_eq!((report.scene.as_str(), report.tets), ("tet", 1));
+        let lesson = report.lesson.expect("the lesson");
+        assert_eq!((lesson.step, lesson.steps), (2, 4));
+        assert_eq!(lesson.checks.len(), 1);
+        assert_eq!(lesson.checks[0].expect, "inverted_tets == 1");
+        assert!(!lesson.checks[0].holds);
+        app.do_step();
+        let report = app.report();
+        assert_eq!(report.inverted_tets, 1);
+        assert!(report.lesson.unwrap().checks[0].holds);
+        assert_eq!(report.frame, app.bench.simulation.frame());
+    }
+
+    /// A fragment that cannot be read leaves the defaults and says which key was wrong.
+    #[test]
+    fn a_malformed_link_falls_back_to_the_defaults_with_a_message() {
+        let mut app = TetlabApp::with_preferences(Preferences::default());
+        let before = *app.bench.simulation.settings();
+        app.open_fragment("#scene=cube&substeps=lots");
+        let error = app.error.as_deref().unwrap();
+        assert!(error.contains("'substeps'"), "{error}");
+        assert!(error.contains("defaults"), "{error}");
+        assert_eq!(*app.bench.simulation.settings(), before);
+
+        let mut app = TetlabApp::with_preferences(Preferences::default());
+        app.open_fragment("#scene=tet&edits=tet:9:0");
+        let error = app.error.as_deref().unwrap();
+        assert!(
+            error.contains("tet 9 is not in a body of 1 tets"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn remembered_settings_out_of_range_are_refused_with_a_message() {
+        let mut preferences = Preferences::default();
+        preferences.settings.dt = 0.0;
+        preferences.settings.compliance[Family::VOLUME] = f64::INFINITY;
+        let app = TetlabApp::with_preferences(preferences);
+        assert_eq!(
+            *app.bench.simulation.settings(),
+            Preferences::default().settings
+        );
+        let error = app.error.expect("the refusal is shown");
+        assert!(error.contains("dt 0 is out of range"), "{error}");
+    }
+}

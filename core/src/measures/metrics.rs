@@ -1,0 +1,249 @@
+//! What a frame is measured by. The CLI prints these, the recorder logs them and the GUI plots
+//! them: all from [`Metrics::measure`]. No value is replaced by a fallback: a metric that
+//! overflows is reported as it is, and [`Metrics::check`] turns it into a [`Divergence`], so that
+//! nothing that is not a number is ever printed, plotted or recorded.
+
+use crate::constraints::volume::signed_volume;
+use crate::constraints::{Constraint, Family, PerFamily, Visit};
+use crate::simulation::divergence::{Cause, Divergence};
+use crate::simulation::{ConstraintSet, Simulation};
+use glam::DVec3;
+
+/// Rest volumes at or below this fraction of the mean rest volume are left out of
+/// [`Metrics::min_volume_ratio`]: V/V₀ of a tet that had no volume means nothing.
+pub const SLIVER: f64 = 1e-9;
+
+/// Measurements of one state of a simulation. Finite for a sound state, except where
+/// [`Metrics::check`] says otherwise.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Metrics {
+    /// Tets whose signed volume is negative.
+    pub inverted_tets: usize,
+    /// min over tets of V / V₀ (tets with a positive V₀ above [`SLIVER`] of the mean |V₀|); 1 at
+    /// rest, and 1 when no tet has a rest volume.
+    pub min_volume_ratio: f64,
+    /// |ΣV − ΣV₀| / ΣV₀, the relative change of the total volume (0 when ΣV₀ is 0).
+    pub volume_error: f64,
+    /// max over edges of |l − l₀| / l₀.
+    pub max_edge_strain: f64,
+    /// max over particles of |x − x_rest|, in metres: how far the body moved from its rest
+    /// shape (a cantilever's tip deflection).
+    pub max_displacement: f64,
+    /// max over particles of |v|, in m/s.
+    pub max_speed: f64,
+    /// The centre of mass (the lumped masses' weighted mean position), in metres.
+    pub centre_of_mass: DVec3,
+    /// Root mean square of C over each family's constraints (metres for edges and heights,
+    /// cubic metres for volumes), whether or not the family is active.
+    pub residual: PerFamily<f64>,
+}
+
+impl Metrics {
+    /// The four headline measurements, by the names used in JSON, recordings and plots.
+    pub fn headline(&self) -> [(&'static str, f64); 4] {
+        [
+            ("inverted_tets", self.inverted_tets as f64),
+            ("volume_error", self.volume_error),
+            ("max_edge_strain", self.max_edge_strain),
+            ("min_volume_ratio", self.min_volume_ratio),
+        ]
+    }
+
+    /// Ok when every measurement is finite; otherwise the first that is not, as the divergence
+    /// of a state at `frame`.
+    pub fn check(&self, frame: u64) -> Result<(), Divergence> {
+        let more = [
+            ("max_displacement", self.max_displacement),
+            ("max_speed", self.max_speed),
+            ("centre_of_mass", self.centre_of_mass.length()),
+        ];
+        let all = self.headline().into_iter().chain(more);
+        if let Some((name, value)) = all.into_iter().find(|(_, v)| !v.is_finite()) {
+            return Err(Divergence::new(frame, Cause::Metric { name, value }));
+        }
+        match self.residual.iter().find(|(_, v)| !v.is_finite()) {
+            Some((family, value)) => Err(Divergence::new(frame, Cause::Residual { family, value })),
+            None => Ok(()),
+        }
+    }
+
+    /// The metrics of a sound state: [`Simulation::check`], then [`Metrics::measure`], then
+    /// [`Metrics::check`]. What every front end calls after a frame.
+    pub fn measure_sound(simulation: &Simulation) -> Result<Metrics, Divergence> {
+        simulation.check()?;
+        let metrics = Metrics::measure(simulation);
+        metrics.check(simulation.frame())?;
+        Ok(metrics)
+    }
+
+    /// Measures the current state of `simulation`.
+    pub fn measure(simulation: &Simulation) -> Metrics {
+        let positions = simulation.positions();
+        let rest_volumes = simulation.constraints(Family::VOLUME).rest();
+        let total_rest: f64 = rest_volumes.iter().sum();
+        // The scale of "a sliver": the mean size of a rest volume (a degenerate tet may be a hair
+        // negative, and a mesh of them could make a signed mean negative or zero).
+        let mean_rest =
+            rest_volumes.iter().map(|v| v.abs()).sum::<f64>() / rest_volumes.len().max(1) as f64;
+        let mut inverted_tets = 0;
+        let mut min_volume_ratio: Option<f64> = None;
+        let mut total = 0.0;
+        for (tet, &rest) in simulation.tets().iter().zip(rest_volumes) {
+            let v = signed_volume(&tet.map(|i| positions[i as usize]));
+            total += v;
+            if v < 0.0 {
+                inverted_tets += 1;
+            }
+            if rest > 0.0 && rest > SLIVER * mean_rest {
+                let ratio = v / rest;
+                min_volume_ratio = Some(min_volume_ratio.map_or(ratio, |m| smaller(m, ratio)));
+            }
+        }
+        let mut max_edge_strain: f64 = 0.0;
+        let edges = simulation.constraints(Family::EDGES);
+        for (c, &rest) in edges.rest().iter().enumerate() {
+            if rest > 0.0 {
+                let [a, b] = [edges.particles(c)[0], edges.particles(c)[1]];
+                let length = positions[a as usize].distance(positions[b as usize]);
+                max_edge_strain = larger(max_edge_strain, (length - rest).abs() / rest);
+            }
+        }
+        Metrics {
+            inverted_tets,
+            min_volume_ratio: min_volume_ratio.unwrap_or(1.0),
+            volume_error: if total_rest > 0.0 {
+                (total - total_rest).abs() / total_rest
+            } else {
+                0.0
+            },
+            max_edge_strain,
+            max_displacement: positions
+                .iter()
+                .zip(simulation.rest_positions())
+                .map(|(p, r)| p.distance(*r))
+                .fold(0.0, larger),
+            max_speed: simulation
+                .velocities()
+                .iter()
+                .map(|v| v.length())
+                .fold(0.0, larger),
+            centre_of_mass: simulation.centre_of_mass(positions),
+            residual: PerFamily::from_fn(|family| {
+                family.visit(Rms {
+                    set: simulation.constraints(family),
+                    positions,
+                    rest_positions: simulation.rest_positions(),
+                })
+            }),
+        }
+    }
+}
+
+/// The smaller of two numbers, NaN if either is (f64::min would drop a NaN).
+fn smaller(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+/// The larger of two numbers, NaN if either is.
+fn larger(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// √(mean C²) over the constraints of `set`; 0 when there are none.
+struct Rms<'a> {
+    set: &'a ConstraintSet,
+    positions: &'a [DVec3],
+    rest_positions: &'a [DVec3],
+}
+
+impl Visit for Rms<'_> {
+    type Output = f64;
+
+    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, constraint: &C) -> f64 {
+        let set = self.set;
+        if set.is_empty() {
+            return 0.0;
+        }
+        let sum: f64 = (0..set.len())
+            .map(|c| {
+                let idx: [u32; N] = std::array::from_fn(|k| set.particles(c)[k]);
+                let p = idx.map(|i| self.positions[i as usize]);
+                let shape = idx.map(|i| self.rest_positions[i as usize]);
+                constraint.evaluate(&p, set.rest()[c], &shape).value.powi(2)
+            })
+            .sum();
+        (sum / set.len() as f64).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Builtin, Scene};
+    use crate::simulation::Settings;
+    use crate::simulation::divergence::Cause;
+
+    /// Found by the fuzzer: a mesh whose tets all have (nearly) zero rest volume, two of its
+    /// points coinciding, gave V / V₀ = 0 / 0 at rest.
+    #[test]
+    fn a_mesh_of_degenerate_tets_measures_finitely_at_rest() {
+        let p = |x, y, z| DVec3::new(x, y, z);
+        let positions = vec![
+            p(0.0, 0.8, 0.0),
+            p(0.0, 0.8, 0.0),
+            p(0.5, 0.8, 0.866),
+            p(0.5, 1.6, 0.289),
+            p(0.5, 0.0, 0.289),
+        ];
+        let (mesh, report) =
+            crate::scene::mesh::TetMesh::new(positions, vec![[3, 0, 1, 2], [0, 1, 2, 4]]);
+        assert_eq!(report.degenerate_tets, 2);
+        let scene = Scene::from_mesh("coincident".into(), mesh, report);
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        let metrics = Metrics::measure_sound(&simulation).expect("finite at rest");
+        assert_eq!(
+            metrics.min_volume_ratio, 1.0,
+            "no tet has a rest volume to compare"
+        );
+        simulation.step();
+        assert!(Metrics::measure_sound(&simulation).is_ok());
+    }
+
+    #[test]
+    fn a_metric_that_overflows_is_reported_not_replaced() {
+        let tet = Scene::builtin(Builtin::Tet, 1).unwrap().mesh;
+        let tiny: Vec<DVec3> = tet.positions.iter().map(|p| *p * 1e-100).collect();
+        let (mesh, report) = crate::scene::mesh::TetMesh::new(tiny, tet.tets);
+        let scene = Scene::from_mesh("tiny".into(), mesh, report);
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        assert_eq!(Metrics::measure_sound(&simulation).map(|_| ()), Ok(()));
+        // Positions still below the sound limit of 1e30, but the tet is (1e129)³ times its rest
+        // volume: V / V₀ and the relative volume error overflow.
+        let grown: Vec<DVec3> = simulation.positions().iter().map(|p| *p * 1e129).collect();
+        simulation.set_positions(&grown);
+        assert!(simulation.is_sound());
+        let metrics = Metrics::measure(&simulation);
+        assert_eq!(metrics.min_volume_ratio, f64::INFINITY, "{metrics:?}");
+        assert_eq!(metrics.volume_error, f64::INFINITY, "{metrics:?}");
+        let divergence = Metrics::measure_sound(&simulation).unwrap_err();
+        assert!(
+            matches!(
+                divergence.cause,
+                Cause::Metric {
+                    name: "volume_error",
+                    ..
+                }
+            ),
+            "{divergence}"
+        );
+        assert!(smaller(1.0, f64::NAN).is_nan() && larger(f64::NAN, 1.0).is_nan());
+    }
+}

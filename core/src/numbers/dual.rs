@@ -1,0 +1,259 @@
+//! Forward-mode automatic differentiation for the constraint code: [`Tangent`], a dual number
+//! a + a′ε (ε² = 0) over any [`Real`], and [`DualVec3`], a 3-vector of f64 ones, as a
+//! [`Vector3`]. Any formula written over those traits (the built-in families, a constraint file's
+//! compiled program) then gives, beside its value, its derivative along one direction of the
+//! inputs: seed one coordinate's slope with 1 and read ∂C/∂x from the value's slope.
+
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
+
+use crate::numbers::vector::{Real, Vector3};
+
+/// A dual number over any [`Real`] (f64, f32, the fast solver's lanes): `value + slope ε` with
+/// ε² = 0. Its own type rather than num-dual's, whose dual numbers need a scalar primitive and so
+/// cannot carry the eight lanes of the fast solver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tangent<T> {
+    /// The value.
+    pub value: T,
+    /// Its derivative along the seeded direction.
+    pub slope: T,
+}
+
+impl<T: Real> Tangent<T> {
+    /// `value` with slope 0 (a constant) or 1 (the variable differentiated by).
+    pub fn new(value: T, slope: T) -> Self {
+        Tangent { value, slope }
+    }
+}
+
+impl<T: Real> Add for Tangent<T> {
+    type Output = Self;
+    #[inline]
+    fn add(self, b: Self) -> Self {
+        Tangent::new(self.value + b.value, self.slope + b.slope)
+    }
+}
+impl<T: Real> Sub for Tangent<T> {
+    type Output = Self;
+    #[inline]
+    fn sub(self, b: Self) -> Self {
+        Tangent::new(self.value - b.value, self.slope - b.slope)
+    }
+}
+impl<T: Real> Mul for Tangent<T> {
+    type Output = Self;
+    /// (a + a′ε)(b + b′ε) = ab + (a′b + ab′)ε.
+    #[inline]
+    fn mul(self, b: Self) -> Self {
+        Tangent::new(
+            self.value * b.value,
+            self.slope * b.value + self.value * b.slope,
+        )
+    }
+}
+impl<T: Real> Div for Tangent<T> {
+    type Output = Self;
+    /// (a + a′ε) / (b + b′ε) = a/b + (a′b − ab′)/b² ε.
+    #[inline]
+    fn div(self, b: Self) -> Self {
+        Tangent::new(
+            self.value / b.value,
+            (self.slope * b.value - self.value * b.slope) / (b.value * b.value),
+        )
+    }
+}
+impl<T: Real> Neg for Tangent<T> {
+    type Output = Self;
+    #[inline]
+    fn neg(self) -> Self {
+        Tangent::new(-self.value, -self.slope)
+    }
+}
+impl<T: Real> AddAssign for Tangent<T> {
+    #[inline]
+    fn add_assign(&mut self, b: Self) {
+        *self = *self + b;
+    }
+}
+impl<T: Real> SubAssign for Tangent<T> {
+    #[inline]
+    fn sub_assign(&mut self, b: Self) {
+        *self = *self - b;
+    }
+}
+
+impl<T: Real> Real for Tangent<T> {
+    type Mask = T::Mask;
+    const ZERO: Self = Tangent {
+        value: T::ZERO,
+        slope: T::ZERO,
+    };
+    const ONE: Self = Tangent {
+        value: T::ONE,
+        slope: T::ZERO,
+    };
+    const EPSILON: Self = Tangent {
+        value: T::EPSILON,
+        slope: T::ZERO,
+    };
+    const MIN_POSITIVE: Self = Tangent {
+        value: T::MIN_POSITIVE,
+        slope: T::ZERO,
+    };
+    #[inline]
+    fn from_f64(x: f64) -> Self {
+        Tangent::new(T::from_f64(x), T::ZERO)
+    }
+    /// √(a + a′ε) = √a + a′ / (2√a) ε.
+    #[inline]
+    fn sqrt(self) -> Self {
+        let root = self.value.sqrt();
+        Tangent::new(root, self.slope / (root + root))
+    }
+    #[inline]
+    fn finite(self) -> T::Mask {
+        self.value.finite() & self.slope.finite()
+    }
+    #[inline]
+    fn le(self, other: Self) -> T::Mask {
+        self.value.le(other.value)
+    }
+    #[inline]
+    fn gt(self, other: Self) -> T::Mask {
+        self.value.gt(other.value)
+    }
+    #[inline]
+    fn select(mask: T::Mask, if_true: Self, if_false: Self) -> Self {
+        Tangent::new(
+            T::select(mask, if_true.value, if_false.value),
+            T::select(mask, if_true.slope, if_false.slope),
+        )
+    }
+}
+
+/// A dual number over f64.
+pub type Dual64 = Tangent<f64>;
+
+/// A 3-vector of dual numbers over f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualVec3(pub [Dual64; 3]);
+
+impl DualVec3 {
+    /// The point `p` with the slopes `direction`.
+    pub fn seeded(p: glam::DVec3, direction: glam::DVec3) -> Self {
+        DualVec3([0, 1, 2].map(|i| Tangent::new(p[i], direction[i])))
+    }
+}
+
+impl Add for DualVec3 {
+    type Output = Self;
+    fn add(self, b: Self) -> Self {
+        DualVec3([0, 1, 2].map(|i| self.0[i] + b.0[i]))
+    }
+}
+impl Sub for DualVec3 {
+    type Output = Self;
+    fn sub(self, b: Self) -> Self {
+        DualVec3([0, 1, 2].map(|i| self.0[i] - b.0[i]))
+    }
+}
+impl Neg for DualVec3 {
+    type Output = Self;
+    fn neg(self) -> Self {
+        DualVec3(self.0.map(|x| -x))
+    }
+}
+impl Mul<Dual64> for DualVec3 {
+    type Output = Self;
+    fn mul(self, k: Dual64) -> Self {
+        DualVec3(self.0.map(|x| x * k))
+    }
+}
+impl Div<Dual64> for DualVec3 {
+    type Output = Self;
+    fn div(self, k: Dual64) -> Self {
+        DualVec3(self.0.map(|x| x / k))
+    }
+}
+impl AddAssign for DualVec3 {
+    fn add_assign(&mut self, b: Self) {
+        *self = *self + b;
+    }
+}
+impl SubAssign for DualVec3 {
+    fn sub_assign(&mut self, b: Self) {
+        *self = *self - b;
+    }
+}
+
+impl Vector3 for DualVec3 {
+    type Real = Dual64;
+    const ZERO: Self = DualVec3([Dual64::ZERO; 3]);
+    fn dot(self, b: Self) -> Dual64 {
+        self.0[0] * b.0[0] + self.0[1] * b.0[1] + self.0[2] * b.0[2]
+    }
+    fn cross(self, b: Self) -> Self {
+        let (a, b) = (self.0, b.0);
+        DualVec3([
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ])
+    }
+    fn from_f64s(x: f64, y: f64, z: f64) -> Self {
+        DualVec3([x, y, z].map(Dual64::from_f64))
+    }
+    fn y(self) -> Dual64 {
+        self.0[1]
+    }
+    fn set_y(&mut self, y: Dual64) {
+        self.0[1] = y;
+    }
+    fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
+        if mask { if_true } else { if_false }
+    }
+    fn to_array(self) -> [Dual64; 3] {
+        self.0
+    }
+    fn from_array(a: [Dual64; 3]) -> Self {
+        DualVec3(a)
+    }
+}
+
+/// ∇C by forward-mode automatic differentiation: for every coordinate of every point, `value`
+/// evaluated on dual numbers seeded with slope 1 on that coordinate; ∂C/∂x is the value's slope.
+/// `None` when a derivative is not finite (a length or normalisation of a zero vector, a
+/// division by zero: the gradient is undefined there).
+///
+/// ```
+/// use glam::DVec3;
+/// use tetlab_core::numbers::dual::{gradient, DualVec3};
+/// use tetlab_core::numbers::vector::Vector3;
+/// // C = |p0 − p1|: ∇p0 C is the unit vector from p1 to p0, ∇p1 C its negative.
+/// let points = [DVec3::new(3.0, 0.0, 4.0), DVec3::ZERO];
+/// let g = gradient(&points, |p: &[DualVec3]| (p[0] - p[1]).length()).unwrap();
+/// assert!((g[0] - DVec3::new(0.6, 0.0, 0.8)).length() < 1e-15);
+/// assert_eq!(g[1], -g[0]);
+/// ```
+pub fn gradient(
+    points: &[glam::DVec3],
+    mut value: impl FnMut(&[DualVec3]) -> Dual64,
+) -> Option<Vec<glam::DVec3>> {
+    let mut seeded: Vec<DualVec3> = points
+        .iter()
+        .map(|&p| DualVec3::seeded(p, glam::DVec3::ZERO))
+        .collect();
+    let mut gradients = vec![glam::DVec3::ZERO; points.len()];
+    for (i, gradient) in gradients.iter_mut().enumerate() {
+        for axis in 0..3 {
+            seeded[i].0[axis].slope = 1.0;
+            let d = value(&seeded).slope;
+            seeded[i].0[axis].slope = 0.0;
+            if !d.is_finite() {
+                return None;
+            }
+            gradient[axis] = d;
+        }
+    }
+    Some(gradients)
+}

@@ -1,0 +1,165 @@
+//! The constraints of one family as the reference solver keeps them: flat arrays, one entry per
+//! constraint in the binding's order (the particles, `arity` of them each; the rest value; the
+//! XPBD multiplier λ), built once from the family's binding to the mesh, and the order a sweep
+//! projects them in (the binding's, or a permutation drawn from an order seed).
+
+use crate::constraints::material::Material;
+use crate::constraints::{Constraint, Family, Visit};
+use crate::scene::mesh::TetMesh;
+use glam::DVec3;
+
+/// One family's constraints.
+#[derive(Clone, Debug, Default)]
+pub struct ConstraintSet {
+    /// The family's definition it was built from ([`Family::generation`]); `None` before it is
+    /// built.
+    generation: Option<u64>,
+    arity: usize,
+    particles: Vec<u32>,
+    rest: Vec<f64>,
+    lambda: Vec<f64>,
+    /// The size of each constraint's element: the longest rest edge among its particles, what
+    /// its reach is measured in ([`crate::simulation::Settings::reach`]).
+    size: Vec<f64>,
+    /// The order a sweep projects the constraints in; empty for 0, 1, 2, …
+    /// ([`crate::simulation::Settings::order_seed`]).
+    order: Vec<u32>,
+}
+
+impl ConstraintSet {
+    /// The constraints of `family` on `mesh` ([`crate::constraints::Binding::particles`]), each
+    /// with its rest value measured on the mesh's rest positions ([`Constraint::rest_value`]).
+    pub(crate) fn new(family: Family, mesh: &TetMesh, material: &Material) -> ConstraintSet {
+        let particles = family.row().binding.particles(mesh);
+        let size = particles
+            .chunks_exact(family.arity())
+            .map(|idx| {
+                crate::scene::mesh::longest_edge(idx.iter().map(|&i| mesh.positions[i as usize]))
+            })
+            .collect();
+        let mut set = ConstraintSet {
+            generation: Some(family.generation()),
+            arity: family.arity(),
+            lambda: vec![0.0; particles.len() / family.arity()],
+            particles,
+            rest: Vec::new(),
+            size,
+            order: Vec::new(),
+        };
+        set.measure_rest(family, &mesh.positions, material);
+        set
+    }
+
+    /// Measures the rest values again on `rest_positions`, with `material` (for a family whose
+    /// rest values depend on it, when the material changes).
+    pub(crate) fn measure_rest(
+        &mut self,
+        family: Family,
+        rest_positions: &[DVec3],
+        material: &Material,
+    ) {
+        struct RestValues<'a>(&'a [u32], &'a [DVec3], &'a Material);
+        impl Visit for RestValues<'_> {
+            type Output = Vec<f64>;
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Vec<f64> {
+                let (particles, positions, material) = (self.0, self.1, self.2);
+                let (groups, _) = particles.as_chunks::<N>();
+                groups
+                    .iter()
+                    .map(|idx| c.rest_value(&idx.map(|i| positions[i as usize]), material))
+                    .collect()
+            }
+        }
+        self.rest = family.visit(RestValues(&self.particles, rest_positions, material));
+    }
+
+    /// Whether it was built from the definition of `family` now in force.
+    pub(crate) fn is_current(&self, family: Family) -> bool {
+        self.generation == Some(family.generation())
+    }
+
+    /// Whether it was built at all (the sets of families that joined the table after the
+    /// simulation was made are built when they are switched on).
+    pub(crate) fn is_built(&self) -> bool {
+        self.generation.is_some()
+    }
+
+    /// The number of constraints.
+    pub fn len(&self) -> usize {
+        self.rest.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.rest.is_empty()
+    }
+
+    /// How many particles each constraint touches.
+    pub fn arity(&self) -> usize {
+        self.arity
+    }
+
+    /// The particles of constraint `c`, in the constraint's own order.
+    pub fn particles(&self, c: usize) -> &[u32] {
+        &self.particles[c * self.arity..(c + 1) * self.arity]
+    }
+
+    /// The particles of every constraint, flat (`arity` per constraint).
+    pub fn all_particles(&self) -> &[u32] {
+        &self.particles
+    }
+
+    /// The particles of constraint `c` as an array of the family's arity `N`.
+    #[inline]
+    pub(crate) fn indices<const N: usize>(&self, c: usize) -> [u32; N] {
+        debug_assert_eq!(N, self.arity);
+        let (groups, _) = self.particles.as_chunks::<N>();
+        groups[c]
+    }
+
+    /// The rest value (d, V) of each constraint.
+    pub fn rest(&self) -> &[f64] {
+        &self.rest
+    }
+
+    /// The size of each constraint's element: the longest rest edge among its particles.
+    pub fn size(&self) -> &[f64] {
+        &self.size
+    }
+
+    /// The XPBD multiplier λ of each constraint, accumulated within the current substep.
+    pub fn lambda(&self) -> &[f64] {
+        &self.lambda
+    }
+
+    /// λ of constraint `c` grows by `delta`.
+    #[inline]
+    pub(crate) fn add_lambda(&mut self, c: usize, delta: f64) {
+        self.lambda[c] += delta;
+    }
+
+    /// λ = 0 for every constraint (a new substep).
+    pub(crate) fn reset_lambda(&mut self) {
+        self.lambda.fill(0.0);
+    }
+
+    /// Sets the order a sweep projects the constraints in: a permutation of 0..len, or `None`
+    /// for the binding's order.
+    pub(crate) fn set_order(&mut self, order: Option<Vec<u32>>) {
+        self.order = order.unwrap_or_default();
+        debug_assert!(self.order.is_empty() || self.order.len() == self.len());
+    }
+
+    /// The constraint a sweep projects `k`-th.
+    #[inline]
+    pub fn in_order(&self, k: usize) -> usize {
+        self.order.get(k).map_or(k, |&c| c as usize)
+    }
+
+    /// The bytes its arrays take (their capacities).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        (self.particles.capacity() + self.order.capacity()) * size_of::<u32>()
+            + (self.rest.capacity() + self.lambda.capacity() + self.size.capacity())
+                * size_of::<f64>()
+    }
+}

@@ -1,0 +1,344 @@
+//! The fast solver's kernels: a family's constraints projected colour by colour, eight elements
+//! (edges, tets or a tet's vertices) at a time in SIMD lanes, through the generic formula
+//! ([`Constraint`]) and projection rule ([`correction_lanes`]); threads share large colours.
+//!
+//! A batch's particles are gathered into registers, its constraints projected there, and the
+//! corrections added to the positions (Gauss–Seidel) or to the Jacobi sums.
+
+use super::batches::{Batches, Layout, Typed};
+use super::particles::Particles;
+use crate::constraints::Constraint;
+use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
+use crate::numbers::vector::{Real, Vector3};
+use crate::simulation::projection::{Rule, SkipCounts, correction_lanes, pair_correction_lanes};
+use glam::Vec3A;
+
+/// Colours with fewer elements than this are projected on one thread even when several are
+/// available: below it, handing out the work costs more than it saves.
+pub const PARALLEL_MIN: usize = 1024;
+
+/// Batches per task when threads share a colour. Which thread projects a batch does not change
+/// what it computes, so the result is the same bits for any thread count.
+#[cfg(feature = "parallel")]
+const CHUNK: usize = 64;
+
+/// The particles `indices` (one per lane) as eight x, eight y and eight z.
+#[inline(always)]
+fn gather(positions: Particles, indices: [u32; LANES]) -> Vec3x8 {
+    let [i0, i1, i2, i3, i4, i5, i6, i7] = indices;
+    Vec3x8::from_rows([
+        positions.get(i0),
+        positions.get(i1),
+        positions.get(i2),
+        positions.get(i3),
+        positions.get(i4),
+        positions.get(i5),
+        positions.get(i6),
+        positions.get(i7),
+    ])
+}
+
+/// Every particle of a batch, gathered.
+#[inline(always)]
+fn gather_batch<const N: usize>(positions: Particles, indices: &[[u32; LANES]; N]) -> [Vec3x8; N] {
+    let mut p = [Vec3x8::ZERO; N];
+    for (p, &indices) in p.iter_mut().zip(indices) {
+        *p = gather(positions, indices);
+    }
+    p
+}
+
+/// Adds lane k of `delta` to particle `indices[k]`.
+#[inline(always)]
+fn scatter_add(positions: Particles, indices: [u32; LANES], delta: Vec3x8) {
+    for (&i, row) in indices.iter().zip(delta.rows()) {
+        positions.add(i, row);
+    }
+}
+
+/// Where the kernels read and write: the positions (or their rest shape, for a family that reads
+/// it), and where corrections go: the same positions for Gauss–Seidel, the sums for Jacobi.
+#[derive(Clone, Copy)]
+struct Access<'a> {
+    read: Particles<'a>,
+    rest_shape: Particles<'a>,
+    /// The Jacobi sums, when projecting in Jacobi order.
+    sums: Option<Particles<'a>>,
+}
+
+/// Projects batches of elements that share no particle, one constraint per element: the
+/// corrections are added to the positions (Gauss–Seidel) or, in Jacobi order, to the sums.
+/// Returns the projections skipped for a counted reason.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn project_batches<const N: usize, C: Constraint<N>>(
+    constraint: &C,
+    particles: &[[[u32; LANES]; N]],
+    weights: &[[F32x8; N]],
+    (size, reach): (&[F32x8], F32x8),
+    rest: &[F32x8],
+    lambda: &mut [F32x8],
+    access: Access,
+    rule: Rule<F32x8>,
+) -> SkipCounts {
+    let mut skips = SkipCounts::default();
+    let read = access.read;
+    let write = access.sums.unwrap_or(read);
+    // The next batch is gathered before this one is written (they share no particle), so that
+    // its loads overlap this one's arithmetic.
+    let mut next = particles.first().map(|indices| gather_batch(read, indices));
+    for (b, (((indices, weights), size), (rest, lambda))) in particles
+        .iter()
+        .zip(weights)
+        .zip(size)
+        .zip(rest.iter().zip(lambda.iter_mut()))
+        .enumerate()
+    {
+        let Some(p) = next else { break };
+        next = particles
+            .get(b + 1)
+            .map(|indices| gather_batch(read, indices));
+        let shape = if C::USES_REST_SHAPE {
+            gather_batch(access.rest_shape, indices)
+        } else {
+            p
+        };
+        let evaluation = constraint.evaluate(&p, *rest, &shape);
+        let (skipped, d) = correction_lanes(evaluation, *weights, *lambda, rule, *size * reach);
+        skips.add(skipped);
+        *lambda += d.delta_lambda;
+        for (&indices, delta) in indices.iter().zip(d.delta_x) {
+            scatter_add(write, indices, delta);
+        }
+    }
+    skips
+}
+
+/// The colour projected `k`-th: `order[k]`, or `k` when `order` is empty (the layout's order).
+#[inline]
+fn in_order(order: &[u32], k: usize) -> usize {
+    order.get(k).map_or(k, |&c| c as usize)
+}
+
+/// Projects every constraint of a family (`batches`, on `layout`), colour by colour in `order`
+/// (empty: the layout's), moving `positions` (Gauss–Seidel) or, given `sums`, adding the
+/// corrections to `sums` (Jacobi: `positions` stay as they are); with `parallel`, large colours
+/// are shared by the threads of the current pool. Returns how many constraints it projected, and
+/// how many of them were skipped for a counted reason.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
+    constraint: &C,
+    layout: &Layout,
+    order: &[u32],
+    batches: &mut Batches,
+    (positions, residuals): (&mut [Vec3A], &mut [Vec3A]),
+    rest_positions: &mut [Vec3A],
+    sums: Option<&mut [Vec3A]>,
+    (rule, reach): (Rule<f64>, f64),
+    parallel: bool,
+) -> (usize, SkipCounts) {
+    let rule: Rule<F32x8> = rule.to();
+    let reach = F32x8::from_f64(reach);
+    let Typed {
+        particles,
+        weights,
+        size,
+        colours,
+        particle_count,
+    } = layout.typed::<N>();
+    let (rest, lambda) = batches.rows();
+    let access = Access {
+        read: Particles::compensated(positions, residuals, particle_count),
+        rest_shape: Particles::new(rest_positions, particle_count),
+        sums: sums.map(|sums| Particles::new(sums, particle_count)),
+    };
+    let mut count = 0;
+    let mut skips = SkipCounts::default();
+    for k in 0..colours.len() {
+        let colour = &colours[in_order(order, k)];
+        let range = colour.batches.clone();
+        let (particles, weights, size, rest, lambda) = (
+            &particles[range.clone()],
+            &weights[range.clone()],
+            &size[range.clone()],
+            &rest[range.clone()],
+            &mut lambda[range],
+        );
+        let skipped = match parallel && colour.elements >= PARALLEL_MIN {
+            #[cfg(feature = "parallel")]
+            true => {
+                use rayon::prelude::*;
+                lambda
+                    .par_chunks_mut(CHUNK)
+                    .zip(particles.par_chunks(CHUNK))
+                    .zip(weights.par_chunks(CHUNK))
+                    .zip(size.par_chunks(CHUNK).zip(rest.par_chunks(CHUNK)))
+                    .map(|(((lambda, particles), weights), (size, rest))| {
+                        project_batches::<N, C>(
+                            constraint,
+                            particles,
+                            weights,
+                            (size, reach),
+                            rest,
+                            lambda,
+                            access,
+                            rule,
+                        )
+                    })
+                    .reduce(SkipCounts::default, |a, b| a + b)
+            }
+            _ => project_batches::<N, C>(
+                constraint,
+                particles,
+                weights,
+                (size, reach),
+                rest,
+                lambda,
+                access,
+                rule,
+            ),
+        };
+        skips = skips + skipped;
+        count += colour.elements;
+    }
+    (count, skips)
+}
+
+/// [`project_batches`] for two families projected together ([`pair_correction_lanes`]): one
+/// constraint of each per element, on the same layout; each has its own rest values and
+/// multipliers.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
+    (first, second): (&A, &B),
+    particles: &[[[u32; LANES]; N]],
+    (weights, size, reach): (&[[F32x8; N]], &[F32x8], F32x8),
+    (rest_a, rest_b): (&[F32x8], &[F32x8]),
+    (lambda_a, lambda_b): (&mut [F32x8], &mut [F32x8]),
+    access: Access,
+    rules: [Rule<F32x8>; 2],
+) -> [SkipCounts; 2] {
+    assert_eq!(N, M, "a pair shares its particles");
+    let mut skips = [SkipCounts::default(); 2];
+    for (b, (indices, weights)) in particles.iter().zip(weights).enumerate() {
+        let p = gather_batch(access.read, indices);
+        let shape = if A::USES_REST_SHAPE || B::USES_REST_SHAPE {
+            gather_batch(access.rest_shape, indices)
+        } else {
+            p
+        };
+        let first_evaluation = first.evaluate(&p, rest_a[b], &shape);
+        let p2: [Vec3x8; M] = std::array::from_fn(|k| p[k]);
+        let shape2: [Vec3x8; M] = std::array::from_fn(|k| shape[k]);
+        let e = second.evaluate(&p2, rest_b[b], &shape2);
+        let second_evaluation = crate::constraints::Evaluation {
+            value: e.value,
+            gradients: std::array::from_fn(|k| e.gradients[k]),
+            degenerate: e.degenerate,
+        };
+        let d = pair_correction_lanes(
+            first_evaluation,
+            second_evaluation,
+            *weights,
+            [lambda_a[b], lambda_b[b]],
+            rules,
+            size[b] * reach,
+        );
+        for (counts, skipped) in skips.iter_mut().zip(d.skipped) {
+            counts.add(skipped);
+        }
+        lambda_a[b] += d.delta_lambda[0];
+        lambda_b[b] += d.delta_lambda[1];
+        for (i, &indices) in indices.iter().enumerate() {
+            match access.sums {
+                Some(sums) => scatter_add(sums, indices, d.delta_x[i]),
+                None => scatter_add(access.read, indices, d.delta_x[i]),
+            }
+        }
+    }
+    skips
+}
+
+/// [`project_family`] for two families projected together, element by element (the neo-Hookean
+/// pair: one constraint of each per tet, on the same layout). Returns how many constraints of
+/// each it projected, and how many of each were skipped for a counted reason.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>(
+    constraints: (&A, &B),
+    layout: &Layout,
+    order: &[u32],
+    (first, second): (&mut Batches, &mut Batches),
+    (positions, residuals): (&mut [Vec3A], &mut [Vec3A]),
+    rest_positions: &mut [Vec3A],
+    sums: Option<&mut [Vec3A]>,
+    (rules, reach): ([Rule<f64>; 2], f64),
+    parallel: bool,
+) -> (usize, [SkipCounts; 2]) {
+    let rules: [Rule<F32x8>; 2] = rules.map(Rule::to);
+    let reach = F32x8::from_f64(reach);
+    let Typed {
+        particles,
+        weights,
+        size,
+        colours,
+        particle_count,
+    } = layout.typed::<N>();
+    let (rest_a, lambda_a) = first.rows();
+    let (rest_b, lambda_b) = second.rows();
+    let access = Access {
+        read: Particles::compensated(positions, residuals, particle_count),
+        rest_shape: Particles::new(rest_positions, particle_count),
+        sums: sums.map(|sums| Particles::new(sums, particle_count)),
+    };
+    let mut count = 0;
+    let mut skips = [SkipCounts::default(); 2];
+    let add = |a: [SkipCounts; 2], b: [SkipCounts; 2]| [a[0] + b[0], a[1] + b[1]];
+    for k in 0..colours.len() {
+        let colour = &colours[in_order(order, k)];
+        let range = colour.batches.clone();
+        let (particles, weights) = (&particles[range.clone()], &weights[range.clone()]);
+        let size = &size[range.clone()];
+        let rest = (&rest_a[range.clone()], &rest_b[range.clone()]);
+        let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
+        let skipped = match parallel && colour.elements >= PARALLEL_MIN {
+            #[cfg(feature = "parallel")]
+            true => {
+                use rayon::prelude::*;
+                lambda_a
+                    .par_chunks_mut(CHUNK)
+                    .zip(lambda_b.par_chunks_mut(CHUNK))
+                    .zip(particles.par_chunks(CHUNK))
+                    .zip(weights.par_chunks(CHUNK).zip(size.par_chunks(CHUNK)))
+                    .zip(rest.0.par_chunks(CHUNK).zip(rest.1.par_chunks(CHUNK)))
+                    .map(
+                        |((((lambda_a, lambda_b), particles), (weights, size)), rest)| {
+                            project_pair_batches::<N, A, M, B>(
+                                constraints,
+                                particles,
+                                (weights, size, reach),
+                                rest,
+                                (lambda_a, lambda_b),
+                                access,
+                                rules,
+                            )
+                        },
+                    )
+                    .reduce(|| [SkipCounts::default(); 2], add)
+            }
+            _ => project_pair_batches::<N, A, M, B>(
+                constraints,
+                particles,
+                (weights, size, reach),
+                rest,
+                (lambda_a, lambda_b),
+                access,
+                rules,
+            ),
+        };
+        skips = add(skips, skipped);
+        count += colour.elements;
+    }
+    (count, skips)
+}

@@ -1,0 +1,375 @@
+//! The projection rule both solvers share: how one constraint moves its particles, in any
+//! precision and for one constraint or eight in SIMD lanes.
+//!
+//! Projecting one constraint C with particles i, gradients ∇ᵢC and inverse masses wᵢ:
+//! - XPBD: α̃ = α / h², Δλ = (−C − α̃ λ) / (Σ wᵢ|∇ᵢC|² + α̃), λ += Δλ, Δxᵢ = wᵢ ∇ᵢC Δλ;
+//! - PBD: s = −C / Σ wᵢ|∇ᵢC|², Δxᵢ = k′ s wᵢ ∇ᵢC with k′ = 1 − (1 − k)^(1/iterations), so that
+//!   `iterations` sweeps of stiffness k′ compound to k;
+//! - PBD on a family whose compliance a material gives (the neo-Hookean pair, which has no
+//!   stiffness k): Δλ = −C / (Σ wᵢ|∇ᵢC|² + α̃) in every sweep, XPBD without the multiplier's
+//!   memory, so that more sweeps make the material stiffer, as in PBD.
+//!
+//! A constraint is skipped (no correction) where its evaluation is degenerate (undefined ∇C),
+//! where every particle is fixed, where it is [`LOCKED`], and where its step would be longer
+//! than [`DEFAULT_REACH`] times the longest rest edge of its element: such a step is not a correction
+//! but a singularity of ∇C (see [`DEFAULT_REACH`]). The degenerate and the too long are counted
+//! ([`Skips`]).
+
+pub use super::settings::DEFAULT_REACH;
+use super::settings::{Method, Settings};
+use crate::constraints::{Evaluation, Family};
+use crate::numbers::vector::{Real, Vector3};
+use glam::DVec3;
+
+/// The change one projection makes: Δλ (XPBD; the scaled step s for PBD) and Δx per particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Correction<const N: usize, V: Vector3 = DVec3> {
+    /// XPBD: Δλ. PBD: k′ s.
+    pub delta_lambda: V::Real,
+    /// Δx for each particle of the constraint.
+    pub delta_x: [V; N],
+}
+
+/// How a correction is scaled: XPBD with α̃ = α / h², or PBD with the per-iteration stiffness k′.
+#[derive(Clone, Copy, Debug)]
+pub enum Rule<R> {
+    /// XPBD with α̃ = α / h².
+    Xpbd {
+        /// α̃ = α / h².
+        alpha_tilde: R,
+    },
+    /// PBD with the per-sweep stiffness k′.
+    Pbd {
+        /// k′ = 1 − (1 − k)^(1/iterations).
+        k: R,
+    },
+    /// PBD with a compliance: each sweep starts from λ = 0.
+    CompliantPbd {
+        /// α̃ = α / h².
+        alpha_tilde: R,
+    },
+}
+
+impl Rule<f64> {
+    /// The rule `settings` give `family` in a substep of length h: XPBD α̃ = α / h², or PBD
+    /// k′ = 1 − (1 − k)^(1/iterations), so that the sweeps of a substep compound to k.
+    pub fn for_settings(settings: &Settings, family: Family, h: f64) -> Rule<f64> {
+        match settings.method {
+            Method::Xpbd => Rule::Xpbd {
+                alpha_tilde: settings.compliance[family] / (h * h),
+            },
+            Method::Pbd if family.row().compliance_from_material.is_some() => Rule::CompliantPbd {
+                alpha_tilde: settings.compliance[family] / (h * h),
+            },
+            Method::Pbd => {
+                let k = settings.stiffness[family].clamp(0.0, 1.0);
+                let n = settings.iterations.max(1) as f64;
+                Rule::Pbd {
+                    k: 1.0 - (1.0 - k).powf(1.0 / n),
+                }
+            }
+        }
+    }
+
+    /// The same rule in another precision.
+    pub fn to<R: Real>(self) -> Rule<R> {
+        match self {
+            Rule::Xpbd { alpha_tilde } => Rule::Xpbd {
+                alpha_tilde: R::from_f64(alpha_tilde),
+            },
+            Rule::Pbd { k } => Rule::Pbd { k: R::from_f64(k) },
+            Rule::CompliantPbd { alpha_tilde } => Rule::CompliantPbd {
+                alpha_tilde: R::from_f64(alpha_tilde),
+            },
+        }
+    }
+}
+
+/// The correction that projecting one constraint would make, or `None` when it is skipped
+/// (degenerate, every particle pinned, or a step longer than `reach`, [`DEFAULT_REACH`]). In any
+/// precision: the f64 path and the fast f32 path share it, through [`correction_lanes`].
+#[inline]
+pub(crate) fn correction<V: Vector3, const N: usize>(
+    evaluation: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: V::Real,
+    rule: Rule<V::Real>,
+    reach: V::Real,
+) -> Option<Correction<N, V>>
+where
+    V::Real: Real<Mask = bool>,
+{
+    let (skipped, correction) = correction_lanes(evaluation, weights, lambda, rule, reach);
+    (!skipped.any()).then_some(correction)
+}
+
+/// Whether a projection (or each lane of one) was skipped (`all`), and the reasons that are
+/// counted: its ∇C undefined or not finite where some particle could move (`degenerate`), or its
+/// step longer than its reach (`too_long`). A constraint whose particles are all fixed (or
+/// [`LOCKED`]) is skipped without being counted: that is a pin, not a fault.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Skipped<M> {
+    /// Skipped, for any reason.
+    pub all: M,
+    /// ∇C undefined (degenerate, or not finite).
+    pub degenerate: M,
+    /// The step, max |Δxᵢ|, longer than the reach.
+    pub too_long: M,
+}
+
+impl<M: crate::numbers::vector::Mask> Skipped<M> {
+    /// Whether it (some lane of it) was skipped.
+    #[inline(always)]
+    pub fn any(self) -> bool {
+        self.all.any()
+    }
+}
+
+/// Projections skipped for a counted reason ([`Skipped`]), summed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SkipCounts {
+    /// With ∇C undefined or not finite.
+    pub degenerate: u64,
+    /// With a step longer than the reach ([`DEFAULT_REACH`]).
+    pub too_long: u64,
+}
+
+impl SkipCounts {
+    /// Adds the lanes `skipped` flags.
+    #[inline(always)]
+    pub(crate) fn add<M: crate::numbers::vector::Mask>(&mut self, skipped: Skipped<M>) {
+        self.degenerate += u64::from(skipped.degenerate.count());
+        self.too_long += u64::from(skipped.too_long.count());
+    }
+
+    /// Whether none was skipped.
+    pub fn is_zero(&self) -> bool {
+        *self == SkipCounts::default()
+    }
+}
+
+impl std::ops::Add for SkipCounts {
+    type Output = SkipCounts;
+    fn add(self, other: SkipCounts) -> SkipCounts {
+        SkipCounts {
+            degenerate: self.degenerate + other.degenerate,
+            too_long: self.too_long + other.too_long,
+        }
+    }
+}
+
+/// The projection rule without a branch, for one constraint or several in lanes:
+/// Σ wᵢ|∇ᵢC|²; XPBD Δλ = (−C − α̃λ) / (Σ wᵢ|∇ᵢC|² + α̃), PBD Δλ = −k′C / Σ wᵢ|∇ᵢC|²; Δxᵢ = wᵢ ∇ᵢC Δλ.
+/// The correction is zero where the evaluation is degenerate, where Σ wᵢ|∇ᵢC|² is not positive
+/// and finite (every particle fixed), where the constraint is [`LOCKED`] (its free particles
+/// can barely change it), and where the step max |Δxᵢ| is longer than `reach` (or not a number);
+/// the counted reasons are returned ([`Skipped`]).
+#[inline(always)]
+pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
+    evaluation: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: V::Real,
+    rule: Rule<V::Real>,
+    reach: V::Real,
+) -> (Skipped<<V::Real as Real>::Mask>, Correction<N, V>) {
+    let (skipped, degenerate, weighted_norm, largest) = skipped_lanes(&evaluation, &weights);
+    let delta_lambda = match rule {
+        Rule::Xpbd { alpha_tilde } => {
+            (-evaluation.value - alpha_tilde * lambda) / (weighted_norm + alpha_tilde)
+        }
+        Rule::Pbd { k } => k * -evaluation.value / weighted_norm,
+        Rule::CompliantPbd { alpha_tilde } => -evaluation.value / (weighted_norm + alpha_tilde),
+    };
+    // The longest step, max |Δxᵢ|² = Δλ² max wᵢ²|∇ᵢC|², from the norms already taken. A step
+    // that is not a number is not "too long": it reaches the positions, and the divergence check
+    // names it.
+    let too_long = !skipped & (delta_lambda * delta_lambda * largest).gt(reach * reach);
+    let skipped = skipped | too_long;
+    let mut delta_x = [V::ZERO; N];
+    for ((dx, g), w) in delta_x.iter_mut().zip(&evaluation.gradients).zip(weights) {
+        *dx = V::select(skipped, V::ZERO, *g * (w * delta_lambda));
+    }
+    (
+        Skipped {
+            all: skipped,
+            degenerate,
+            too_long,
+        },
+        Correction {
+            delta_lambda: V::Real::select(skipped, V::Real::ZERO, delta_lambda),
+            delta_x,
+        },
+    )
+}
+
+/// What [`skipped_lanes`] finds: whether each lane is skipped, which of those are counted as
+/// degenerate, Σ wᵢ|∇ᵢC|², and max wᵢ²|∇ᵢC|².
+type Norms<R> = (<R as Real>::Mask, <R as Real>::Mask, R, R);
+
+/// Whether a projection skips the constraint (degenerate, every particle fixed, or [`LOCKED`]);
+/// of those, the degenerate ones where some particle is free (the ones counted);
+/// Σ wᵢ|∇ᵢC|²; and max wᵢ²|∇ᵢC|², the longest step per unit Δλ, squared.
+#[inline(always)]
+fn skipped_lanes<V: Vector3, const N: usize>(
+    evaluation: &Evaluation<V, N>,
+    weights: &[V::Real; N],
+) -> Norms<V::Real> {
+    // Σ wᵢ|∇ᵢC|², max wᵢ²|∇ᵢC|², and for LOCKED max wᵢ and Σ|∇ᵢC|², in one pass.
+    let mut weighted_norm = V::Real::ZERO;
+    let mut norm = V::Real::ZERO;
+    let mut heaviest = V::Real::ZERO;
+    let mut largest = V::Real::ZERO;
+    for (w, g) in weights.iter().zip(&evaluation.gradients) {
+        let squared = g.length_squared();
+        let weighted = *w * squared;
+        weighted_norm += weighted;
+        norm += squared;
+        heaviest = V::Real::select(w.gt(heaviest), *w, heaviest);
+        let reach = *w * weighted;
+        largest = V::Real::select(reach.gt(largest), reach, largest);
+    }
+    let locked = weighted_norm.le(V::Real::from_f64(LOCKED) * heaviest * norm);
+    let undefined = evaluation.degenerate | !weighted_norm.finite();
+    let skipped = undefined | !weighted_norm.gt(V::Real::ZERO) | locked;
+    (
+        skipped,
+        undefined & heaviest.gt(V::Real::ZERO),
+        weighted_norm,
+        largest,
+    )
+}
+
+/// What projecting two constraints of the same particles together makes: Δλ of each and the
+/// particles' Δx.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairCorrection<const N: usize, V: Vector3 = DVec3> {
+    /// Δλ of the first and of the second constraint (0 for one that is skipped).
+    pub delta_lambda: [V::Real; 2],
+    /// Δx for each particle.
+    pub delta_x: [V; N],
+    /// Why each of the two was skipped, among the counted reasons (a step too long skips both).
+    pub skipped: [Skipped<<V::Real as Real>::Mask>; 2],
+}
+
+/// Two constraints on the same particles projected together (the neo-Hookean pair, whose two
+/// constraints pull against each other at rest): with gᵃ, gᵇ their gradients, W the inverse
+/// masses and α̃ each one's compliance / h², Δλ solves the 2 × 2 system
+///
+/// ⎡gᵃ·W gᵃ + α̃ᵃ   gᵃ·W gᵇ     ⎤ ⎡Δλᵃ⎤   ⎡−Cᵃ − α̃ᵃ λᵃ⎤
+/// ⎣gᵇ·W gᵃ        gᵇ·W gᵇ + α̃ᵇ⎦ ⎣Δλᵇ⎦ = ⎣−Cᵇ − α̃ᵇ λᵇ⎦,   Δxᵢ = wᵢ (gᵃᵢ Δλᵃ + gᵇᵢ Δλᵇ),
+///
+/// where projecting them one after the other would let the first undo itself fully before the
+/// second answers (a stiff material's deviatoric constraint then squashes each tet). A
+/// constraint that [`correction_lanes`] would skip takes no part; under PBD (no multiplier's
+/// memory) λ counts as 0. The diagonal gains ε (a + b) so that the system stays solvable when
+/// the gradients are parallel and the compliances nearly 0 (a tet at rest). A step longer than
+/// `reach` skips both ([`DEFAULT_REACH`]).
+#[inline(always)]
+pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
+    first: Evaluation<V, N>,
+    second: Evaluation<V, N>,
+    weights: [V::Real; N],
+    lambda: [V::Real; 2],
+    rules: [Rule<V::Real>; 2],
+    reach: V::Real,
+) -> PairCorrection<N, V> {
+    let zero = V::Real::ZERO;
+    let one = V::Real::ONE;
+    let part = |e: &Evaluation<V, N>, lambda: V::Real, rule: Rule<V::Real>| {
+        let (skipped, degenerate, weighted_norm, _) = skipped_lanes(e, &weights);
+        let (alpha, rhs) = match rule {
+            Rule::Xpbd { alpha_tilde } => (alpha_tilde, -e.value - alpha_tilde * lambda),
+            Rule::CompliantPbd { alpha_tilde } => (alpha_tilde, -e.value),
+            Rule::Pbd { k } => (zero, -(k * e.value)),
+        };
+        let mut gradients = [V::ZERO; N];
+        for (g, &kept) in gradients.iter_mut().zip(&e.gradients) {
+            *g = V::select(skipped, V::ZERO, kept);
+        }
+        let diagonal = V::Real::select(skipped, one, weighted_norm + alpha);
+        (
+            skipped,
+            degenerate,
+            gradients,
+            diagonal,
+            V::Real::select(skipped, zero, rhs),
+        )
+    };
+    let (skip_a, degenerate_a, ga, mut a, rhs_a) = part(&first, lambda[0], rules[0]);
+    let (skip_b, degenerate_b, gb, mut b, rhs_b) = part(&second, lambda[1], rules[1]);
+    let mut ab = zero;
+    for k in 0..N {
+        ab += weights[k] * ga[k].dot(gb[k]);
+    }
+    let ridge = V::Real::EPSILON * (a + b);
+    a += ridge;
+    b += ridge;
+    let det = a * b - ab * ab;
+    let delta_a = V::Real::select(skip_a, zero, (b * rhs_a - ab * rhs_b) / det);
+    let delta_b = V::Real::select(skip_b, zero, (a * rhs_b - ab * rhs_a) / det);
+    let mut delta_x = [V::ZERO; N];
+    let mut step = zero;
+    for k in 0..N {
+        delta_x[k] = (ga[k] * delta_a + gb[k] * delta_b) * weights[k];
+        let squared = delta_x[k].length_squared();
+        step = V::Real::select(squared.gt(step), squared, step);
+    }
+    let too_long = !(skip_a & skip_b) & !step.le(reach * reach);
+    for dx in &mut delta_x {
+        *dx = V::select(too_long, V::ZERO, *dx);
+    }
+    let skipped = |all, degenerate| Skipped {
+        all: all | too_long,
+        degenerate,
+        too_long,
+    };
+    PairCorrection {
+        delta_lambda: [
+            V::Real::select(too_long, zero, delta_a),
+            V::Real::select(too_long, zero, delta_b),
+        ],
+        delta_x,
+        skipped: [skipped(skip_a, degenerate_a), skipped(skip_b, degenerate_b)],
+    }
+}
+
+/// One rigid XPBD projection of a constraint at `points` with rest value `rest` and inverse
+/// masses `weights`, starting from λ = 0, with a reach of `reach`: Δx per particle (zero when
+/// skipped). The kernel the solvers run per constraint, for benchmarks (`core/benches/kernels.rs`).
+pub fn project_kernel<V: Vector3, const N: usize>(
+    evaluate: impl Fn(&[V; N], V::Real) -> Evaluation<V, N>,
+    points: &[V; N],
+    rest: V::Real,
+    weights: [V::Real; N],
+    reach: V::Real,
+) -> [V; N] {
+    let rule = Rule::Xpbd {
+        alpha_tilde: V::Real::ZERO,
+    };
+    correction_lanes(evaluate(points, rest), weights, V::Real::ZERO, rule, reach)
+        .1
+        .delta_x
+}
+
+/// Below this fraction of max wᵢ · Σ|∇ᵢC|², Σ wᵢ|∇ᵢC|² says that the particles free to move
+/// (w > 0) can barely change the constraint: those that could are pinned or held, and the free
+/// ones' gradients nearly vanish. Projecting it would move a free particle by about |C| / |∇ᵢC|,
+/// unboundedly far as ∇ᵢC → 0 (a face vertex of a height constraint whose other corners are
+/// held flings out by millions of metres, and the next projections feed on it). At this
+/// threshold a projection moves no particle more than 1/√LOCKED = 100 times as far as it would
+/// with every particle free; at or below it the constraint is skipped, like a degenerate one:
+/// Σ wᵢ|∇ᵢC|² ≤ LOCKED · max wᵢ · Σ|∇ᵢC|².
+pub const LOCKED: f64 = 1e-4;
+
+/// Σ wᵢ |∇ₚᵢC|², the denominator of every projection.
+#[inline]
+pub(crate) fn weighted_norm<V: Vector3, const N: usize>(
+    weights: &[V::Real; N],
+    gradients: &[V; N],
+) -> V::Real {
+    let mut sum = V::Real::ZERO;
+    for (w, g) in weights.iter().zip(gradients) {
+        sum += *w * g.length_squared();
+    }
+    sum
+}

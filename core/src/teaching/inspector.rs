@@ -1,0 +1,157 @@
+//! What the inspector shows about a constraint: its numbers as the solver sees them
+//! ([`Projection`]) and its analytic gradient checked against central differences, live; for a
+//! constraint file's family, ∇C by automatic differentiation beside the file's own.
+
+use crate::constraints::Family;
+use crate::simulation::{Projection, Simulation};
+use crate::teaching::verify::{analytic_and_numeric, relative_error};
+use glam::DVec3;
+
+/// One constraint, inspected.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inspection {
+    /// C, ∇C, w, λ, Δλ and Δx, as the next projection would compute them.
+    pub projection: Projection,
+    /// ∇ₚC by central differences, per particle (the first `projection.len`).
+    pub numeric_gradients: [DVec3; 4],
+    /// maxᵢ |∇ₚᵢC − ∇ₚᵢC_fd|∞ / maxᵢ |∇ₚᵢC| (see [`relative_error`]).
+    pub relative_error: f64,
+    /// For a family read from a constraint file: ∇C by AD and the file's own, side by side.
+    pub file_gradients: Option<FileGradients>,
+}
+
+/// The two gradients of a constraint file's constraint, per particle (the first
+/// `projection.len`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FileGradients {
+    /// ∇ₚC by automatic differentiation (zero where it is undefined).
+    pub automatic: [DVec3; 4],
+    /// The file's own ∇ₚC, for each particle it gives one for.
+    pub yours: [Option<DVec3>; 4],
+}
+
+impl Inspection {
+    /// Σᵢ |∇ₚᵢC|², unweighted.
+    pub fn gradient_norm_squared(&self) -> f64 {
+        let p = &self.projection;
+        p.gradients[..p.len]
+            .iter()
+            .map(|g| g.length_squared())
+            .sum()
+    }
+}
+
+/// Inspects constraint `c` of `family` in the current state of `simulation`.
+///
+/// ```
+/// use tetlab_core::constraints::Family;
+/// use tetlab_core::teaching::inspector::inspect;
+/// use tetlab_core::scene::{Builtin, Perturbation, Scene};
+/// use tetlab_core::simulation::{Settings, Simulation};
+/// let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
+/// let mut simulation = Simulation::new(&scene, Settings::default());
+/// simulation.perturb(Perturbation::Invert);
+/// let volume = inspect(&simulation, Family::VOLUME, 0);
+/// // Inverted: C = −2V, and the analytic gradient agrees with central differences.
+/// assert!((volume.projection.value + 2.0 * volume.projection.rest).abs() < 1e-12);
+/// assert!(volume.relative_error < 1e-6);
+/// ```
+pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection {
+    let projection = simulation.projection(family, c);
+    let (points, rest_shape) = particles_of(simulation, &projection);
+    let (analytic, numeric) = analytic_and_numeric(family, &points, projection.rest, &rest_shape);
+    let mut numeric_gradients = [DVec3::ZERO; 4];
+    numeric_gradients[..numeric.len()].copy_from_slice(&numeric);
+    let file_gradients = family.file().map(|file| {
+        let mut automatic = [DVec3::ZERO; 4];
+        let mut at = [DVec3::ZERO; 4];
+        at[..points.len()].copy_from_slice(&points);
+        match points.len() {
+            2 => {
+                let e = file.evaluate_by(&[at[0], at[1]], projection.rest, false);
+                automatic[..2].copy_from_slice(&e.gradients);
+            }
+            _ => automatic = file.evaluate_by(&at, projection.rest, false).gradients,
+        }
+        FileGradients {
+            automatic,
+            yours: file.yours(&points, projection.rest),
+        }
+    });
+    Inspection {
+        projection,
+        numeric_gradients,
+        relative_error: relative_error(&analytic, &numeric),
+        file_gradients,
+    }
+}
+
+/// What else the family shows of the inspected constraint ([`Family::describe_state`]: F and
+/// det F for the neo-Hookean pair), one line each.
+pub fn state_lines(simulation: &Simulation, projection: &Projection) -> Vec<String> {
+    let (points, rest_shape) = particles_of(simulation, projection);
+    projection.family.describe_state(&points, &rest_shape)
+}
+
+/// The constraint's particles now and at rest.
+fn particles_of(simulation: &Simulation, projection: &Projection) -> (Vec<DVec3>, Vec<DVec3>) {
+    let at = |positions: &[DVec3]| -> Vec<DVec3> {
+        projection
+            .particles()
+            .iter()
+            .map(|&i| positions[i as usize])
+            .collect()
+    };
+    (at(simulation.positions()), at(simulation.rest_positions()))
+}
+
+/// Inspects every constraint of the active families on tet `tet`, family by family. Appends to
+/// `out`.
+pub fn inspect_tet(simulation: &Simulation, tet: usize, out: &mut Vec<Inspection>) {
+    let active = simulation.settings().active;
+    for family in active.families() {
+        for c in simulation.tet_constraints(tet, family) {
+            out.push(inspect(simulation, family, c));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraints::PerFamily;
+    use crate::scene::{Builtin, Perturbation, Scene};
+    use crate::simulation::Settings;
+
+    #[test]
+    fn a_tet_shows_six_edges_four_heights_and_one_volume_all_checked() {
+        let scene = Scene::builtin(Builtin::Cube, 1).unwrap();
+        let settings = Settings {
+            active: PerFamily::splat(true),
+            ..Settings::default()
+        };
+        let mut simulation = Simulation::new(&scene, settings);
+        simulation.perturb(Perturbation::Scramble(2));
+        let mut out = Vec::new();
+        inspect_tet(&simulation, 3, &mut out);
+        let count = |f: Family| out.iter().filter(|i| i.projection.family == f).count();
+        assert_eq!(
+            [Family::EDGES, Family::HEIGHT, Family::VOLUME].map(count),
+            [6, 4, 1]
+        );
+        for inspection in &out {
+            let p = &inspection.projection;
+            assert!(
+                p.particles()
+                    .iter()
+                    .all(|i| simulation.tets()[3].contains(i))
+            );
+            assert!(inspection.relative_error < 1e-5, "{p:?}");
+            let sum: f64 = (0..p.len)
+                .map(|k| p.inverse_masses[k] * p.gradients[k].length_squared())
+                .sum();
+            assert!((sum - p.weighted_norm).abs() <= 1e-12 * sum);
+            assert!(inspection.gradient_norm_squared() > 0.0);
+        }
+    }
+}

@@ -1,0 +1,163 @@
+//! The fast engine against the reference one it is built from: the same constraints coloured
+//! and renumbered, the same outcomes, the same bits on any number of threads, and what it counts.
+
+use tetlab_core::constraints::{Family, PerFamily};
+use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::scene::{Builtin, Perturbation, Scene};
+#[cfg(feature = "parallel")]
+use tetlab_core::simulation::fast::PARALLEL_MIN;
+use tetlab_core::simulation::fast::{FastSimulation, Order};
+use tetlab_core::simulation::{Settings, Simulation};
+
+fn cube(resolution: u32, active: PerFamily<bool>) -> Simulation {
+    let scene = Scene::builtin(Builtin::Cube, resolution).unwrap();
+    Simulation::new(
+        &scene,
+        Settings {
+            active,
+            ..Settings::default()
+        },
+    )
+}
+
+#[test]
+fn colours_share_no_particle_and_cover_every_constraint_once() {
+    let simulation = cube(4, PerFamily::splat(true));
+    let fast = FastSimulation::new(simulation.fast_start(), 1);
+    let n = simulation.positions().len();
+    for family in Family::all() {
+        assert!(fast.batches(family).colouring_is_valid(n), "{family}");
+        let set = simulation.constraints(family);
+        assert_eq!(fast.batches(family).len(), set.len(), "{family}");
+    }
+    let volumes = simulation.constraints(Family::VOLUME);
+    let mut before: Vec<&[u32]> = (0..volumes.len()).map(|c| volumes.particles(c)).collect();
+    let renumbered: Vec<[u32; 4]> = fast
+        .batches(Family::VOLUME)
+        .constraints()
+        .map(|(p, _)| p.map(|i| fast.original()[i as usize]))
+        .collect();
+    let mut after: Vec<&[u32]> = renumbered.iter().map(|p| &p[..]).collect();
+    before.sort_unstable();
+    after.sort_unstable();
+    assert_eq!(before, after, "the same constraints, renumbered");
+}
+
+#[test]
+fn a_mirrored_cube_recovers_on_the_fast_path_as_on_the_reference() {
+    let mut reference = cube(3, PerFamily::splat(true));
+    reference.set_settings(Settings {
+        settle_edits: false,
+        ..*reference.settings()
+    });
+    reference.perturb(Perturbation::Mirror);
+    let mut fast = FastSimulation::new(reference.fast_start(), 1);
+    for _ in 0..60 {
+        reference.step();
+        fast.step();
+    }
+    let mut check = reference.clone();
+    check.set_positions(&fast.positions());
+    assert_eq!(Metrics::measure(&reference).inverted_tets, 0);
+    assert_eq!(Metrics::measure(&check).inverted_tets, 0);
+}
+
+#[test]
+fn edges_alone_leave_a_mirrored_cube_inverted_on_the_fast_path_too() {
+    let mut reference = cube(3, PerFamily::parse_list("edges").unwrap());
+    reference.perturb(Perturbation::Mirror);
+    let mut fast = FastSimulation::new(reference.fast_start(), 1);
+    for _ in 0..60 {
+        fast.step();
+    }
+    let mut check = reference.clone();
+    check.set_positions(&fast.positions());
+    assert_eq!(
+        Metrics::measure(&check).inverted_tets,
+        reference.tets().len()
+    );
+}
+
+#[cfg(feature = "parallel")]
+#[test]
+fn two_threads_give_the_same_bits_as_one() {
+    let mut reference = cube(16, PerFamily::parse_list("edges,volume").unwrap());
+    reference.perturb(Perturbation::Scramble(4));
+    for order in [Order::GaussSeidel, Order::Jacobi { relaxation: 1.5 }] {
+        let mut one = FastSimulation::new(reference.fast_start(), 1);
+        let mut two = FastSimulation::new(reference.fast_start(), 2);
+        one.set_order(order);
+        two.set_order(order);
+        assert_eq!(two.threads(), 2);
+        assert!(
+            two.batches(Family::VOLUME)
+                .colours()
+                .iter()
+                .any(|c| c.elements >= PARALLEL_MIN),
+            "some colour is large enough to be shared"
+        );
+        for _ in 0..5 {
+            one.step();
+            two.step();
+        }
+        assert_eq!(one.positions(), two.positions(), "{order:?}");
+    }
+}
+
+#[test]
+fn a_mirrored_cube_recovers_in_jacobi_order_too() {
+    let mut reference = cube(3, PerFamily::splat(true));
+    reference.perturb(Perturbation::Mirror);
+    let mut fast = FastSimulation::new(reference.fast_start(), 1);
+    fast.set_order(Order::Jacobi { relaxation: 1.0 });
+    assert_eq!(fast.order(), Order::Jacobi { relaxation: 1.0 });
+    for _ in 0..60 {
+        fast.step();
+    }
+    let mut check = reference.clone();
+    check.set_positions(&fast.positions());
+    assert!(fast.is_sound());
+    assert_eq!(Metrics::measure(&check).inverted_tets, 0);
+}
+
+/// Jacobi averages where Gauss–Seidel chains: with the same projections per frame, a body
+/// resting under gravity holds its edges and volumes less tightly.
+#[test]
+fn the_jacobi_order_holds_the_constraints_less_tightly_than_gauss_seidel() {
+    let simulation = cube(4, PerFamily::parse_list("edges,volume").unwrap());
+    let error = |order| {
+        let mut fast = FastSimulation::new(simulation.fast_start(), 1);
+        fast.set_order(order);
+        for _ in 0..60 {
+            fast.step();
+        }
+        fast.relative_error()
+    };
+    let gauss_seidel = error(Order::GaussSeidel);
+    let jacobi = error(Order::Jacobi { relaxation: 1.0 });
+    assert_eq!(gauss_seidel[Family::HEIGHT], None, "heights not active");
+    for family in [Family::EDGES, Family::VOLUME] {
+        let (gs, j) = (gauss_seidel[family], jacobi[family]);
+        let (gs, j) = (gs.unwrap(), j.unwrap());
+        assert!(gs > 0.0 && j > 2.0 * gs, "Gauss–Seidel {gs}, Jacobi {j}");
+    }
+}
+
+#[test]
+fn projections_and_memory_are_counted() {
+    let simulation = cube(4, PerFamily::parse_list("edges,volume").unwrap());
+    let mut fast = FastSimulation::new(simulation.fast_start(), 1);
+    let count = |f| simulation.constraint_count(f) as u64;
+    let substeps = simulation.settings().substeps as u64;
+    let per_frame = (count(Family::EDGES) + count(Family::VOLUME)) * substeps;
+    assert_eq!(fast.projections_per_frame(), per_frame);
+    fast.step();
+    let t = fast.timings();
+    assert_eq!(
+        t.projections[Family::EDGES] + t.projections[Family::VOLUME],
+        per_frame
+    );
+    assert_eq!(t.projections[Family::HEIGHT], 0);
+    let per_tet = fast.heap_bytes() / fast.tet_count();
+    assert!((100..300).contains(&per_tet), "{per_tet} bytes per tet");
+}
