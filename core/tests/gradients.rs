@@ -1,37 +1,13 @@
-//! Analytic gradients against central finite differences, 10⁴ random configurations per family.
+//! Every built-in family through the one gradient check: against central finite differences and
+//! automatic differentiation on 10⁴ random configurations each, and every check a constraint
+//! file gets (invariances, reflection, near-degenerate configurations).
 
 use glam::DVec3;
 use tetlab_core::constraints::Family;
-use tetlab_core::teaching::verify::{analytic_and_numeric, random_check, relative_error};
+use tetlab_core::constraints::verify::{analytic_and_numeric, random_check, relative_error};
 
 const SAMPLES: usize = 10_000;
 const BOUND: f64 = 1e-6;
-
-fn check(family: Family, seed: u64) {
-    let report = random_check(family, SAMPLES, seed);
-    assert_eq!(report.compared, SAMPLES);
-    assert!(
-        report.max_relative_error <= BOUND,
-        "{family:?}: max relative error {:e} over {} configurations exceeds {BOUND:e}",
-        report.max_relative_error,
-        report.compared
-    );
-}
-
-#[test]
-fn distance_gradient_matches_finite_differences() {
-    check(Family::EDGES, 1);
-}
-
-#[test]
-fn height_gradient_matches_finite_differences() {
-    check(Family::HEIGHT, 2);
-}
-
-#[test]
-fn volume_gradient_matches_finite_differences() {
-    check(Family::VOLUME, 3);
-}
 
 /// The check itself must be able to fail: a gradient with one term of the source note's formula
 /// dropped (the (n×e₃)(n·e₁) term of ∇ₚ₂C) is caught.
@@ -50,4 +26,64 @@ fn the_check_catches_a_wrong_gradient() {
     analytic[2] = e3.cross(e1) / c.length();
     analytic[0] = -(analytic[1] + analytic[2] + analytic[3]);
     assert!(relative_error(&analytic, &numeric) > 1e-3);
+}
+
+/// Every check of the one harness, on every built-in family (the neo-Hookean pair included), as
+/// on a constraint file: the analytic gradient against AD per particle, AD against central
+/// differences, translation and rotation invariance, what a reflection does, and that
+/// near-degenerate configurations are flagged, never NaN.
+#[test]
+fn every_built_in_family_passes_every_check_of_the_harness() {
+    use tetlab_core::constraints::verify::{Reflection, check};
+    // With rest value 0 (as the harness reflects): |p0 − p1| and √V₀ ‖F‖ keep their value, the
+    // signed height, the signed volume and √V₀ det F change sign.
+    let expected = [
+        (Family::EDGES, Reflection::Unchanged),
+        (Family::HEIGHT, Reflection::Negated),
+        (Family::VOLUME, Reflection::Negated),
+        (Family::NEOHOOKEAN_DEVIATORIC, Reflection::Unchanged),
+        (Family::NEOHOOKEAN_HYDROSTATIC, Reflection::Negated),
+    ];
+    for (family, reflection) in expected {
+        let report = check(&family, 2000, 7);
+        assert_eq!(report.compared, 2000, "{family}");
+        assert!(report.agrees(), "{family}: {:?}", report.max_relative_error);
+        assert!(
+            report
+                .max_relative_error
+                .iter()
+                .all(|e| e.is_some_and(|e| e <= 1e-12)),
+            "{family}: the analytic gradient is AD's to rounding: {:?}",
+            report.max_relative_error
+        );
+        assert!(
+            report.automatic_vs_finite_difference <= 1e-6,
+            "{family}: {report:?}"
+        );
+        assert!(
+            report.translation_invariant(),
+            "{family}: {}",
+            report.translation
+        );
+        assert!(report.rotation_invariant(), "{family}: {}", report.rotation);
+        assert_eq!(report.reflection, reflection, "{family}");
+        assert_eq!(report.near_degenerate, 200, "{family}");
+        assert!(report.undefined <= report.near_degenerate, "{family}");
+    }
+}
+
+/// The figures `tetlab check-gradients` prints for the built-in families, asserted: against
+/// central differences (the neo-Hookean pair's too) and against AD, on 10⁴ configurations.
+#[test]
+fn the_printed_figures_hold_for_every_built_in_family() {
+    for family in Family::all() {
+        let report = random_check(family, SAMPLES, 1);
+        assert_eq!(report.compared, SAMPLES, "{family}");
+        assert!(report.max_relative_error <= BOUND, "{family}: {report:?}");
+        assert!(
+            report.mean_relative_error <= report.max_relative_error,
+            "{family}"
+        );
+        assert!(report.max_automatic_error <= 1e-12, "{family}: {report:?}");
+    }
 }

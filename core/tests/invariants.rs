@@ -1,9 +1,9 @@
 //! Geometric invariants of the three constraints, on seeded random configurations.
 
 use glam::{DVec3, Vec3, Vec3A};
+use tetlab_core::constraints::verify::well_conditioned;
 use tetlab_core::constraints::{Family, distance, height, volume};
 use tetlab_core::numbers::random::SplitMix64;
-use tetlab_core::teaching::verify::well_conditioned;
 
 const TRIALS: usize = 2_000;
 
@@ -14,7 +14,7 @@ fn random_points(rng: &mut SplitMix64, n: usize) -> Vec<DVec3> {
 fn well_conditioned_points(rng: &mut SplitMix64, family: Family) -> Vec<DVec3> {
     loop {
         let p = random_points(rng, family.arity());
-        if well_conditioned(family, &p) {
+        if well_conditioned(&p) {
             return p;
         }
     }

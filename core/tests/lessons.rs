@@ -7,14 +7,39 @@ use tetlab_core::input::shared_meshes;
 use tetlab_core::simulation::Engine;
 use tetlab_core::teaching::lesson::{BUILTIN, Expectation, Lesson, LessonRun};
 
+/// The built-in lessons are the files of `assets/lessons`, every one, in file-name order and as
+/// they are on disk (the library is rebuilt when the folder changes); lesson k opens the k-th
+/// file (or names the mesh it lacks), and 0 and N + 1 are refused, naming the range.
 #[test]
-fn there_are_at_least_six_lessons_in_order() {
-    assert!(BUILTIN.len() >= 6);
-    let files: Vec<&str> = BUILTIN.iter().map(|b| b.file).collect();
-    let mut sorted = files.clone();
-    sorted.sort();
-    assert_eq!(files, sorted);
-    assert!(Lesson::builtin(0).is_err() && Lesson::builtin(BUILTIN.len() + 1).is_err());
+fn the_built_in_lessons_are_the_files_of_assets_lessons_in_order() {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/lessons");
+    let mut files: Vec<(String, String)> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
+        .map(|path| {
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read_to_string(&path).unwrap())
+        })
+        .collect();
+    files.sort();
+    let builtin: Vec<(String, String)> = BUILTIN
+        .iter()
+        .map(|b| (b.file.to_owned(), b.text.to_owned()))
+        .collect();
+    assert_eq!(builtin, files);
+    for (number, lesson) in (1..).zip(BUILTIN) {
+        let header = lesson.header().unwrap();
+        match Lesson::builtin(number) {
+            Ok(opened) => assert_eq!(opened.title, header.title),
+            Err(e) => assert!(header.missing_mesh().is_some(), "lesson {number}: {e}"),
+        }
+    }
+    let range = format!("1..={}", BUILTIN.len());
+    for number in [0, BUILTIN.len() + 1] {
+        let error = Lesson::builtin(number).unwrap_err().to_string();
+        assert!(error.contains(&range), "{error}");
+    }
 }
 
 /// Every built-in lesson, run headless. A lesson whose mesh is one of `../shared/meshes` skips

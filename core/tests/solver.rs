@@ -163,21 +163,6 @@ fn a_mirrored_cube_recovers_under_edges_and_volume() {
     assert_eq!(m.inverted_tets, 0);
 }
 
-#[test]
-fn same_inputs_give_the_same_bits() {
-    let settings = settings(families(true, true, true), 9.81);
-    let (a, _) = run(Builtin::Ball, Some(Perturbation::Scramble(5)), settings, 40);
-    let (b, _) = run(Builtin::Ball, Some(Perturbation::Scramble(5)), settings, 40);
-    let bits = |s: &Simulation| {
-        s.positions()
-            .iter()
-            .flat_map(|p| p.to_array())
-            .map(f64::to_bits)
-            .collect::<Vec<_>>()
-    };
-    assert_eq!(bits(&a), bits(&b));
-}
-
 /// On either engine, with a particle held and an edit settling: after the first frame (which
 /// builds the fast engine), a frame allocates nothing, the fast engine's taking up of an edit
 /// and its writing back included.

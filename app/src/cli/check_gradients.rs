@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraint_file::check::{AGREEMENT, Reflection, Report, check};
 use tetlab_core::constraints::Family;
-use tetlab_core::teaching::verify::{CONDITIONING, random_check};
+use tetlab_core::constraints::verify::{CONDITIONING, random_check};
 
 /// Options of `tetlab check-gradients`.
 #[derive(Debug, clap::Args)]
@@ -237,8 +237,8 @@ fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()>
     }
     writeln!(
         out,
-        "seed {}; a configuration is skipped when an edge is shorter than {CONDITIONING} of the \
-         longest or (height) the face's edges meet at a sine below {CONDITIONING}",
+        "seed {}; a configuration is skipped when two points are closer than {CONDITIONING} of the \
+         largest distance or a triangle of three has an angle whose sine is below {CONDITIONING}",
         args.seed
     )?;
     let w = rows.iter().map(|r| r.constraint.len()).max().unwrap_or(0) + 2;

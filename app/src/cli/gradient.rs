@@ -7,8 +7,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::Family;
+use tetlab_core::constraints::verify::{analytic_and_numeric, max_abs_error};
 use tetlab_core::numbers::finite_difference::central_difference;
-use tetlab_core::teaching::verify::{analytic_and_numeric, max_abs_error};
 
 /// Options of `tetlab gradient`.
 #[derive(Debug, clap::Args)]

@@ -8,7 +8,7 @@
 use super::ConstraintFile;
 use super::check::{self, AGREEMENT, Worst};
 use crate::constraints::Family;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// The configurations a grade compares on (seed 1, as `gradient_error.NAME` in a lesson).
 pub const GRADED_CONFIGS: usize = 100;
@@ -155,22 +155,8 @@ impl Grade {
     }
 }
 
-/// The grade of `family`'s file, worked out once per definition of the family (the lesson panel
-/// shows it every frame, and the student redefines it as they type); `None` for a built-in
-/// family.
+/// The grade of `family`'s file ([`ConstraintFile::grade`], worked out once per definition of
+/// the family: the student redefines it as they type); `None` for a built-in family.
 pub fn of_family(family: Family) -> Option<Arc<Grade>> {
-    static GRADED: Mutex<Vec<(Family, u64, Arc<Grade>)>> = Mutex::new(Vec::new());
-    let file = family.file()?;
-    let generation = family.generation();
-    let mut graded = GRADED.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((_, _, grade)) = graded
-        .iter()
-        .find(|(f, g, _)| *f == family && *g == generation)
-    {
-        return Some(Arc::clone(grade));
-    }
-    let grade = Arc::new(Grade::of(&file));
-    graded.retain(|(f, _, _)| *f != family);
-    graded.push((family, generation, Arc::clone(&grade)));
-    Some(grade)
+    Some(family.file()?.grade())
 }

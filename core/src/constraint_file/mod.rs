@@ -104,6 +104,20 @@ pub struct ConstraintFile {
     /// Per particle, the output of `yours` that is the file's gradient for it.
     gradient_outputs: [Option<usize>; 4],
     rest: Option<Tape>,
+    /// Its grade as an exercise, worked out the first time it is asked for ([`ConstraintFile::grade`]).
+    grade: GradeOnce,
+}
+
+/// A grade worked out once per compiled file: a cache that belongs to the file, so that a file
+/// redefined (the editor, as a student types) starts with none and the old one goes with the old
+/// file. It is not part of what the file is: two files equal in all else are equal.
+#[derive(Clone, Debug, Default)]
+struct GradeOnce(std::sync::OnceLock<std::sync::Arc<grade::Grade>>);
+
+impl PartialEq for GradeOnce {
+    fn eq(&self, _: &GradeOnce) -> bool {
+        true
+    }
 }
 
 /// C at a configuration, by AD and as the file derives it.
@@ -364,7 +378,18 @@ impl ConstraintFile {
             yours: program.tape(&outputs),
             gradient_outputs,
             rest,
+            grade: GradeOnce::default(),
         })
+    }
+
+    /// Its grade as an exercise ([`grade::Grade::of`]), worked out once for this file: the
+    /// lesson panel shows it every frame.
+    pub fn grade(&self) -> std::sync::Arc<grade::Grade> {
+        std::sync::Arc::clone(
+            self.grade
+                .0
+                .get_or_init(|| std::sync::Arc::new(grade::Grade::of(self))),
+        )
     }
 
     /// How many particles a constraint of this file has.
@@ -482,20 +507,13 @@ impl ConstraintFile {
     /// ∇C by forward-mode AD in f64 over [`Tangent`] numbers, one pass per coordinate; `None`
     /// where it is undefined.
     fn forward_mode<const N: usize>(&self, points: &[DVec3], rest: f64) -> Option<Vec<DVec3>> {
-        let constant = |x: f64| Tangent::new(x, 0.0);
-        let mut p: [[Tangent<f64>; 3]; N] =
-            std::array::from_fn(|k| points[k].to_array().map(constant));
-        let mut value = Tangent::new(0.0, 0.0);
-        let mut gradients = [[0.0; 3]; N];
-        for k in 0..N {
-            for axis in 0..3 {
-                p[k][axis].slope = 1.0;
-                value = self.value.run(&p, constant(rest), |r| r.scalar(0));
-                p[k][axis].slope = 0.0;
-                gradients[k][axis] = value.slope;
-            }
-        }
-        let e = sound::<DVec3, N>(value.value, gradients);
+        let rest = Tangent::new(rest, 0.0);
+        let gradients = crate::numbers::dual::gradient(points, |p| {
+            let p: [[Tangent<f64>; 3]; N] = std::array::from_fn(|k| p[k].to_array());
+            self.value.run(&p, rest, |r| r.scalar(0))
+        })?;
+        let gradients: [[f64; 3]; N] = std::array::from_fn(|k| gradients[k].to_array());
+        let e = sound::<DVec3, N>(self.value(points, rest.value), gradients);
         (!e.degenerate).then(|| e.gradients.to_vec())
     }
 

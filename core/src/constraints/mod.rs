@@ -28,6 +28,7 @@ pub mod material;
 pub mod neohookean;
 pub mod registry;
 mod table;
+pub mod verify;
 pub mod volume;
 
 pub use family::{Binding, Family, PerFamily, Row, TABLE, Visit, VisitPair};

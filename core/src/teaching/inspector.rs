@@ -3,8 +3,8 @@
 //! constraint file's family, ∇C by automatic differentiation beside the file's own.
 
 use crate::constraints::Family;
+use crate::constraints::verify::{analytic_and_numeric, relative_error};
 use crate::simulation::{Projection, Simulation};
-use crate::teaching::verify::{analytic_and_numeric, relative_error};
 use glam::DVec3;
 
 /// One constraint, inspected.

@@ -1,9 +1,8 @@
 //! What a learner sees and does: [`visual`] (what every front end draws, from the simulation),
-//! [`stepper`] (one projection at a time), [`inspector`] (the live gradient check of one tet),
-//! [`verify`] (analytic gradients against finite differences) and [`lesson`]s as TOML files.
+//! [`stepper`] (one projection at a time), [`inspector`] (the live gradient check of one tet,
+//! by [`crate::constraints::verify`]) and [`lesson`]s as TOML files.
 
 pub mod inspector;
 pub mod lesson;
 pub mod stepper;
-pub mod verify;
 pub mod visual;

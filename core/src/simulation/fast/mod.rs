@@ -4,7 +4,8 @@
 //!
 //! What is the same: the constraint formulas (the [`crate::constraints::Constraint`] types of
 //! the family table), the projection rule ([`crate::simulation::projection`]), the integration
-//! (`integrate`), rest values, masses and pins (taken from a [`crate::simulation::Simulation`]).
+//! (`integrate`), rest values, masses and pins (taken from a simulation, [`Start`]); grabs and settling edits too
+//! ([`FrameInputs`]).
 //!
 //! What differs, for speed:
 //! - particles are renumbered along a Morton (Z-order) curve ([`morton`]), so that particles close

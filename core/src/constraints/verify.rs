@@ -1,0 +1,484 @@
+//! The gradient check, one for every constraint: a built-in family or a compiled constraint
+//! file ([`GradientSource`]). One sampling recipe ([`draw`]), one test of near-degeneracy
+//! ([`well_conditioned`]) and one forward-mode seeding ([`crate::numbers::dual::gradient`]) serve
+//! both. [`check`] compares the gradient a source gives against automatic differentiation (AD),
+//! AD against central finite differences, and reports what C does under a translation, a rotation
+//! and a reflection and at near-degenerate configurations; [`random_check`] gives the figures of
+//! `tetlab check-gradients` for the built-in families (the analytic gradient against central
+//! differences and against AD).
+//!
+//! The same routines back the test suite (which asserts every figure) and `tetlab
+//! check-gradients` (which prints the figures quoted in `docs/gradients.md`).
+
+use crate::constraints::{Constraint, Family, Visit};
+use crate::numbers::dual::{Dual64, DualVec3};
+use crate::numbers::finite_difference::central_difference;
+use crate::numbers::random::SplitMix64;
+use crate::numbers::vector::Real;
+use glam::DVec3;
+
+/// Below this sine of an angle of any triangle of the points, or this fraction of the largest
+/// distance between two of them, a random configuration counts as near-degenerate and is not
+/// compared.
+pub const CONDITIONING: f64 = 0.05;
+
+/// The largest relative error (against AD) at which a gradient agrees.
+pub const AGREEMENT: f64 = 1e-6;
+
+/// The largest |Σᵢ ∇ᵢC| (and |Σᵢ pᵢ × ∇ᵢC|), relative to the gradient's size (times the
+/// configuration's), at which C counts as translation (rotation) invariant.
+pub const INVARIANCE: f64 = 1e-9;
+
+/// The configuration where the file's gradient is furthest from AD.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Worst {
+    /// The particle whose gradient is furthest off.
+    pub particle: usize,
+    /// The configuration.
+    pub points: Vec<DVec3>,
+    /// Its rest value.
+    pub rest: f64,
+    /// That particle's error: |yours − AD|∞ / maxⱼ |∇ⱼC|.
+    pub relative_error: f64,
+}
+
+/// What C does when the configuration is mirrored (x → −x).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reflection {
+    /// C is the same (a length, an unsigned area).
+    Unchanged,
+    /// C changes sign (a signed volume, a signed height).
+    Negated,
+    /// Neither.
+    Changed,
+    /// Not known: C is undefined with rest 0 everywhere tried (C = V / rest − 1).
+    Untried,
+}
+
+impl Reflection {
+    /// One word for it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Reflection::Unchanged => "unchanged",
+            Reflection::Negated => "negated",
+            Reflection::Changed => "changed",
+            Reflection::Untried => "untried (C is undefined with rest 0)",
+        }
+    }
+}
+
+/// The outcome of [`check`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    /// Well-conditioned configurations compared.
+    pub compared: usize,
+    /// Drawn but skipped as near-degenerate (an edge or a face angle below
+    /// [`CONDITIONING`]).
+    pub skipped: usize,
+    /// Per particle, the largest relative error of the file's gradient against AD; `None` for a
+    /// particle the file gives no gradient for.
+    pub max_relative_error: Vec<Option<f64>>,
+    /// Where the largest of those is.
+    pub worst: Option<Worst>,
+    /// The largest relative error of AD against central differences.
+    pub automatic_vs_finite_difference: f64,
+    /// The largest |Σᵢ ∇ᵢC| / maxᵢ |∇ᵢC| (AD).
+    pub translation: f64,
+    /// The largest |Σᵢ (pᵢ − centre) × ∇ᵢC| / (maxᵢ |∇ᵢC| · size) (AD).
+    pub rotation: f64,
+    /// What a reflection does to C (with rest 0).
+    pub reflection: Reflection,
+    /// Near-degenerate configurations evaluated (points coincident or coplanar).
+    pub near_degenerate: usize,
+    /// Of those, how many have C or ∇C undefined there (flagged, never NaN in the results).
+    pub undefined: usize,
+}
+
+impl Report {
+    /// Whether every gradient the file gives agrees with AD within [`AGREEMENT`].
+    pub fn agrees(&self) -> bool {
+        self.max_relative_error
+            .iter()
+            .flatten()
+            .all(|&e| e <= AGREEMENT)
+    }
+
+    /// Whether Σᵢ ∇ᵢC = 0 within [`INVARIANCE`].
+    pub fn translation_invariant(&self) -> bool {
+        self.translation <= INVARIANCE
+    }
+
+    /// Whether Σᵢ pᵢ × ∇ᵢC = 0 within [`INVARIANCE`].
+    pub fn rotation_invariant(&self) -> bool {
+        self.rotation <= INVARIANCE
+    }
+}
+
+/// The error of an analytic gradient against central differences, relative to the gradient's size:
+/// maxᵢ |∇ₚᵢC − ∇ₚᵢC_fd|∞ / maxᵢ |∇ₚᵢC|.
+pub fn relative_error(analytic: &[DVec3], numeric: &[DVec3]) -> f64 {
+    let scale = analytic.iter().map(|g| g.length()).fold(0.0, f64::max);
+    let error = max_abs_error(analytic, numeric);
+    if scale > 0.0 { error / scale } else { error }
+}
+
+/// maxᵢ |∇ₚᵢC − ∇ₚᵢC_fd|∞, the largest difference of any one component.
+pub fn max_abs_error(analytic: &[DVec3], numeric: &[DVec3]) -> f64 {
+    analytic
+        .iter()
+        .zip(numeric)
+        .map(|(a, n)| (*a - *n).abs().max_element())
+        .fold(0.0, f64::max)
+}
+
+/// The analytic gradient of `family` at `points` (with rest value `rest` and rest shape
+/// `rest_shape`) and the central-difference one, in f64.
+pub fn analytic_and_numeric(
+    family: Family,
+    points: &[DVec3],
+    rest: f64,
+    rest_shape: &[DVec3],
+) -> (Vec<DVec3>, Vec<DVec3>) {
+    let analytic = family.evaluate(points, rest, rest_shape).gradients[..points.len()].to_vec();
+    let numeric = central_difference(points, |p| family.evaluate(p, rest, rest_shape).value);
+    (analytic, numeric)
+}
+
+/// ∇C of `family` by forward-mode automatic differentiation ([`crate::numbers::dual`]): the family's own
+/// formula evaluated on dual numbers, once per coordinate; the rest shape is held fixed. `None`
+/// where a derivative is not finite.
+pub fn automatic_gradient(
+    family: Family,
+    points: &[DVec3],
+    rest: f64,
+    rest_shape: &[DVec3],
+) -> Option<Vec<DVec3>> {
+    struct Value<'a>(&'a [DualVec3], f64, &'a [DVec3]);
+    impl Visit for Value<'_> {
+        type Output = Dual64;
+        fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Dual64 {
+            let p: [DualVec3; N] = std::array::from_fn(|k| self.0[k]);
+            let shape: [DualVec3; N] =
+                std::array::from_fn(|k| DualVec3::seeded(self.2[k], DVec3::ZERO));
+            c.evaluate(&p, Dual64::from_f64(self.1), &shape).value
+        }
+    }
+    crate::numbers::dual::gradient(points, |p| family.visit(Value(p, rest, rest_shape)))
+}
+
+/// Whether `points` are far from degenerate: no two closer than [`CONDITIONING`] times the
+/// largest distance, and no face of three of them with an angle's sine below it.
+pub fn well_conditioned(points: &[DVec3]) -> bool {
+    let n = points.len();
+    let mut longest: f64 = 0.0;
+    for i in 0..n {
+        for j in i + 1..n {
+            longest = longest.max(points[i].distance(points[j]));
+        }
+    }
+    if longest == 0.0 {
+        return false;
+    }
+    for i in 0..n {
+        for j in i + 1..n {
+            if points[i].distance(points[j]) < CONDITIONING * longest {
+                return false;
+            }
+            for k in j + 1..n {
+                let (a, b) = (points[j] - points[i], points[k] - points[i]);
+                for (u, v) in [(a, b), (points[i] - points[j], points[k] - points[j])] {
+                    if u.cross(v).length() < CONDITIONING * u.length() * v.length() {
+                        return false;
+                    }
+                }
+            }
+        }
+    }
+    true
+}
+
+/// A random configuration of `arity` points: uniform in a cube of random size 10^U(−2, 2) around
+/// a random centre. Gives the points and the size.
+pub fn draw(rng: &mut SplitMix64, arity: usize) -> (Vec<DVec3>, f64) {
+    let size = 10f64.powf(rng.range(-2.0, 2.0));
+    let centre = rng.in_cube(size);
+    let points = (0..arity).map(|_| centre + rng.in_cube(size)).collect();
+    (points, size)
+}
+
+/// [`draw`], and for a source that reads a rest shape (the neo-Hookean pair's Dm) a rest shape
+/// drawn the same way around the same centre; otherwise the rest shape is the points.
+fn draw_with_rest_shape(
+    rng: &mut SplitMix64,
+    source: &impl GradientSource,
+) -> (Vec<DVec3>, Vec<DVec3>, f64) {
+    let size = 10f64.powf(rng.range(-2.0, 2.0));
+    let centre = rng.in_cube(size);
+    let mut points = || -> Vec<DVec3> {
+        (0..source.arity())
+            .map(|_| centre + rng.in_cube(size))
+            .collect()
+    };
+    let current = points();
+    let rest_shape = if source.uses_rest_shape() {
+        points()
+    } else {
+        current.clone()
+    };
+    (current, rest_shape, size)
+}
+
+/// What the check needs of a constraint: C, the gradient it gives, and ∇C by forward-mode AD.
+/// A built-in [`Family`] gives its analytic gradient for every particle; a constraint file
+/// gives the gradients it writes (its `[gradient]` table), and none for the others.
+pub trait GradientSource {
+    /// How many particles one constraint touches.
+    fn arity(&self) -> usize;
+    /// Whether C reads a rest shape (then one is drawn beside the points).
+    fn uses_rest_shape(&self) -> bool;
+    /// C at `points` with rest value `rest` and rest shape `rest_shape` (NaN where undefined).
+    fn value(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> f64;
+    /// The gradient the source gives, per particle; `None` for a particle it gives none for.
+    fn given(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Vec<Option<DVec3>>;
+    /// ∇C by forward-mode AD; `None` where it is undefined.
+    fn automatic(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Option<Vec<DVec3>>;
+    /// A rest value of the size C's own would have at `points` (a file's rest expression where
+    /// it gives one, otherwise C with rest value 0).
+    fn natural_rest(&self, points: &[DVec3], rest_shape: &[DVec3]) -> f64;
+}
+
+impl GradientSource for Family {
+    fn arity(&self) -> usize {
+        Family::arity(*self)
+    }
+
+    fn uses_rest_shape(&self) -> bool {
+        Family::uses_rest_shape(*self)
+    }
+
+    fn value(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> f64 {
+        self.evaluate(points, rest, rest_shape).value
+    }
+
+    fn given(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Vec<Option<DVec3>> {
+        let evaluation = self.evaluate(points, rest, rest_shape);
+        evaluation.gradients[..points.len()]
+            .iter()
+            .map(|&g| Some(g))
+            .collect()
+    }
+
+    fn automatic(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Option<Vec<DVec3>> {
+        automatic_gradient(*self, points, rest, rest_shape)
+    }
+
+    fn natural_rest(&self, points: &[DVec3], rest_shape: &[DVec3]) -> f64 {
+        self.evaluate(points, 0.0, rest_shape).value
+    }
+}
+
+/// The outcome of [`random_check`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FamilyReport {
+    /// The family checked.
+    pub family: Family,
+    /// Configurations compared.
+    pub compared: usize,
+    /// Configurations drawn but skipped as near-degenerate.
+    pub skipped: usize,
+    /// The largest [`relative_error`] seen.
+    pub max_relative_error: f64,
+    /// The mean [`relative_error`].
+    pub mean_relative_error: f64,
+    /// The largest [`relative_error`] of the analytic gradient against automatic differentiation
+    /// ([`automatic_gradient`]), on the same configurations.
+    pub max_automatic_error: f64,
+}
+
+/// Draws configurations until `samples` well-conditioned ones have been compared: points uniform
+/// in a cube of random size 10^U(−2, 2) around a random centre, rest value random in the range of
+/// the constraint's own values, and (for a family that reads one) a rest shape drawn the same
+/// way. Returns the error statistics.
+pub fn random_check(family: Family, samples: usize, seed: u64) -> FamilyReport {
+    let mut rng = SplitMix64::new(seed);
+    let (mut compared, mut skipped) = (0, 0);
+    let (mut max_error, mut sum_error, mut max_automatic) = (0.0_f64, 0.0, 0.0_f64);
+    while compared < samples {
+        let (points, rest_shape, _) = draw_with_rest_shape(&mut rng, &family);
+        if !well_conditioned(&points) || !well_conditioned(&rest_shape) {
+            skipped += 1;
+            continue;
+        }
+        let rest = family.evaluate(&points, 0.0, &rest_shape).value * rng.range(-1.5, 1.5);
+        let (analytic, numeric) = analytic_and_numeric(family, &points, rest, &rest_shape);
+        let error = relative_error(&analytic, &numeric);
+        max_error = max_error.max(error);
+        if let Some(automatic) = automatic_gradient(family, &points, rest, &rest_shape) {
+            max_automatic = max_automatic.max(relative_error(&analytic, &automatic));
+        }
+        sum_error += error;
+        compared += 1;
+    }
+    FamilyReport {
+        family,
+        compared,
+        skipped,
+        max_relative_error: max_error,
+        mean_relative_error: if compared > 0 {
+            sum_error / compared as f64
+        } else {
+            0.0
+        },
+        max_automatic_error: max_automatic,
+    }
+}
+
+/// Compares on `configs` well-conditioned random configurations ([`draw`]; rest value the natural
+/// one × U(−1.5, 1.5)), then on near-degenerate ones.
+pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report {
+    let arity = source.arity();
+    let mut rng = SplitMix64::new(seed);
+    let mut report = Report {
+        compared: 0,
+        skipped: 0,
+        max_relative_error: vec![None; arity],
+        worst: None,
+        automatic_vs_finite_difference: 0.0,
+        translation: 0.0,
+        rotation: 0.0,
+        reflection: Reflection::Unchanged,
+        near_degenerate: 0,
+        undefined: 0,
+    };
+    let (mut unchanged, mut negated, mut reflected_any) = (true, true, false);
+    let mut attempts = 0usize;
+    while report.compared < configs && attempts < configs.saturating_mul(100).max(1000) {
+        attempts += 1;
+        let (points, shape, size) = draw_with_rest_shape(&mut rng, source);
+        if !well_conditioned(&points) || !well_conditioned(&shape) {
+            report.skipped += 1;
+            continue;
+        }
+        // A rest value of the size C's own would have: the file's rest expression where it
+        // gives one (C = V / rest − 1 is undefined with rest 0), else C with rest 0.
+        let rest = source.natural_rest(&points, &shape) * rng.range(-1.5, 1.5);
+        let value = source.value(&points, rest, &shape);
+        let automatic = source
+            .automatic(&points, rest, &shape)
+            .filter(|_| value.is_finite());
+        let Some(automatic) = automatic else {
+            report.skipped += 1;
+            continue;
+        };
+        report.compared += 1;
+        let scale = automatic.iter().map(|g| g.length()).fold(0.0, f64::max);
+        let numeric = central_difference(&points, |p| source.value(p, rest, &shape));
+        report.automatic_vs_finite_difference = report
+            .automatic_vs_finite_difference
+            .max(relative_error(&automatic, &numeric));
+        for (k, yours) in source.given(&points, rest, &shape).iter().enumerate() {
+            let Some(yours) = yours else { continue };
+            let difference = (*yours - automatic[k]).abs().max_element();
+            let error = if scale > 0.0 {
+                difference / scale
+            } else {
+                difference
+            };
+            // A non-finite gradient of yours where AD's is finite is as wrong as it gets.
+            let error = if error.is_finite() {
+                error
+            } else {
+                f64::INFINITY
+            };
+            let slot = report.max_relative_error[k].get_or_insert(0.0);
+            *slot = slot.max(error);
+            if report
+                .worst
+                .as_ref()
+                .is_none_or(|w| error > w.relative_error)
+            {
+                report.worst = Some(Worst {
+                    particle: k,
+                    points: points.clone(),
+                    rest,
+                    relative_error: error,
+                });
+            }
+        }
+        if scale > 0.0 {
+            let sum: DVec3 = automatic.iter().sum();
+            report.translation = report.translation.max(sum.length() / scale);
+            let mean = points.iter().sum::<DVec3>() / arity as f64;
+            let torque: DVec3 = points
+                .iter()
+                .zip(&automatic)
+                .map(|(p, g)| (*p - mean).cross(*g))
+                .sum();
+            report.rotation = report.rotation.max(torque.length() / (scale * size));
+        }
+        // Reflection, and a rotation's effect on C itself, with rest 0.
+        let raw = source.value(&points, 0.0, &shape);
+        let mirrored: Vec<DVec3> = points.iter().map(|p| DVec3::new(-p.x, p.y, p.z)).collect();
+        let reflected = source.value(&mirrored, 0.0, &shape);
+        if raw.is_finite() && reflected.is_finite() {
+            reflected_any = true;
+            let tolerance = 1e-9 * raw.abs().max(1e-300);
+            unchanged &= (reflected - raw).abs() <= tolerance;
+            negated &= (reflected + raw).abs() <= tolerance;
+        }
+    }
+    report.reflection = match (unchanged, negated) {
+        _ if !reflected_any => Reflection::Untried,
+        (true, _) => Reflection::Unchanged,
+        (false, true) => Reflection::Negated,
+        _ => Reflection::Changed,
+    };
+    for points in near_degenerate(arity, &mut rng, 200) {
+        report.near_degenerate += 1;
+        let value = source.value(&points, 0.0, &points);
+        if !value.is_finite() || source.automatic(&points, 0.0, &points).is_none() {
+            report.undefined += 1;
+        }
+    }
+    report
+}
+
+/// Configurations at or near degeneracy: two points coincident, all coincident, all on a line,
+/// p3 on the plane of p0, p1, p2 (for four), and the same moved by 10⁻⁹ of their size.
+fn near_degenerate(arity: usize, rng: &mut SplitMix64, count: usize) -> Vec<Vec<DVec3>> {
+    let mut shapes = Vec::with_capacity(count);
+    while shapes.len() < count {
+        let size = 10f64.powf(rng.range(-2.0, 2.0));
+        let mut points: Vec<DVec3> = (0..arity).map(|_| rng.in_cube(size)).collect();
+        match shapes.len() % 4 {
+            0 => points[arity - 1] = points[0],
+            1 => {
+                let p = points[0];
+                points.iter_mut().for_each(|q| *q = p);
+            }
+            2 => {
+                let (a, b) = (points[0], points[1]);
+                for (i, q) in points.iter_mut().enumerate() {
+                    *q = a + (b - a) * i as f64;
+                }
+            }
+            _ => {
+                if arity == 4 {
+                    let (u, v) = (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+                    points[3] =
+                        points[0] + (points[1] - points[0]) * u + (points[2] - points[0]) * v;
+                } else {
+                    points[1] = points[0] + DVec3::splat(size * 1e-12);
+                }
+            }
+        }
+        if shapes.len() % 8 >= 4 {
+            let rotation = rng.rotation();
+            for q in &mut points {
+                *q = rotation * *q + DVec3::splat(1e-9 * size);
+            }
+        }
+        shapes.push(points);
+    }
+    shapes
+}
