@@ -10,6 +10,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use gui_support::{click_at, open_lesson_file, pixels_like, workbench};
 use tetlab::gui::{Preferences, TetlabApp, viewport};
+use tetlab_core::constraints::Families;
 use tetlab_core::teaching::visual;
 
 #[test]
@@ -53,7 +54,10 @@ fn a_tet_inverted_through_the_ui_turns_red_with_arrows_and_recovers_when_played(
     assert!(
         pixels_like(
             &mut harness,
-            visual::family_colour(tetlab_core::constraints::Family::VOLUME)
+            visual::family_colour(
+                &tetlab_core::constraints::Families::builtin(),
+                tetlab_core::constraints::Family::VOLUME,
+            )
         ) > 50,
         "volume arrows"
     );
@@ -216,10 +220,10 @@ fn the_neo_hookean_family_is_switched_on_with_its_material() {
         .click();
     harness.run_steps(2);
     let settings = *harness.state().bench.simulation.settings();
-    assert_eq!(settings.active.describe(), "neohookean");
+    assert_eq!(Families::builtin().describe(&settings.active), "neohookean");
     assert!(harness.state().bench.stability_warning.is_none());
     // At rest ∇C_H = √3 ∇C_D: the hydrostatic arrows cover the deviatoric ones.
-    let colour = |family| visual::family_colour(family);
+    let colour = |family| visual::family_colour(&Families::builtin(), family);
     assert!(pixels_like(&mut harness, colour(Family::NEOHOOKEAN_HYDROSTATIC)) > 20);
     harness.key_press(egui::Key::M);
     harness.run_steps(1);
@@ -532,7 +536,7 @@ fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
     harness.run_steps(2);
     let families = |harness: &Harness<'static, TetlabApp>| {
         let comparison = harness.state().comparison.as_ref().expect("comparing");
-        comparison.bench.simulation.settings().active.describe()
+        Families::builtin().describe(&comparison.bench.simulation.settings().active)
     };
     assert_eq!(families(&harness), "height+volume");
     harness.get_by_label("height+volume");
@@ -552,7 +556,10 @@ fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
         tetlab_core::simulation::Method::Pbd,
         "both sides"
     );
-    assert_eq!(left.active.describe(), "edges+height+volume");
+    assert_eq!(
+        Families::builtin().describe(&left.active),
+        "edges+height+volume"
+    );
     assert_eq!(families(&harness), "height+volume", "its own families");
     harness.get_by_label("XPBD").click();
     harness.get_all_by_label("heights").next().unwrap().click();

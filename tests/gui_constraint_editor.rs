@@ -3,35 +3,40 @@
 //! mistake is shown at its line and column while the last good definition stays; a wrong
 //! gradient is named by the check and drawn pale beside AD's; a dropped file opens in the editor.
 //!
-//! A test binary of its own: these tests add families to the table, which is the process's, and
-//! the snapshots of tests/gui.rs would otherwise show them.
+//! Each test's workbench owns its table of families: the examples are added to it, in the same
+//! order, before anything is drawn, so that the snapshots do not depend on which test ran first.
 
 #[path = "support/gui.rs"]
 mod gui_support;
 
 use eframe::egui;
+use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use gui_support::{pixels_like, workbench};
 use std::path::Path;
+use tetlab::gui::TetlabApp;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraints::Family;
+use tetlab_core::constraints::{Families, Family};
 use tetlab_core::teaching::visual::{self, Quantity};
 
-/// The example families these tests use, registered once, in this order, before any test draws:
-/// the solver panel lists every family of the table, so that the snapshots do not depend on which
-/// test ran first.
-fn register_examples() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        for name in ["height.toml", "height-wrong-sign.toml", "volume.toml"] {
-            let example = tetlab_core::constraint_file::EXAMPLES
-                .iter()
-                .find(|e| e.file == name)
-                .unwrap();
-            let file = ConstraintFile::parse(&example.shown(), example.text).unwrap();
-            Family::register(file).unwrap();
-        }
-    });
+/// The example families these tests use, added to `harness`'s workbench in this order before
+/// anything is drawn: the solver panel lists every family of its table.
+fn with_examples(harness: &mut Harness<'static, TetlabApp>) {
+    let mut families = Families::builtin();
+    for name in ["height.toml", "height-wrong-sign.toml", "volume.toml"] {
+        let example = tetlab_core::constraint_file::EXAMPLES
+            .iter()
+            .find(|e| e.file == name)
+            .unwrap();
+        let file = ConstraintFile::parse(&example.shown(), example.text).unwrap();
+        families.register(file).unwrap();
+    }
+    harness.state_mut().bench.set_families(families);
+}
+
+/// The workbench's table of families.
+fn families(harness: &Harness<'static, TetlabApp>) -> Families {
+    harness.state().bench.simulation.families().clone()
 }
 
 /// G opens the editor on the source note's height; it is defined, switched on, drawn in its own
@@ -39,22 +44,25 @@ fn register_examples() {
 /// typed in the editor is reported at its line and column, and the family stays as it was.
 #[test]
 fn a_constraint_typed_in_the_editor_is_simulated_and_its_mistakes_are_shown() {
-    register_examples();
     let mut harness = workbench("tet", 1);
+    with_examples(&mut harness);
     harness.key_press(egui::Key::G);
     harness.run_steps(2);
     let family = harness.state().editor.family.expect("the example compiles");
-    assert_eq!(family.name(), "my-height");
+    assert_eq!(families(&harness).name(family), "my-height");
     let settings = *harness.state().bench.simulation.settings();
     assert!(settings.active[family], "switched on");
-    assert_eq!(settings.active.describe(), "edges+volume+my-height");
+    assert_eq!(
+        families(&harness).describe(&settings.active),
+        "edges+volume+my-height"
+    );
     harness.get_by_label_contains("family my-height: on in the solver panel");
 
     harness.key_press(egui::Key::I);
     harness.run_steps(2);
     assert_eq!(harness.state().bench.metrics.inverted_tets, 1);
     harness.snapshot("constraint_editor");
-    let colour = Quantity::Gradient(family).colour();
+    let colour = Quantity::Gradient(family).colour(&families(&harness));
     assert!(
         pixels_like(&mut harness, colour) > 50,
         "the file's arrows, in its own colour"
@@ -112,8 +120,8 @@ fn a_constraint_typed_in_the_editor_is_simulated_and_its_mistakes_are_shown() {
 /// are drawn pale beside AD's, and the inspector marks yours.
 #[test]
 fn a_wrong_gradient_is_named_by_the_check_and_drawn_beside_ads() {
-    register_examples();
     let mut harness = workbench("tet", 1);
+    with_examples(&mut harness);
     harness.key_press(egui::Key::G);
     harness.run_steps(2);
     // The editor's example button (the solver panel has a checkbox of the same name).
@@ -122,9 +130,9 @@ fn a_wrong_gradient_is_named_by_the_check_and_drawn_beside_ads() {
         .click();
     harness.run_steps(2);
     let family = harness.state().editor.family.unwrap();
-    assert_eq!(family.name(), "height-wrong-sign");
+    assert_eq!(families(&harness).name(family), "height-wrong-sign");
     let active = harness.state().bench.simulation.settings().active;
-    assert!(active[family] && !active[Family::parse("my-height").unwrap()]);
+    assert!(active[family] && !active[families(&harness).parse("my-height").unwrap()]);
     harness.get_by_label("Check my gradient").click();
     harness.run_steps(2);
     harness.get_by_label("your gradient does NOT agree with AD");
@@ -133,7 +141,7 @@ fn a_wrong_gradient_is_named_by_the_check_and_drawn_beside_ads() {
     harness.run_steps(2);
     // It is simulated with its own gradient (use_gradient): AD's is the one drawn pale (the
     // legend says "grad C: height-wrong-sign, AD, where it differs").
-    let pale = Quantity::Disagreeing(family).colour();
+    let pale = Quantity::Disagreeing(family).colour(&families(&harness));
     assert!(pixels_like(&mut harness, pale) > 30, "the other gradient");
     harness.snapshot("constraint_editor_wrong_gradient");
 }
@@ -152,8 +160,8 @@ fn a_dropped_constraint_file_opens_in_the_editor() {
             std::fs::read(&self.0).map_err(|e| e.to_string())
         }
     }
-    register_examples();
     let mut harness = workbench("cube", 2);
+    with_examples(&mut harness);
     let volume = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints/volume.toml");
     harness
         .input_mut()
@@ -161,7 +169,7 @@ fn a_dropped_constraint_file_opens_in_the_editor() {
         .push(std::sync::Arc::new(Dropped(volume)));
     harness.run_steps(3);
     let family = harness.state().editor.family.expect("dropped and defined");
-    assert_eq!(family.name(), "my-volume");
+    assert_eq!(families(&harness).name(family), "my-volume");
     assert!(harness.state().editor.open);
     assert!(harness.state().bench.simulation.settings().active[family]);
 
@@ -187,5 +195,6 @@ fn a_dropped_constraint_file_opens_in_the_editor() {
         harness.state().editor.text.contains("p0 - p2"),
         "the text to mend"
     );
-    assert!(visual::family_colour(family) != visual::family_colour(Family::VOLUME));
+    let table = families(&harness);
+    assert!(visual::family_colour(&table, family) != visual::family_colour(&table, Family::VOLUME));
 }

@@ -146,7 +146,7 @@ fn frame(c: &mut Criterion) {
         ),
     };
     let settings = Settings {
-        active: PerFamily::parse_list("edges,volume").expect("two families"),
+        active: PerFamily::builtin_list("edges,volume").expect("two families"),
         substeps: 10,
         ..Settings::default()
     };

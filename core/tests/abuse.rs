@@ -91,7 +91,7 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
     };
     settings.set_gravity(gravity);
     settings.ground = settings.ground && !rng.next_u64().is_multiple_of(4);
-    for family in Family::all().filter(|f| f.row().compliance_from_material.is_none()) {
+    for family in Family::builtins().filter(|f| f.compliance_from_material().is_none()) {
         settings
             .active
             .set(family, !rng.next_u64().is_multiple_of(3));
@@ -106,7 +106,7 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
     // The families a material describes: on or off together, as the command line and the
     // workbench have them, with any material in range.
     let on = !rng.next_u64().is_multiple_of(3);
-    for family in Family::all().filter(|f| f.row().compliance_from_material.is_some()) {
+    for family in Family::builtins().filter(|f| f.compliance_from_material().is_some()) {
         settings.active.set(family, on);
     }
     // Within the material's documented stable range (Material::substeps_needed) on the
@@ -432,7 +432,7 @@ fn survives_random_edits_grabs_and_settings(engine: Engine, seed: u64, name: &st
         if engine == Engine::Fast && simulation.is_sound() {
             let relative = simulation.fast_solver().relative_error();
             assert!(
-                Family::all().all(|f| relative.get(f).is_none_or(f64::is_finite)),
+                Family::builtins().all(|f| relative.get(f).is_none_or(f64::is_finite)),
                 "{relative:?}"
             );
         }

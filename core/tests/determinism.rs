@@ -18,7 +18,7 @@ fn simulation(engine: Engine, threads: usize) -> Simulation {
         Settings {
             engine,
             substeps: 10,
-            active: PerFamily::parse_list("edges,height,volume").unwrap(),
+            active: PerFamily::builtin_list("edges,height,volume").unwrap(),
             ..Settings::default()
         },
     );

@@ -193,7 +193,7 @@ impl Claim {
     /// The command line's settings for the claim: edits settle unless --no-settle-edits.
     fn settings(&self, engine: Engine) -> Settings {
         let mut settings = Settings {
-            active: PerFamily::parse_list(self.families).unwrap(),
+            active: PerFamily::builtin_list(self.families).unwrap(),
             engine,
             settle_edits: true,
             ..Settings::default()
@@ -438,7 +438,7 @@ fn a_body_in_free_fall_falls_as_far_on_both_engines() {
         let settings = Settings {
             engine,
             ground: false,
-            active: PerFamily::parse_list("edges,volume").unwrap(),
+            active: PerFamily::builtin_list("edges,volume").unwrap(),
             ..Settings::default()
         };
         let mut simulation = Simulation::new(&scene, settings);

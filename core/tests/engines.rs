@@ -12,7 +12,7 @@ use tetlab_core::teaching::stepper::StepByStep;
 fn simulation(builtin: Builtin, resolution: u32, families: &str, engine: Engine) -> Simulation {
     let scene = Scene::builtin(builtin, resolution).unwrap();
     let settings = Settings {
-        active: PerFamily::parse_list(families).unwrap(),
+        active: PerFamily::builtin_list(families).unwrap(),
         engine,
         substeps: 10,
         gravity: 0.0,

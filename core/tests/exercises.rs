@@ -95,8 +95,8 @@ fn each_exercise_grades_a_right_and_a_wrong_answer() {
             .unwrap()
             .text;
         let lesson = Lesson::builtin(exercise.lesson).unwrap();
-        let family = lesson.families[0];
-        let as_shipped = grade::of_family(family).unwrap();
+        let family = lesson.file_families[0];
+        let as_shipped = grade::of_family(&lesson.families, family).unwrap();
         assert!(!as_shipped.passed(), "lesson {}", exercise.lesson);
 
         // Wrong: not passed; the particle named, with a configuration, and not AD's gradient.

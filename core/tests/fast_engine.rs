@@ -25,7 +25,7 @@ fn colours_share_no_particle_and_cover_every_constraint_once() {
     let simulation = cube(4, PerFamily::splat(true));
     let fast = FastSimulation::new(simulation.fast_start(), 1);
     let n = simulation.positions().len();
-    for family in Family::all() {
+    for family in Family::builtins() {
         assert!(fast.batches(family).colouring_is_valid(n), "{family}");
         let set = simulation.constraints(family);
         assert_eq!(fast.batches(family).len(), set.len(), "{family}");
@@ -64,7 +64,7 @@ fn a_mirrored_cube_recovers_on_the_fast_path_as_on_the_reference() {
 
 #[test]
 fn edges_alone_leave_a_mirrored_cube_inverted_on_the_fast_path_too() {
-    let mut reference = cube(3, PerFamily::parse_list("edges").unwrap());
+    let mut reference = cube(3, PerFamily::builtin_list("edges").unwrap());
     reference.perturb(Perturbation::Mirror);
     let mut fast = FastSimulation::new(reference.fast_start(), 1);
     for _ in 0..60 {
@@ -81,7 +81,7 @@ fn edges_alone_leave_a_mirrored_cube_inverted_on_the_fast_path_too() {
 #[cfg(feature = "parallel")]
 #[test]
 fn two_threads_give_the_same_bits_as_one() {
-    let mut reference = cube(16, PerFamily::parse_list("edges,volume").unwrap());
+    let mut reference = cube(16, PerFamily::builtin_list("edges,volume").unwrap());
     reference.perturb(Perturbation::Scramble(4));
     for order in [Order::GaussSeidel, Order::Jacobi { relaxation: 1.5 }] {
         let mut one = FastSimulation::new(reference.fast_start(), 1);
@@ -124,7 +124,7 @@ fn a_mirrored_cube_recovers_in_jacobi_order_too() {
 /// resting under gravity holds its edges and volumes less tightly.
 #[test]
 fn the_jacobi_order_holds_the_constraints_less_tightly_than_gauss_seidel() {
-    let simulation = cube(4, PerFamily::parse_list("edges,volume").unwrap());
+    let simulation = cube(4, PerFamily::builtin_list("edges,volume").unwrap());
     let error = |order| {
         let mut fast = FastSimulation::new(simulation.fast_start(), 1);
         fast.set_order(order);
@@ -145,7 +145,7 @@ fn the_jacobi_order_holds_the_constraints_less_tightly_than_gauss_seidel() {
 
 #[test]
 fn projections_and_memory_are_counted() {
-    let simulation = cube(4, PerFamily::parse_list("edges,volume").unwrap());
+    let simulation = cube(4, PerFamily::builtin_list("edges,volume").unwrap());
     let mut fast = FastSimulation::new(simulation.fast_start(), 1);
     let count = |f| simulation.constraint_count(f) as u64;
     let substeps = simulation.settings().substeps as u64;

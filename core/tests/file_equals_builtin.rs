@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::material::Material;
-use tetlab_core::constraints::{Constraint, Family, PerFamily, Visit};
+use tetlab_core::constraints::{Constraint, Families, Family, PerFamily, Visit};
 use tetlab_core::input::shared_meshes;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
@@ -35,14 +35,15 @@ struct Route {
     own: Family,
 }
 
-static ROUTES: LazyLock<Vec<Route>> = LazyLock::new(|| {
-    [
+/// The files' families, in one table ([`table`]).
+static ROUTES: LazyLock<(Families, Vec<Route>)> = LazyLock::new(|| {
+    let mut table = Families::builtin();
+    let mut routes = Vec::new();
+    for (builtin, file) in [
         (Family::EDGES, "edge.toml"),
         (Family::HEIGHT, "height.toml"),
         (Family::VOLUME, "volume.toml"),
-    ]
-    .into_iter()
-    .map(|(builtin, file)| {
+    ] {
         let text = std::fs::read_to_string(asset(file)).unwrap();
         let name = text
             .lines()
@@ -57,17 +58,24 @@ static ROUTES: LazyLock<Vec<Route>> = LazyLock::new(|| {
             ),
             1,
         );
-        let parse = |text: &str, path: &str| {
-            Family::register(ConstraintFile::parse(Path::new(path), text).unwrap()).unwrap()
+        let mut parse = |text: &str, path: &str| {
+            table
+                .register(ConstraintFile::parse(Path::new(path), text).unwrap())
+                .unwrap()
         };
-        Route {
+        routes.push(Route {
             builtin,
             by_ad: parse(&text, file),
             own: parse(&own, &format!("own-{file}")),
-        }
-    })
-    .collect()
+        });
+    }
+    (table, routes)
 });
+
+/// The table the routes' families are in.
+fn table() -> &'static Families {
+    &ROUTES.0
+}
 
 /// C and ∇C of constraint `points` of `family` in f64 and in f32 (as f64).
 struct Both<'a> {
@@ -106,8 +114,9 @@ impl Visit for Both<'_> {
 /// `positions`, and the constraints compared.
 fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2], [f64; 2], usize) {
     let family = route.builtin;
-    let arity = family.arity();
-    let particles = family.row().binding.particles(mesh);
+    let table = table();
+    let arity = table.arity(family);
+    let particles = table.binding(family).particles(mesh);
     let mut worst = [0.0f64; 2];
     let mut worst_own = [0.0f64; 2];
     let mut compared = 0;
@@ -117,13 +126,16 @@ fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2],
             .map(|&i| mesh.positions[i as usize])
             .collect();
         let points: Vec<DVec3> = constraint.iter().map(|&i| positions[i as usize]).collect();
-        let rest = family.rest_value(&shape, &Material::default());
+        let rest = table.rest_value(family, &shape, &Material::default());
         let at = |f: Family| {
-            f.visit(Both {
-                points: &points,
-                rest,
-                shape: &shape,
-            })
+            table.visit(
+                f,
+                Both {
+                    points: &points,
+                    rest,
+                    shape: &shape,
+                },
+            )
         };
         let builtin = at(family);
         if builtin[0].2 {
@@ -157,12 +169,12 @@ fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2],
 /// frames of the built-in edges, heights and volume (the command line's settings).
 fn states(scene: &Scene, perturbation: Perturbation, frames: &[u64]) -> Vec<Vec<DVec3>> {
     let settings = Settings {
-        active: PerFamily::parse_list("edges,height,volume").unwrap(),
+        active: PerFamily::builtin_list("edges,height,volume").unwrap(),
         engine: Engine::Reference,
         settle_edits: true,
         ..Settings::default()
     };
-    let mut simulation = Simulation::new(scene, settings);
+    let mut simulation = Simulation::with_families(scene, settings, table().clone());
     simulation.perturb(perturbation);
     let mut out = Vec::new();
     for frame in 0..=*frames.iter().max().unwrap() {
@@ -189,12 +201,12 @@ fn scenes() -> Vec<(Scene, Perturbation)> {
 fn every_projection_of_a_file_is_the_built_ins() {
     for (scene, perturbation) in scenes() {
         for positions in states(&scene, perturbation, &[0, 1, 2, 5, 20, 60]) {
-            for route in ROUTES.iter() {
+            for route in ROUTES.1.iter() {
                 let (ad, own, compared) = differences(route, &scene.mesh, &positions);
                 println!(
                     "{} {perturbation:?}, {}: {compared} constraints; by AD {:.1e} (f64) {:.1e} (f32), its own gradient {:.1e} {:.1e}",
                     scene.name,
-                    route.builtin.name(),
+                    table().name(route.builtin),
                     ad[0],
                     ad[1],
                     own[0],
@@ -205,12 +217,12 @@ fn every_projection_of_a_file_is_the_built_ins() {
                     assert!(
                         f64s <= 1e-12,
                         "{}: {what}: f64 {f64s:e}",
-                        route.builtin.name()
+                        table().name(route.builtin)
                     );
                     assert!(
                         f32s <= 1e-5,
                         "{}: {what}: f32 {f32s:e}",
-                        route.builtin.name()
+                        table().name(route.builtin)
                     );
                 }
             }
@@ -226,7 +238,7 @@ fn every_projection_of_a_file_is_the_built_ins() {
 /// an edge: one ordering each.
 #[test]
 fn a_file_recovers_where_the_built_in_does_on_both_engines() {
-    let routes = &*ROUTES;
+    let routes = &ROUTES.1;
     for (scene, perturbation) in scenes() {
         let seeds: Vec<Option<u64>> = if scene.name == "cube" {
             (1..=4).map(Some).collect()
@@ -244,13 +256,14 @@ fn a_file_recovers_where_the_built_in_does_on_both_engines() {
                 let mut count = 0;
                 for &order_seed in &seeds {
                     let settings = Settings {
-                        active: PerFamily::from_fn(|f| families.contains(&f)),
+                        active: table().per_family(|f| families.contains(&f)),
                         engine,
                         settle_edits: true,
                         order_seed,
                         ..Settings::default()
                     };
-                    let mut simulation = Simulation::new(&scene, settings);
+                    let mut simulation =
+                        Simulation::with_families(&scene, settings, table().clone());
                     simulation.perturb(perturbation);
                     let start = Metrics::measure(&simulation);
                     let mut outcome = Outcome::start(&simulation, &start);

@@ -2,14 +2,14 @@
 //! them, and the source note's height written as a file recovers a mirrored cube exactly as the
 //! built-in height family does.
 //!
-//! Every family this binary uses is registered once, before any test looks at the table
-//! ([`families`]), so that no test sees the table change under it.
+//! The families this binary uses are in one table, made once ([`families`]); a test that
+//! changes a table changes its own copy.
 
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraints::{Binding, Family, PerFamily};
+use tetlab_core::constraints::{Binding, Families, Family, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
 use tetlab_core::simulation::fast::FastSimulation;
@@ -21,8 +21,9 @@ fn asset(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// The families of the example files this binary uses.
-struct Families {
+/// The families of the example files this binary uses, and the table they are in.
+struct Examples {
+    table: Families,
     height: Family,
     /// height.toml with `use_gradient = true`, under another name.
     height_own: Family,
@@ -33,30 +34,34 @@ struct Families {
     redefined: Family,
 }
 
-static FAMILIES: LazyLock<Families> = LazyLock::new(|| {
-    let register =
-        |name: &str| Family::register(ConstraintFile::load(&asset(name)).unwrap()).unwrap();
+static FAMILIES: LazyLock<Examples> = LazyLock::new(|| {
+    let mut table = Families::builtin();
+    let mut register = |file: ConstraintFile| table.register(file).unwrap();
+    let load = |name: &str| ConstraintFile::load(&asset(name)).unwrap();
     let text = "name = \"to-redefine\"\napplies_to = \"tets\"\nvalue = \"det(p1 - p0, p2 - p0, p3 - p0) / 6 - rest\"\n";
     let height = std::fs::read_to_string(asset("height.toml")).unwrap();
     let own = height.replace(
         "name = \"my-height\"",
         "name = \"my-height-own\"\nuse_gradient = true",
     );
-    Families {
-        height: register("height.toml"),
-        height_own: Family::register(ConstraintFile::parse(Path::new("own.toml"), &own).unwrap())
-            .unwrap(),
-        volume: register("volume.toml"),
-        edge: register("edge.toml"),
-        wrong_height: register("height-wrong-sign.toml"),
-        redefined: Family::register(
-            ConstraintFile::parse(Path::new("to-redefine.toml"), text).unwrap(),
-        )
-        .unwrap(),
+    let height = register(load("height.toml"));
+    let height_own = register(ConstraintFile::parse(Path::new("own.toml"), &own).unwrap());
+    let volume = register(load("volume.toml"));
+    let edge = register(load("edge.toml"));
+    let wrong_height = register(load("height-wrong-sign.toml"));
+    let redefined = register(ConstraintFile::parse(Path::new("to-redefine.toml"), text).unwrap());
+    Examples {
+        table,
+        height,
+        height_own,
+        volume,
+        edge,
+        wrong_height,
+        redefined,
     }
 });
 
-fn families() -> &'static Families {
+fn families() -> &'static Examples {
     &FAMILIES
 }
 
@@ -69,11 +74,11 @@ fn cube(active: PerFamily<bool>, substeps: u32) -> Simulation {
         ground: false,
         ..Settings::default()
     };
-    Simulation::new(&scene, settings)
+    Simulation::with_families(&scene, settings, families().table.clone())
 }
 
 fn with(families: &[Family]) -> PerFamily<bool> {
-    PerFamily::from_fn(|f| families.contains(&f))
+    self::families().table.per_family(|f| families.contains(&f))
 }
 
 /// A mirrored cube with no gravity under the workbench's settings (100 substeps, edits settle),
@@ -87,7 +92,7 @@ fn mirrored_cube(height: Family) -> Simulation {
         ground: false,
         ..Settings::default()
     };
-    let mut simulation = Simulation::new(&scene, settings);
+    let mut simulation = Simulation::with_families(&scene, settings, families().table.clone());
     simulation.perturb(Perturbation::Mirror);
     simulation
 }
@@ -225,7 +230,7 @@ fn the_fast_solver_projects_a_file_family_in_lanes() {
 #[test]
 fn a_wrong_gradient_in_use_is_what_the_projection_follows() {
     let f = families();
-    let file = f.wrong_height.file().unwrap();
+    let file = f.table.file(f.wrong_height).unwrap();
     assert!(
         file.use_gradient,
         "the lesson's wrong height is simulated with its own gradient"
@@ -254,25 +259,31 @@ fn a_wrong_gradient_in_use_is_what_the_projection_follows() {
 #[test]
 fn a_file_family_has_a_name_of_its_own() {
     let f = families();
-    let again = Family::register(ConstraintFile::load(&asset("height.toml")).unwrap()).unwrap();
+    let mut table = f.table.clone();
+    let again = table
+        .register(ConstraintFile::load(&asset("height.toml")).unwrap())
+        .unwrap();
     assert_eq!(again, f.height);
     let other = ConstraintFile::parse(
         Path::new("elsewhere/height.toml"),
         "name = \"my-height\"\napplies_to = \"tets\"\nvalue = \"1 - rest\"\n",
     )
     .unwrap();
-    let error = Family::register(other).unwrap_err();
+    let error = table.register(other).unwrap_err();
     assert!(error.contains("already the name of"), "{error}");
     for name in ["volume", "heights", "neohookean"] {
         let text = format!("name = \"{name}\"\napplies_to = \"tets\"\nvalue = \"1\"\n");
         let builtin = ConstraintFile::parse(Path::new("b.toml"), &text).unwrap();
-        let error = Family::register(builtin).unwrap_err();
+        let error = table.register(builtin).unwrap_err();
         assert!(error.contains("built-in"), "{name}: {error}");
     }
-    assert_eq!(f.height.row().binding, Binding::TetVertices);
-    assert_eq!(f.edge.arity(), 2);
-    assert_eq!(Family::parse("my-volume"), Ok(f.volume));
-    assert!(Family::all().any(|family| family == f.height));
+    assert_eq!(table, f.table, "nothing was added");
+    assert_eq!(table.binding(f.height), Binding::TetVertices);
+    assert_eq!(table.arity(f.edge), 2);
+    assert_eq!(table.parse("my-volume"), Ok(f.volume));
+    assert!(table.all().any(|family| family == f.height));
+    // Another table does not have them.
+    assert!(Families::builtin().parse("my-volume").is_err());
 }
 
 /// The editor redefines a family as the user types: every simulation that uses it rebuilds its
@@ -288,11 +299,18 @@ fn a_redefined_family_is_rebuilt_in_every_simulation() {
     let edges = simulation.constraint_count(Family::EDGES);
     let text =
         "name = \"to-redefine\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p1) - rest\"\n";
-    let redefined =
-        Family::define(ConstraintFile::parse(Path::new("to-redefine.toml"), text).unwrap())
-            .unwrap();
+    let mut table = simulation.families().clone();
+    let redefined = table
+        .define(ConstraintFile::parse(Path::new("to-redefine.toml"), text).unwrap())
+        .unwrap();
     assert_eq!(redefined, f.redefined, "the same place in the table");
-    assert_eq!(redefined.arity(), 2);
+    assert_eq!(table.arity(redefined), 2);
+    assert_eq!(
+        f.table.arity(redefined),
+        4,
+        "the table it was copied from is as it was"
+    );
+    simulation.set_families(table);
     simulation.step();
     assert_eq!(simulation.constraint_count(f.redefined), edges);
     let metrics = Metrics::measure_sound(&simulation).unwrap();

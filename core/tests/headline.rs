@@ -11,7 +11,7 @@ use tetlab_core::simulation::{Engine, Settings, Simulation};
 /// The bunny's metrics after `perturbation` and 300 frames; `None` when `../shared/meshes` is
 /// absent (the test then skips).
 fn bunny_after(perturbation: Perturbation, active: &str, edge_compliance: f64) -> Option<Metrics> {
-    let active = PerFamily::parse_list(active).unwrap();
+    let active = PerFamily::builtin_list(active).unwrap();
     let path = shared_meshes::for_test("bunny.node")?;
     let scene = Scene::load(&path).unwrap();
     let mut settings = Settings {

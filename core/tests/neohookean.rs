@@ -12,7 +12,7 @@ use tetlab_core::simulation::{Settings, Simulation};
 fn cube_with(material: Material, substeps: u32, gravity: f64) -> Simulation {
     let scene = Scene::builtin(Builtin::Cube, 4).unwrap();
     let mut settings = Settings {
-        active: PerFamily::parse_list("neohookean").unwrap(),
+        active: PerFamily::builtin_list("neohookean").unwrap(),
         substeps,
         ..Settings::default()
     };
@@ -222,7 +222,7 @@ fn xpbd_stiffness_is_the_same_for_any_iteration_count_and_pbd_is_not() {
     let tip = |method: Method, iterations: u32| {
         let scene = Scene::builtin(Builtin::Beam, 1).unwrap();
         let mut settings = Settings {
-            active: PerFamily::parse_list("neohookean").unwrap(),
+            active: PerFamily::builtin_list("neohookean").unwrap(),
             method,
             substeps: 20,
             iterations,

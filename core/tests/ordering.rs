@@ -23,7 +23,7 @@ fn hash(simulation: &Simulation) -> u64 {
 fn simulation(engine: Engine, families: &str, order_seed: Option<u64>) -> Simulation {
     let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
     let settings = Settings {
-        active: PerFamily::parse_list(families).unwrap(),
+        active: PerFamily::builtin_list(families).unwrap(),
         engine,
         substeps: 10,
         order_seed,
@@ -87,7 +87,9 @@ fn without_an_order_seed_the_order_is_the_tables_bit_for_bit() {
         let what = format!(
             "{:?} {}",
             simulation.engine(),
-            simulation.settings().active.describe()
+            simulation
+                .families()
+                .describe(&simulation.settings().active)
         );
         let got = run(simulation, perturbation);
         assert_eq!(got, expected, "{what}: {got:#018x}");

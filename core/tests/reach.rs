@@ -5,7 +5,7 @@
 use glam::DVec3;
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraints::{Family, PerFamily};
+use tetlab_core::constraints::{Families, Family, PerFamily};
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
 use tetlab_core::simulation::projection::SkipCounts;
 use tetlab_core::simulation::{Engine, Settings, Simulation};
@@ -21,7 +21,7 @@ fn a_step_beyond_the_reach_is_skipped_and_counted_on_both_engines() {
         let far = |reach: f64| {
             let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
             let mut settings = Settings {
-                active: PerFamily::parse_list("volume").unwrap(),
+                active: PerFamily::builtin_list("volume").unwrap(),
                 engine,
                 reach,
                 ..Settings::default()
@@ -64,10 +64,13 @@ fn a_step_beyond_the_reach_is_skipped_and_counted_on_both_engines() {
 fn a_correct_constraint_with_a_vanishing_gradient_does_not_diverge() {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints/dihedral-cosine.toml");
-    let family = Family::register(ConstraintFile::load(&path).unwrap()).unwrap();
+    let mut families = Families::builtin();
+    let family = families
+        .register(ConstraintFile::load(&path).unwrap())
+        .unwrap();
     for engine in [Engine::Reference, Engine::Fast] {
         let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
-        let mut active = PerFamily::parse_list("edges,volume").unwrap();
+        let mut active = PerFamily::builtin_list("edges,volume").unwrap();
         active.set(family, true);
         let settings = Settings {
             active,
@@ -75,7 +78,7 @@ fn a_correct_constraint_with_a_vanishing_gradient_does_not_diverge() {
             substeps: 10,
             ..Settings::default()
         };
-        let mut simulation = Simulation::new(&scene, settings);
+        let mut simulation = Simulation::with_families(&scene, settings, families.clone());
         simulation.perturb(Perturbation::Flatten);
         for frame in 1..=30 {
             simulation.step();
@@ -114,7 +117,7 @@ fn the_reach_leaves_the_built_in_families_alone() {
                 ] {
                     let scene = Scene::builtin(builtin, 2).unwrap();
                     let settings = Settings {
-                        active: PerFamily::parse_list(families).unwrap(),
+                        active: PerFamily::builtin_list(families).unwrap(),
                         engine,
                         settle_edits,
                         substeps: 20,
@@ -125,7 +128,8 @@ fn the_reach_leaves_the_built_in_families_alone() {
                     for _ in 0..60 {
                         simulation.step();
                     }
-                    for (family, skipped) in simulation.skipped().iter() {
+                    let table = simulation.families();
+                    for (family, skipped) in table.values(simulation.skipped()) {
                         assert_eq!(
                             skipped.too_long, 0,
                             "{builtin:?} {perturbation:?} {families} {engine:?} settle \

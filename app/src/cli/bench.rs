@@ -7,7 +7,7 @@ use super::simulation_args::SolverArgs;
 use serde::Serialize;
 use std::io::Write;
 use std::time::{Duration, Instant};
-use tetlab_core::constraints::{Family, PerFamily};
+use tetlab_core::constraints::{Families, Family, Named, PerFamily};
 use tetlab_core::input::limits;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::numbers::lanes::{LANES, REGISTERS};
@@ -72,29 +72,30 @@ struct Report {
     tets: usize,
     edges: usize,
     constraints: String,
+    /// The active families' names, in table order.
     #[serde(skip)]
-    active: PerFamily<bool>,
+    active: Vec<String>,
     substeps: u32,
     iterations: u32,
     frames: u64,
     projections_per_frame: u64,
     ns_per_projection: f64,
-    ns_per_projection_by_family: Option<PerFamily<f64>>,
+    ns_per_projection_by_family: Option<Named<f64>>,
     ms_per_frame: f64,
     frames_per_second: f64,
     bytes_per_tet: f64,
     peak_rss_bytes: Option<u64>,
-    colours: Option<PerFamily<usize>>,
+    colours: Option<Named<usize>>,
     /// How the fast solver's SIMD lanes are held on this build.
     lanes: Option<String>,
     /// After the run, per active family: √(mean (C / rest value)²).
     #[serde(serialize_with = "active_only")]
-    relative_error: Option<PerFamily<Option<f64>>>,
+    relative_error: Option<Named<Option<f64>>>,
 }
 
 /// A map of the families that have a value (the active ones), so that none is written `null`.
 fn active_only<S: serde::Serializer>(
-    values: &Option<PerFamily<Option<f64>>>,
+    values: &Option<Named<Option<f64>>>,
     serializer: S,
 ) -> Result<S::Ok, S::Error> {
     use serde::ser::SerializeMap;
@@ -102,9 +103,9 @@ fn active_only<S: serde::Serializer>(
         return serializer.serialize_none();
     };
     let mut map = serializer.serialize_map(None)?;
-    for (family, value) in values.iter() {
+    for (family, value) in &values.0 {
         if let Some(value) = value {
-            map.serialize_entry(family.name(), &value)?;
+            map.serialize_entry(family, &value)?;
         }
     }
     map.end()
@@ -115,7 +116,7 @@ fn active_only<S: serde::Serializer>(
 pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let scene = Scene::from_spec(&args.scene, args.resolution)
         .map_err(|e| UsageError(format!("--scene: {e}")))?;
-    let mut settings = args.solver.settings()?;
+    let (mut settings, families) = args.solver.settings()?;
     if args.workbench {
         // The workbench's own settings: edits settle; the engine and threads as it picks them.
         settings.settle_edits = true;
@@ -126,8 +127,14 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         let tets = scene.mesh.tets.len();
         let name = scene.name.clone();
         let engine = settings.engine.resolve(tets).name();
-        let cost =
-            super::workbench_frame::measure(scene, settings, threads, args.frames, args.warmup)?;
+        let cost = super::workbench_frame::measure(
+            scene,
+            settings,
+            families,
+            threads,
+            args.frames,
+            args.warmup,
+        )?;
         return super::workbench_frame::write(out, &name, tets, engine, &cost, args.json)
             .map_err(UsageError::stdout);
     }
@@ -141,7 +148,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             "--jacobi: only the fast engine projects in Jacobi order".into(),
         ));
     }
-    let mut simulation = Simulation::new(&scene, settings);
+    let mut simulation = Simulation::with_families(&scene, settings, families);
     simulation.set_threads(args.solver.threads.unwrap_or(1) as usize);
     super::simulation_args::warn_if_unstable(&simulation);
     let report = match settings.engine {
@@ -162,6 +169,7 @@ fn time_reference(
     Ok(report(
         args,
         scene,
+        simulation.families(),
         simulation.settings().active,
         "reference (f64)",
         1,
@@ -187,6 +195,7 @@ fn time_fast(
         s.fast_solver().reset_timings();
     });
     Metrics::measure_sound(simulation).map_err(|d| UsageError(d.to_string()))?;
+    let families = simulation.families().clone();
     let fast = simulation.fast_solver();
     // The fast solver's own arrays (the simulation it steps keeps its f64 state beside them).
     let heap_bytes = fast.heap_bytes();
@@ -201,8 +210,8 @@ fn time_fast(
             timings.time[f].as_nanos() as f64 / n as f64
         }
     };
-    let by_family = PerFamily::from_fn(|f| if active[f] { per(f) } else { 0.0 });
-    let colours = PerFamily::from_fn(|f| fast.batches(f).colours().len());
+    let by_family = families.named(&families.per_family(|f| if active[f] { per(f) } else { 0.0 }));
+    let colours = families.named(&families.per_family(|f| fast.batches(f).colours().len()));
     let solver = if args.jacobi {
         "fast (f32), Jacobi"
     } else {
@@ -211,6 +220,7 @@ fn time_fast(
     let mut report = report(
         args,
         scene,
+        &families,
         active,
         solver,
         fast.threads(),
@@ -222,18 +232,18 @@ fn time_fast(
     );
     report.lanes = Some(format!("{LANES} f32 per batch, in {REGISTERS}"));
     let relative_error = fast.relative_error();
-    for family in Family::all() {
+    for family in families.all() {
         if let Some(error) = relative_error.get(family)
             && !error.is_finite()
         {
             return Err(UsageError(format!(
                 "the f32 engine could not measure how well the {} constraints hold (their \
                  relative error is {error}); the scene is beyond what f32 resolves",
-                family.name()
+                families.name(family)
             )));
         }
     }
-    report.relative_error = Some(relative_error);
+    report.relative_error = Some(families.named(&relative_error));
     Ok(report)
 }
 
@@ -255,14 +265,15 @@ fn time<S>(args: &Args, solver: &mut S, step: fn(&mut S), warmed: fn(&mut S)) ->
 fn report(
     args: &Args,
     scene: &Scene,
+    families: &Families,
     active: PerFamily<bool>,
     solver: &'static str,
     threads: usize,
     projections_per_frame: u64,
     elapsed: Duration,
-    by_family: Option<PerFamily<f64>>,
+    by_family: Option<Named<f64>>,
     heap_bytes: usize,
-    colours: Option<PerFamily<usize>>,
+    colours: Option<Named<usize>>,
 ) -> Report {
     let seconds = elapsed.as_secs_f64();
     let frames = args.frames as f64;
@@ -274,8 +285,11 @@ fn report(
         particles: scene.mesh.positions.len(),
         tets,
         edges: scene.mesh.edges().len(),
-        constraints: active.describe(),
-        active,
+        constraints: families.describe(&active),
+        active: active
+            .families()
+            .map(|f| families.name(f).to_owned())
+            .collect(),
         substeps: args.solver.substeps,
         iterations: args.solver.iterations,
         frames: args.frames,
@@ -318,17 +332,16 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
         r.ms_per_frame, r.frames_per_second
     )?;
     write!(out, "ns per projection      {:.2}", r.ns_per_projection)?;
-    let active = r.active;
-    let of_active = |values: PerFamily<String>| -> String {
+    let of_active = |values: Vec<(&String, String)>| -> String {
         values
-            .iter_ref()
-            .filter(|(f, _)| active[*f])
-            .map(|(f, v)| format!("{} {v}", f.name()))
+            .into_iter()
+            .filter(|(f, _)| r.active.contains(f))
+            .map(|(f, v)| format!("{f} {v}"))
             .collect::<Vec<_>>()
             .join(", ")
     };
     if let Some(f) = &r.ns_per_projection_by_family {
-        let each = of_active(PerFamily::build(|family| format!("{:.2}", f[family])));
+        let each = of_active(f.0.iter().map(|(n, v)| (n, format!("{v:.2}"))).collect());
         write!(out, " ({each}; inside the sweeps)")?;
     }
     writeln!(out)?;
@@ -342,7 +355,7 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
     }
     writeln!(out)?;
     if let Some(c) = &r.colours {
-        let each = of_active(PerFamily::build(|family| c[family].to_string()));
+        let each = of_active(c.0.iter().map(|(n, v)| (n, v.to_string())).collect());
         writeln!(out, "colours                {each}")?;
     }
     if let Some(lanes) = &r.lanes {
@@ -350,8 +363,9 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
     }
     if let Some(error) = &r.relative_error {
         let shown: Vec<String> = error
+            .0
             .iter()
-            .filter_map(|(family, e)| e.map(|e| format!("{} {e:.2e}", family.name())))
+            .filter_map(|(family, e)| e.map(|e| format!("{family} {e:.2e}")))
             .collect();
         writeln!(
             out,

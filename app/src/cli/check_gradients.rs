@@ -9,7 +9,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraint_file::check::{AGREEMENT, Reflection, Report, check};
-use tetlab_core::constraints::Family;
+use tetlab_core::constraints::Families;
 use tetlab_core::constraints::verify::{CONDITIONING, random_check};
 
 /// Options of `tetlab check-gradients`.
@@ -32,7 +32,7 @@ pub struct Args {
 
 #[derive(Serialize)]
 struct Row {
-    constraint: &'static str,
+    constraint: String,
     compared: usize,
     skipped_near_degenerate: usize,
     max_relative_error: f64,
@@ -47,11 +47,13 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<bool, UsageError> {
     if let Some(path) = &args.constraint_file {
         return run_file(args, path, out);
     }
-    let rows: Vec<Row> = Family::all()
+    let families = Families::builtin();
+    let rows: Vec<Row> = families
+        .all()
         .map(|family| {
-            let r = random_check(family, args.samples as usize, args.seed);
+            let r = random_check(&families, family, args.samples as usize, args.seed);
             Row {
-                constraint: family.name(),
+                constraint: families.name(family).to_owned(),
                 compared: r.compared,
                 skipped_near_degenerate: r.skipped,
                 max_relative_error: r.max_relative_error,

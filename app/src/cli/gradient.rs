@@ -6,8 +6,8 @@ use serde::Serialize;
 use std::io::Write;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraints::Family;
 use tetlab_core::constraints::verify::{analytic_and_numeric, max_abs_error};
+use tetlab_core::constraints::{Families, Family};
 use tetlab_core::numbers::finite_difference::central_difference;
 
 /// Options of `tetlab gradient`.
@@ -16,7 +16,7 @@ use tetlab_core::numbers::finite_difference::central_difference;
 pub struct Args {
     /// The constraint family: edges (2 points: distance), height (4: height of p1 above the
     /// plane of p0, p2, p3) or volume (4: signed volume). `distance` and `plane` are aliases.
-    #[arg(long, value_parser = Family::parse)]
+    #[arg(long, value_parser = builtin_family)]
     constraint: Option<Family>,
     /// A constraint file (assets/constraints/*.toml) instead of a built-in family: C, its
     /// gradient by automatic differentiation, the file's own, and central differences.
@@ -37,10 +37,15 @@ pub struct Args {
     json: bool,
 }
 
+/// A built-in family by name (a file's is given with `--constraint-file`).
+fn builtin_family(text: &str) -> Result<Family, String> {
+    Families::builtin().parse(text)
+}
+
 /// What `--json` prints.
 #[derive(Debug, Serialize)]
 struct Output {
-    constraint: &'static str,
+    constraint: String,
     value: f64,
     rest: f64,
     gradients: Vec<[f64; 3]>,
@@ -54,20 +59,21 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let Some(family) = args.constraint else {
         return run_file(args, out);
     };
-    if args.points.len() != family.arity() {
+    let families = Families::builtin();
+    if args.points.len() != families.arity(family) {
         return Err(UsageError(format!(
             "--points: the {} constraint takes {} points, got {}",
-            family.name(),
-            family.arity(),
+            families.name(family),
+            families.arity(family),
             args.points.len()
         )));
     }
     let rest_shape = if args.rest_shape.is_empty() {
         &args.points
-    } else if !family.uses_rest_shape() {
+    } else if !families.uses_rest_shape(family) {
         return Err(UsageError(format!(
             "--rest-shape: the {} constraint does not read a rest shape",
-            family.name()
+            families.name(family)
         )));
     } else if args.rest_shape.len() != args.points.len() {
         return Err(UsageError(format!(
@@ -78,10 +84,11 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     } else {
         &args.rest_shape
     };
-    let evaluation = family.evaluate(&args.points, args.rest, rest_shape);
-    let (analytic, numeric) = analytic_and_numeric(family, &args.points, args.rest, rest_shape);
+    let evaluation = families.evaluate(family, &args.points, args.rest, rest_shape);
+    let (analytic, numeric) =
+        analytic_and_numeric(&families, family, &args.points, args.rest, rest_shape);
     let output = Output {
-        constraint: family.name(),
+        constraint: families.name(family).to_owned(),
         value: evaluation.value,
         rest: args.rest,
         gradients: analytic.iter().map(|&g| without_negative_zero(g)).collect(),
@@ -107,7 +114,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             .map_err(std::io::Error::from)
             .and_then(|()| writeln!(out))
     } else {
-        write_table(family, &output, out)
+        write_table(&families, family, &output, out)
     };
     written.map_err(UsageError::stdout)
 }
@@ -117,11 +124,17 @@ fn without_negative_zero(v: DVec3) -> [f64; 3] {
     (v + DVec3::ZERO).to_array()
 }
 
-fn write_table(family: Family, o: &Output, out: &mut impl Write) -> std::io::Result<()> {
+fn write_table(
+    families: &Families,
+    family: Family,
+    o: &Output,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
     // The formula's lines up to C itself; its gradient lines are what the table below shows.
-    let definition = family
-        .formula()
-        .iter()
+    let definition = families
+        .row(family)
+        .formula
+        .lines()
         .take_while(|line| !line.starts_with('∇'));
     writeln!(out, "constraint  {}", o.constraint)?;
     for line in definition {

@@ -9,7 +9,6 @@ use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraints::Family;
 use tetlab_core::simulation::Engine;
 use tetlab_core::teaching::lesson::{Action, BUILTIN, Lesson, LessonRun};
 
@@ -107,10 +106,16 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     for path in &args.constraint_files {
         let file =
             ConstraintFile::load(path).map_err(|e| UsageError(format!("--constraint-file {e}")))?;
-        if lesson.families.iter().any(|f| f.name() == file.name) {
+        if lesson
+            .file_families
+            .iter()
+            .any(|&f| lesson.families.name(f) == file.name)
+        {
             answers.push(file);
         } else {
-            let family = Family::register(file)
+            let family = lesson
+                .families
+                .register(file)
                 .map_err(|e| UsageError(format!("--constraint-file {}: {e}", path.display())))?;
             lesson.settings.active.set(family, true);
         }
@@ -272,7 +277,9 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
         }
         // An exercise's grade: which particles held, and where a wrong one is furthest off.
         for family in step.exercises() {
-            let Some(grade) = tetlab_core::constraint_file::grade::of_family(family) else {
+            let families = run.simulation.families();
+            let Some(grade) = tetlab_core::constraint_file::grade::of_family(families, family)
+            else {
                 continue;
             };
             for (line, _) in grade.lines() {

@@ -80,6 +80,7 @@ impl FrameRecord {
     pub fn new(simulation: &Simulation, metrics: &Metrics, start: glam::DVec3) -> Self {
         let first = simulation.frame() == 0;
         let settings = simulation.settings();
+        let families = simulation.families();
         let moved = metrics.centre_of_mass - start;
         FrameRecord {
             frame: simulation.frame(),
@@ -92,26 +93,19 @@ impl FrameRecord {
             max_speed: metrics.max_speed,
             centre_of_mass_displacement: moved.length(),
             centre_of_mass_horizontal_displacement: moved.x.hypot(moved.z),
-            residuals: metrics
-                .residual
-                .iter()
+            residuals: families
+                .values(&metrics.residual)
                 .filter(|&(family, _)| settings.active[family])
-                .map(|(family, value)| (format!("residual_{}", family.name()), value))
+                .map(|(family, value)| (format!("residual_{}", families.name(family)), value))
                 .collect(),
-            skipped: simulation
-                .skipped()
-                .iter()
+            skipped: families
+                .values(simulation.skipped())
                 .filter(|&(family, _)| settings.active[family])
                 .flat_map(|(family, counts)| {
+                    let name = families.name(family);
                     [
-                        (
-                            format!("skipped_degenerate_{}", family.name()),
-                            counts.degenerate,
-                        ),
-                        (
-                            format!("skipped_too_long_{}", family.name()),
-                            counts.too_long,
-                        ),
+                        (format!("skipped_degenerate_{name}"), counts.degenerate),
+                        (format!("skipped_too_long_{name}"), counts.too_long),
                     ]
                 })
                 .collect(),

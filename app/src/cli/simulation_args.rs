@@ -4,9 +4,8 @@
 use super::UsageError;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::constraints::Family;
-use tetlab_core::constraints::PerFamily;
 use tetlab_core::constraints::material::Material;
+use tetlab_core::constraints::{Families, Family};
 use tetlab_core::input::limits::{self, Number};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
@@ -132,9 +131,11 @@ impl SolverArgs {
     /// The solver settings these options ask for: the constraint files loaded and their
     /// families added to the table and to the active ones, then every family name looked up.
     /// An error names the option, and for a file the line and column of its mistake.
-    pub fn settings(&self) -> Result<Settings, UsageError> {
-        let files = self.load_constraint_files()?;
-        let mut active = PerFamily::parse_list(&self.constraints)
+    pub fn settings(&self) -> Result<(Settings, Families), UsageError> {
+        let mut families = Families::builtin();
+        let files = self.load_constraint_files(&mut families)?;
+        let mut active = families
+            .parse_list(&self.constraints)
             .map_err(|e| UsageError(format!("--constraints: {e}")))?;
         for family in files {
             active.set(family, true);
@@ -160,7 +161,7 @@ impl SolverArgs {
             ("--stiffness", &self.stiffness),
         ] {
             for NamedValue { name, value } in values {
-                let family = tetlab_core::simulation::settable_family(name)
+                let family = tetlab_core::simulation::settable_family(&families, name)
                     .map_err(|e| UsageError(format!("{option} {name}={value}: {e}")))?;
                 if option == "--compliance" {
                     settings.compliance.set(family, *value);
@@ -169,14 +170,14 @@ impl SolverArgs {
                 }
             }
         }
-        Ok(settings)
+        Ok((settings, families))
     }
 
-    /// Loads every `--constraint-file` and adds its family to the table.
-    fn load_constraint_files(&self) -> Result<Vec<Family>, UsageError> {
+    /// Loads every `--constraint-file` and adds its family to `families`.
+    fn load_constraint_files(&self, families: &mut Families) -> Result<Vec<Family>, UsageError> {
         self.constraint_files
             .iter()
-            .map(|path| load_constraint_file(path, Family::register))
+            .map(|path| load_constraint_file(path, |file| families.register(file)))
             .collect()
     }
 
@@ -193,11 +194,12 @@ impl SolverArgs {
     /// the settings [`SolverArgs::settings`] gave.
     pub fn describe(&self, simulation: &Simulation) -> String {
         let s = simulation.settings();
+        let families = simulation.families();
         let mut text = format!(
             "engine {}, {}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
             simulation.describe_engine(),
             s.method.name(),
-            s.active.describe(),
+            families.describe(&s.active),
             s.substeps,
             s.iterations,
             if s.iterations == 1 { "" } else { "s" },
@@ -213,7 +215,7 @@ impl SolverArgs {
         let uses_material = s
             .active
             .families()
-            .any(|f| f.row().compliance_from_material.is_some());
+            .any(|f| f.compliance_from_material().is_some());
         if uses_material || self.material.is_some() {
             text += &format!(", material {}", s.material.describe());
         }
@@ -222,7 +224,7 @@ impl SolverArgs {
             text += &format!(", reach {} rest edges", s.reach.show());
         }
         for family in s.active.families() {
-            if let Some(file) = family.file() {
+            if let Some(file) = families.file(family) {
                 let gradient = if file.use_gradient {
                     "its own gradient"
                 } else {
@@ -230,7 +232,7 @@ impl SolverArgs {
                 };
                 text += &format!(
                     ", {} from {} with {gradient}",
-                    family.name(),
+                    families.name(family),
                     file.path.display()
                 );
             }
@@ -241,11 +243,13 @@ impl SolverArgs {
 
 impl SimulationArgs {
     /// The solver settings these options ask for ([`SolverArgs::settings`]).
-    pub fn settings(&self) -> Result<Settings, UsageError> {
-        Ok(Settings {
+    pub fn settings(&self) -> Result<(Settings, Families), UsageError> {
+        let (settings, families) = self.solver.settings()?;
+        let settings = Settings {
             settle_edits: !self.no_settle_edits,
-            ..self.solver.settings()?
-        })
+            ..settings
+        };
+        Ok((settings, families))
     }
 
     /// Advances one frame and measures it; an error when the simulation diverged
@@ -257,10 +261,10 @@ impl SimulationArgs {
 
     /// Loads the scene, builds the simulation and applies the perturbation.
     pub fn build(&self) -> Result<(Scene, Simulation), UsageError> {
-        let settings = self.settings()?;
+        let (settings, families) = self.settings()?;
         let scene = Scene::from_spec(&self.scene, self.resolution)
             .map_err(|e| UsageError(format!("--scene: {e}")))?;
-        let mut simulation = Simulation::new(&scene, settings);
+        let mut simulation = Simulation::with_families(&scene, settings, families);
         simulation.set_threads(self.solver.threads());
         warn_if_unstable(&simulation);
         if let Some(perturbation) = self.perturb {
@@ -300,15 +304,15 @@ pub fn describe_settling(settings: &Settings) -> String {
 /// reach): "skipped projections of dihedral-cosine: 1204 with a step beyond 100 rest edges of
 /// their element, 12 with ∇C undefined". None when nothing was skipped.
 pub fn describe_skipped(simulation: &Simulation) -> Vec<String> {
-    simulation
-        .skipped()
-        .iter()
+    let families = simulation.families();
+    families
+        .values(simulation.skipped())
         .filter(|(_, counts)| !counts.is_zero())
         .map(|(family, counts)| {
             format!(
                 "skipped projections of {}: {} with a step beyond {} rest edges of their \
                  element, {} with ∇C undefined",
-                family.name(),
+                families.name(family),
                 counts.too_long,
                 simulation.settings().reach.show(),
                 counts.degenerate
@@ -317,11 +321,11 @@ pub fn describe_skipped(simulation: &Simulation) -> Vec<String> {
         .collect()
 }
 
-/// Loads the constraint file of `--constraint-file PATH` and adds its family to the table with
-/// `add` ([`Family::register`], or [`Family::define`] to replace a family of the same name).
+/// Loads the constraint file of `--constraint-file PATH` and adds its family to a table with
+/// `add` ([`Families::register`], or [`Families::define`] to replace a family of the same name).
 pub fn load_constraint_file(
     path: &std::path::Path,
-    add: fn(ConstraintFile) -> Result<Family, String>,
+    add: impl FnOnce(ConstraintFile) -> Result<Family, String>,
 ) -> Result<Family, UsageError> {
     let file =
         ConstraintFile::load(path).map_err(|e| UsageError(format!("--constraint-file {e}")))?;

@@ -36,11 +36,13 @@ pub struct FrameCost {
 pub fn measure(
     scene: Scene,
     settings: Settings,
+    families: tetlab_core::constraints::Families,
     threads: usize,
     frames: u64,
     warmup: u64,
 ) -> Result<FrameCost, UsageError> {
     let mut bench = Workbench::new(scene, settings);
+    bench.simulation.set_families(families);
     bench.simulation.set_threads(threads);
     bench.set_playing(true);
     let cache = SceneCache::new(&bench.scene.mesh);

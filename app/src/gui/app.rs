@@ -234,13 +234,18 @@ impl TetlabApp {
     /// constraint files puts the first in the editor, where its exercise is done.
     pub fn open_lesson(&mut self, lesson: Lesson) {
         self.lesson_number = None;
-        if let Some(&family) = lesson.families.first()
-            && let Some(file) = family.file()
+        if let Some(&family) = lesson.file_families.first()
+            && let Some(file) = lesson.families.file(family)
         {
             self.editor.set_text(&file.path, &file.source);
             self.editor.family = Some(family);
+        } else {
+            // The lesson's table replaces the workbench's: what the editor defined is not in it.
+            self.editor.family = None;
+            self.editor.report = None;
         }
         self.load(lesson.scene());
+        self.bench.set_families(lesson.families.clone());
         self.bench.set_settings(lesson.settings);
         self.bench.select_tet(lesson.tet);
         self.viewport.reset_camera();
@@ -437,7 +442,8 @@ impl TetlabApp {
     /// same name), switches it on (and the editor's previous family off, when the name
     /// changed), and rebuilds its constraints in every simulation shown.
     pub fn define_constraint(&mut self, file: tetlab_core::constraint_file::ConstraintFile) {
-        let family = match tetlab_core::constraints::Family::define(file) {
+        let mut families = self.bench.simulation.families().clone();
+        let family = match families.define(file) {
             Ok(family) => family,
             Err(message) => {
                 self.editor.error = Some(format!("{}: {message}", self.editor.path.display()));
@@ -452,10 +458,10 @@ impl TetlabApp {
             }
             settings.active[family] = true;
         }
-        self.bench.refresh_families();
         if let Some(comparison) = &mut self.comparison {
-            comparison.bench.refresh_families();
+            comparison.bench.set_families(families.clone());
         }
+        self.bench.set_families(families);
         self.set_settings(settings);
     }
 
@@ -632,7 +638,8 @@ impl TetlabApp {
                 (left, &mut self.bench, &mut self.viewport),
                 (right, &mut comparison.bench, &mut comparison.viewport),
             ] {
-                let families = bench.simulation.settings().active.describe();
+                let families =
+                    (bench.simulation.families()).describe(&bench.simulation.settings().active);
                 ui.add(
                     egui::Label::new(egui::RichText::new(families).size(size).strong()).truncate(),
                 );

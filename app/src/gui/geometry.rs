@@ -360,6 +360,7 @@ pub fn update(
             );
         }
         visual::projection_arrows(
+            simulation.families(),
             positions,
             projection,
             options.arrow_scale as f64,
@@ -370,7 +371,11 @@ pub fn update(
         tet_arrows(bench, options, arrows);
     }
     for arrow in arrows.iter() {
-        draw_arrow(geometry, arrow);
+        draw_arrow(
+            geometry,
+            arrow.quantity.colour(simulation.families()),
+            arrow,
+        );
     }
 }
 
@@ -432,8 +437,7 @@ fn octahedron(out: &mut Vec<Vertex>, centre: Vec3, r: f32, colour: Rgba) {
 
 /// An arrow: a shaft from the particle along its vector and a cone at its tip, in its quantity's
 /// colour, in the overlay (never hidden by the body).
-fn draw_arrow(geometry: &mut Geometry, arrow: &Arrow) {
-    let colour = arrow.quantity.colour();
+fn draw_arrow(geometry: &mut Geometry, colour: Rgba, arrow: &Arrow) {
     let start = arrow.origin.as_vec3();
     let vector = arrow.vector.as_vec3();
     let length = vector.length();
@@ -488,7 +492,7 @@ mod tests {
         let geometry = build(&bench, &cache, &ViewOptions::default(), None);
         assert_eq!(geometry.triangles.len() % 3, 0);
         assert_eq!(geometry.lines.len() % 2, 0);
-        let arrow_colour = visual::family_colour(Family::VOLUME);
+        let arrow_colour = visual::family_colour(bench.simulation.families(), Family::VOLUME);
         assert!(
             geometry
                 .overlay_lines

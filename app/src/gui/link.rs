@@ -15,8 +15,8 @@ use super::camera::OrbitCamera;
 use super::workbench::Edit;
 use glam::Vec3;
 use std::fmt;
+use tetlab_core::constraints::Families;
 use tetlab_core::constraints::material::Material;
-use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::scene::{Builtin, Perturbation};
 use tetlab_core::simulation::{Engine, Method, Settings};
 
@@ -107,8 +107,11 @@ impl Link {
             out.append_pair("scene", builtin.name());
             out.append_pair("resolution", &resolution.to_string());
         }
+        // Only built-in families travel in a link: the page it is opened on may not have a
+        // constraint file that this one loaded.
+        let families = Families::builtin();
         if s.active != defaults.active {
-            out.append_pair("families", &s.active.describe());
+            out.append_pair("families", &families.describe(&s.active));
         }
         if s.method != defaults.method {
             out.append_pair("method", s.method.name());
@@ -144,17 +147,17 @@ impl Link {
         if s.material != defaults.material {
             out.append_pair("material", &s.material.describe());
         }
-        for family in Family::all() {
+        for family in families.all() {
             // The material gives these; `material` carries them.
-            if family.row().compliance_from_material.is_some() {
+            if family.compliance_from_material().is_some() {
                 continue;
             }
             if s.compliance[family] != defaults.compliance[family] {
-                let key = format!("alpha.{}", family.name());
+                let key = format!("alpha.{}", families.name(family));
                 out.append_pair(&key, &s.compliance[family].to_string());
             }
             if s.stiffness[family] != defaults.stiffness[family] {
-                let key = format!("k.{}", family.name());
+                let key = format!("k.{}", families.name(family));
                 out.append_pair(&key, &s.stiffness[family].to_string());
             }
         }
@@ -229,7 +232,9 @@ impl Link {
                 }
                 "resolution" => resolution = Some(count(&value)?),
                 "families" => {
-                    s.active = PerFamily::parse_list(&value.replace('+', ",")).map_err(wrong)?
+                    s.active = Families::builtin()
+                        .parse_list(&value.replace('+', ","))
+                        .map_err(wrong)?
                 }
                 "method" => s.method = Method::parse(&value).map_err(wrong)?,
                 "engine" => s.engine = Engine::parse(&value).map_err(wrong)?,
@@ -284,7 +289,7 @@ impl Link {
                     let Some((kind, name)) = per_family else {
                         return Err(wrong("not a key of a tetlab link".into()));
                     };
-                    let family = Family::parse(name).map_err(&wrong)?;
+                    let family = Families::builtin().parse(name).map_err(&wrong)?;
                     let value = number(&value)?;
                     match kind {
                         "alpha" => s.compliance[family] = value,
@@ -367,12 +372,13 @@ pub fn page_url() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tetlab_core::constraints::{Family, PerFamily};
 
     /// Every part of a link survives being written and read.
     #[test]
     fn a_link_round_trips() {
         let mut settings = crate::gui::Preferences::default().settings;
-        settings.active = PerFamily::parse_list("edges,height,neohookean").unwrap();
+        settings.active = PerFamily::builtin_list("edges,height,neohookean").unwrap();
         settings.method = Method::Pbd;
         settings.engine = Engine::Fast;
         settings.substeps = 37;

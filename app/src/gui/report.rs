@@ -86,6 +86,7 @@ impl TetlabApp {
         let lesson = self.lesson.as_ref().map(|state| {
             let metrics = &bench.metrics;
             let comparison = self.comparison.as_ref().map(|c| &c.bench.metrics);
+            let families = bench.simulation.families();
             LessonReport {
                 title: state.lesson.title.clone(),
                 step: state.step + 1,
@@ -96,7 +97,9 @@ impl TetlabApp {
                     .iter()
                     .map(|e| CheckReport {
                         expect: e.to_string(),
-                        holds: e.check(metrics, comparison).is_some_and(|(_, holds)| holds),
+                        holds: e
+                            .check(families, metrics, comparison)
+                            .is_some_and(|(_, holds)| holds),
                     })
                     .collect(),
                 frames_left: state.frames_left,
@@ -105,9 +108,10 @@ impl TetlabApp {
                     .current()
                     .exercises()
                     .filter_map(|family| {
-                        let grade = tetlab_core::constraint_file::grade::of_family(family)?;
+                        let grade =
+                            tetlab_core::constraint_file::grade::of_family(families, family)?;
                         Some(GradeReport {
-                            family: family.name().to_owned(),
+                            family: families.name(family).to_owned(),
                             passed: grade.passed(),
                             lines: grade.lines().into_iter().map(|(line, _)| line).collect(),
                         })

@@ -211,7 +211,6 @@ fn to_glam(v: Vec2) -> GVec2 {
 
 /// The colour key in the view's corner.
 fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
-    use tetlab_core::constraints::Family;
     use tetlab_core::teaching::visual;
     let painter = ui.painter_at(rect);
     let mut y = rect.min.y + 10.0;
@@ -248,9 +247,10 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
         entry(geometry::PENDING, "next projection".to_owned());
     }
     let active = bench.simulation.settings().active;
-    for family in Family::all().filter(|&f| options.arrows && active.get(f)) {
-        for quantity in visual::Quantity::of_family(family) {
-            entry(quantity.colour(), quantity.label());
+    let families = bench.simulation.families();
+    for family in families.all().filter(|&f| options.arrows && active.get(f)) {
+        for quantity in visual::Quantity::of_family(families, family) {
+            entry(quantity.colour(families), quantity.label(families));
         }
     }
     if stepping {

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use std::collections::VecDeque;
-use tetlab_core::constraints::PerFamily;
+use tetlab_core::constraints::{Families, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::simulation::divergence::Divergence;
@@ -86,7 +86,12 @@ pub enum Edit {
 impl Workbench {
     /// A workbench on `scene`, paused at rest, with tet 0 and its first corner selected.
     pub fn new(scene: Scene, settings: Settings) -> Self {
-        let mut simulation = Simulation::new(&scene, settings);
+        Workbench::with_families(scene, settings, Families::builtin())
+    }
+
+    /// [`Workbench::new`] on the families of `families`.
+    pub fn with_families(scene: Scene, settings: Settings, families: Families) -> Self {
+        let mut simulation = Simulation::with_families(&scene, settings, families);
         simulation.set_threads(threads());
         let mut workbench = Workbench {
             stability_warning: simulation.stability_warning(),
@@ -139,7 +144,8 @@ impl Workbench {
 
     /// Replaces the scene, keeping the settings.
     pub fn load(&mut self, scene: Scene) {
-        *self = Workbench::new(scene, *self.simulation.settings());
+        let families = self.simulation.families().clone();
+        *self = Workbench::with_families(scene, *self.simulation.settings(), families);
     }
 
     /// Advances one frame.
@@ -372,13 +378,13 @@ impl Workbench {
         self.after_change();
     }
 
-    /// Takes up the families' definitions now in force (a constraint file redefined by the
-    /// editor): step-by-step mode ends where it stands (its next constraint may be gone), and
-    /// the constraints of a redefined family are rebuilt.
-    pub fn refresh_families(&mut self) {
+    /// Simulates the families of `families` from now on (a constraint file defined or
+    /// redefined by the editor, a lesson's): step-by-step mode ends where it stands (its next
+    /// constraint may be gone), and the constraints of a redefined family are rebuilt.
+    pub fn set_families(&mut self, families: Families) {
         self.stepping = None;
         self.last_advance = None;
-        self.simulation.refresh_families();
+        self.simulation.set_families(families);
         self.after_change();
     }
 

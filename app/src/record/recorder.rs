@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use rerun::RecordingStream;
-use tetlab_core::constraints::Family;
+use tetlab_core::constraints::Families;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
 use tetlab_core::simulation::Simulation;
@@ -79,25 +79,28 @@ impl<'a> Recorder<'a> {
         );
         // The constraint files of the families in use, as written: what the arrows of
         // `world/gradients/<name>` are the gradient of.
+        let families = simulation.families();
         for family in simulation.settings().active.families() {
-            if let Some(file) = family.file() {
+            if let Some(file) = families.file(family) {
                 let text = format!(
                     "# {}\n\n{}\n\n```toml\n{}\n```",
-                    family.name(),
+                    families.name(family),
                     file.path.display(),
                     file.source.trim_end()
                 );
                 log(
-                    &format!("constraints/{}", family.name()),
+                    &format!("constraints/{}", families.name(family)),
                     &rerun::TextDocument::from_markdown(text),
                 );
             }
         }
-        let quantities = Family::all().flat_map(Quantity::of_family);
+        let quantities = families
+            .all()
+            .flat_map(|f| Quantity::of_family(families, f));
         for quantity in quantities.chain([Quantity::Correction]) {
             log(
-                &arrow_path(quantity),
-                &rerun::Arrows3D::update_fields().with_colors([rgba(quantity.colour())]),
+                &arrow_path(families, quantity),
+                &rerun::Arrows3D::update_fields().with_colors([rgba(quantity.colour(families))]),
             );
         }
         Recorder {
@@ -206,15 +209,17 @@ impl<'a> Recorder<'a> {
             &mut self.arrow_scratch,
         );
         let active = simulation.settings().active;
-        let quantities = Family::all()
+        let families = simulation.families();
+        let quantities = families
+            .all()
             .filter(|&f| active.get(f))
-            .flat_map(Quantity::of_family)
+            .flat_map(|f| Quantity::of_family(families, f))
             .chain([Quantity::Correction]);
         for quantity in quantities {
             let arrows = self.arrow_scratch.iter().filter(|a| a.quantity == quantity);
             self.rec
                 .log(
-                    format!("{}{}", self.root, arrow_path(quantity)),
+                    format!("{}{}", self.root, arrow_path(families, quantity)),
                     &rerun::Arrows3D::update_fields()
                         .with_origins(arrows.clone().map(|a| a.origin.as_vec3()))
                         .with_vectors(arrows.map(|a| a.vector.as_vec3())),
@@ -225,12 +230,12 @@ impl<'a> Recorder<'a> {
 }
 
 /// Where arrows of `quantity` are logged.
-fn arrow_path(quantity: Quantity) -> String {
+fn arrow_path(families: &Families, quantity: Quantity) -> String {
     match quantity {
-        Quantity::Gradient(family) => format!("world/gradients/{}", family.name()),
+        Quantity::Gradient(family) => format!("world/gradients/{}", families.name(family)),
         Quantity::Disagreeing(family) => {
-            let other = Quantity::disagreeing_name(family).to_lowercase();
-            format!("world/gradients/{}-{other}", family.name())
+            let other = Quantity::disagreeing_name(families, family).to_lowercase();
+            format!("world/gradients/{}-{other}", families.name(family))
         }
         Quantity::Correction => "world/corrections".to_owned(),
     }

@@ -7,7 +7,7 @@
 
 use super::ConstraintFile;
 use super::check::{self, AGREEMENT, Worst};
-use crate::constraints::Family;
+use crate::constraints::{Families, Family};
 use std::sync::Arc;
 
 /// The configurations a grade compares on (seed 1, as `gradient_error.NAME` in a lesson).
@@ -157,6 +157,6 @@ impl Grade {
 
 /// The grade of `family`'s file ([`ConstraintFile::grade`], worked out once per definition of
 /// the family: the student redefines it as they type); `None` for a built-in family.
-pub fn of_family(family: Family) -> Option<Arc<Grade>> {
-    Some(family.file()?.grade())
+pub fn of_family(families: &Families, family: Family) -> Option<Arc<Grade>> {
+    Some(families.file(family)?.grade())
 }

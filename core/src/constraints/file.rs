@@ -1,5 +1,5 @@
 //! A constraint file's family as a [`Constraint`]: its compiled tape gives C and ∇C. The file
-//! joins the table of families in [`super::registry`].
+//! joins the table of families in [`super::Families`].
 
 use super::{Constraint, Evaluation};
 use crate::constraint_file::ConstraintFile;

@@ -13,25 +13,27 @@
 //! | [`neohookean`] deviatoric | p0, p1, p2, p3 | √V₀ ‖F‖_F, F = Ds Dm⁻¹ |
 //! | [`neohookean`] hydrostatic | p0, p1, p2, p3 | √V₀ (det F − γ), γ = 1 + μ/λ |
 //!
-//! Each is a [`Constraint`] type; [`family`] holds the table of families that everything else
-//! reads, and [`file`] adds the families of constraint files to it at run time. [`material`]
+//! Each is a [`Constraint`] type; a [`Families`] value ([`families`]) is the table of families
+//! that everything else reads: the built-in ones, and those of constraint files ([`file`]). [`material`]
 //! turns Young's modulus and Poisson's ratio into the compliances of the families that take them.
 //!
 //! When a gradient is undefined (coincident points, a face of zero area) the evaluation is
 //! flagged ([`Evaluation::degenerate`]), its gradients are zero and its value stays finite.
 
 pub mod distance;
+pub mod families;
 pub mod family;
 pub mod file;
 pub mod height;
 pub mod material;
 pub mod neohookean;
-pub mod registry;
 mod table;
 pub mod verify;
 pub mod volume;
 
-pub use family::{Binding, Family, PerFamily, Row, TABLE, Visit, VisitPair};
+pub use families::{Families, Named};
+pub use family::{Binding, Family, MAX_FAMILIES, PerFamily, Row, TABLE, Visit, VisitPair};
+pub use table::Formula;
 
 use crate::constraints::material::Material;
 use crate::numbers::vector::{Real, Vector3};

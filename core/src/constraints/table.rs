@@ -1,11 +1,12 @@
 //! The table of constraint families: one [`Row`] per family, in projection order, for the
 //! built-in families ([`TABLE`]); the families of constraint files join it at run time
-//! ([`super::registry`]). A [`Family`] is a place in it.
+//! ([`super::Families`]). A [`Family`] is a place in it.
 
 use super::material::Material;
+use std::borrow::Cow;
 
 /// How many families the table can hold: the built-in ones and those read from constraint files
-/// ([`super::registry`]).
+/// ([`super::Families`]).
 pub const MAX_FAMILIES: usize = 16;
 
 /// A constraint family: a row of [`TABLE`].
@@ -26,33 +27,30 @@ pub enum Binding {
 }
 
 /// A family as people see it, and as the code reaches it.
+#[derive(Clone, Debug)]
 pub struct Row {
     /// Its name on the command line, in files, JSON keys and recordings' entity paths.
-    pub name: &'static str,
+    pub name: Cow<'static, str>,
     /// Other spellings the command line and files accept.
     pub aliases: &'static [&'static str],
     /// A title for headings: "Edge distance".
-    pub title: &'static str,
+    pub title: Cow<'static, str>,
     /// A short label for legends and buttons: "edges".
-    pub label: &'static str,
+    pub label: Cow<'static, str>,
     /// The colour of its gradient arrows (sRGB and alpha), the same in the workbench and in
     /// recordings.
     pub colour: [u8; 4],
     /// The constraint and its gradients as lines of math (the inspector, lessons).
-    pub formula: &'static [&'static str],
+    pub formula: Formula,
     /// What the rest value is called in the formula: d or V.
     pub rest_symbol: &'static str,
     /// How many particles one constraint touches.
     pub arity: usize,
     /// How it binds to a mesh.
     pub binding: Binding,
-    /// Whether its gradient needs the face (p0, p2, p3) to span a plane: the gradient check then
-    /// leaves out random configurations where that face is nearly a line (the height's gradient
-    /// grows without bound there).
-    pub needs_face_p0_p2_p3: bool,
     /// The name of the group it belongs to on the command line and in the workbench: its own
     /// name, or that of the families it comes with (`neohookean` names both neo-Hookean ones).
-    pub group: &'static str,
+    pub group: Cow<'static, str>,
     /// Its XPBD compliance, when a [`Material`] gives it (per unit rest volume: the constraint is
     /// scaled by √V₀); otherwise the compliance is set per family.
     pub compliance_from_material: Option<fn(&Material) -> f64>,
@@ -63,8 +61,32 @@ pub struct Row {
     pub(super) kind: Kind,
 }
 
+/// A family's constraint and gradients as lines of math: written in the code for a built-in
+/// family, the file's `define` and `value` lines for a file's.
+#[derive(Clone, Debug)]
+pub enum Formula {
+    /// Lines written in the code.
+    Builtin(&'static [&'static str]),
+    /// Lines read from a file.
+    File(Vec<String>),
+}
+
+impl Formula {
+    /// The lines, in order.
+    pub fn lines(&self) -> impl Iterator<Item = &str> {
+        let (builtin, file): (&[&str], &[String]) = match self {
+            Formula::Builtin(lines) => (lines, &[]),
+            Formula::File(lines) => (&[], lines),
+        };
+        builtin
+            .iter()
+            .copied()
+            .chain(file.iter().map(String::as_str))
+    }
+}
+
 /// Which [`super::Constraint`] type evaluates a family: the one `match` over families.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Kind {
     Distance,
     Height,
@@ -78,81 +100,76 @@ pub(super) enum Kind {
 /// The families, in projection order (edges, heights, volumes, then the neo-Hookean pair).
 pub static TABLE: [Row; 5] = [
     Row {
-        name: "edges",
+        name: Cow::Borrowed("edges"),
         aliases: &["edge", "distance"],
-        title: "Edge distance",
-        label: "edges",
+        title: Cow::Borrowed("Edge distance"),
+        label: Cow::Borrowed("edges"),
         colour: [240, 150, 20, 255],
-        formula: super::distance::FORMULA,
+        formula: Formula::Builtin(super::distance::FORMULA),
         rest_symbol: "d",
         arity: 2,
         binding: Binding::Edges,
-        needs_face_p0_p2_p3: false,
-        group: "edges",
+        group: Cow::Borrowed("edges"),
         compliance_from_material: None,
         projected_with: None,
         kind: Kind::Distance,
     },
     Row {
-        name: "height",
+        name: Cow::Borrowed("height"),
         aliases: &["heights", "plane"],
-        title: "Heights above the opposite face",
-        label: "heights",
+        title: Cow::Borrowed("Heights above the opposite face"),
+        label: Cow::Borrowed("heights"),
         colour: [40, 170, 60, 255],
-        formula: super::height::FORMULA,
+        formula: Formula::Builtin(super::height::FORMULA),
         rest_symbol: "d",
         arity: 4,
         binding: Binding::TetVertices,
-        needs_face_p0_p2_p3: true,
-        group: "height",
+        group: Cow::Borrowed("height"),
         compliance_from_material: None,
         projected_with: None,
         kind: Kind::Height,
     },
     Row {
-        name: "volume",
+        name: Cow::Borrowed("volume"),
         aliases: &[],
-        title: "Signed volume",
-        label: "volume",
+        title: Cow::Borrowed("Signed volume"),
+        label: Cow::Borrowed("volume"),
         colour: [50, 100, 230, 255],
-        formula: super::volume::FORMULA,
+        formula: Formula::Builtin(super::volume::FORMULA),
         rest_symbol: "V",
         arity: 4,
         binding: Binding::Tets,
-        needs_face_p0_p2_p3: false,
-        group: "volume",
+        group: Cow::Borrowed("volume"),
         compliance_from_material: None,
         projected_with: None,
         kind: Kind::Volume,
     },
     Row {
-        name: "neohookean-deviatoric",
+        name: Cow::Borrowed("neohookean-deviatoric"),
         aliases: &["deviatoric"],
-        title: "Neo-Hookean, deviatoric",
-        label: "neo-Hookean dev.",
+        title: Cow::Borrowed("Neo-Hookean, deviatoric"),
+        label: Cow::Borrowed("neo-Hookean dev."),
         colour: [160, 95, 40, 255],
-        formula: super::neohookean::DEVIATORIC_FORMULA,
+        formula: Formula::Builtin(super::neohookean::DEVIATORIC_FORMULA),
         rest_symbol: "0",
         arity: 4,
         binding: Binding::Tets,
-        needs_face_p0_p2_p3: false,
-        group: "neohookean",
+        group: Cow::Borrowed("neohookean"),
         compliance_from_material: Some(|m| 1.0 / m.mu()),
         projected_with: Some(Family::NEOHOOKEAN_HYDROSTATIC),
         kind: Kind::Deviatoric,
     },
     Row {
-        name: "neohookean-hydrostatic",
+        name: Cow::Borrowed("neohookean-hydrostatic"),
         aliases: &["hydrostatic"],
-        title: "Neo-Hookean, hydrostatic",
-        label: "neo-Hookean hyd.",
+        title: Cow::Borrowed("Neo-Hookean, hydrostatic"),
+        label: Cow::Borrowed("neo-Hookean hyd."),
         colour: [135, 80, 225, 255],
-        formula: super::neohookean::HYDROSTATIC_FORMULA,
+        formula: Formula::Builtin(super::neohookean::HYDROSTATIC_FORMULA),
         rest_symbol: "s γ",
         arity: 4,
         binding: Binding::Tets,
-        needs_face_p0_p2_p3: false,
-        group: "neohookean",
+        group: Cow::Borrowed("neohookean"),
         compliance_from_material: Some(|m| 1.0 / m.lambda()),
         projected_with: Some(Family::NEOHOOKEAN_DEVIATORIC),
         kind: Kind::Hydrostatic,
@@ -171,8 +188,8 @@ impl Family {
     /// The hydrostatic half of a neo-Hookean tet ([`super::neohookean`]).
     pub const NEOHOOKEAN_HYDROSTATIC: Family = Family(4);
 
-    /// The family in place `index` of the table.
-    pub(super) fn from_index(index: usize) -> Family {
+    /// The family in place `index` of a table.
+    pub(crate) fn from_index(index: usize) -> Family {
         debug_assert!(index < MAX_FAMILIES);
         Family(index as u8)
     }

@@ -10,7 +10,7 @@
 //! The same routines back the test suite (which asserts every figure) and `tetlab
 //! check-gradients` (which prints the figures quoted in `docs/gradients.md`).
 
-use crate::constraints::{Constraint, Family, Visit};
+use crate::constraints::{Constraint, Families, Family, Visit};
 use crate::numbers::dual::{Dual64, DualVec3};
 use crate::numbers::finite_difference::central_difference;
 use crate::numbers::random::SplitMix64;
@@ -134,13 +134,15 @@ pub fn max_abs_error(analytic: &[DVec3], numeric: &[DVec3]) -> f64 {
 /// The analytic gradient of `family` at `points` (with rest value `rest` and rest shape
 /// `rest_shape`) and the central-difference one, in f64.
 pub fn analytic_and_numeric(
+    families: &Families,
     family: Family,
     points: &[DVec3],
     rest: f64,
     rest_shape: &[DVec3],
 ) -> (Vec<DVec3>, Vec<DVec3>) {
-    let analytic = family.evaluate(points, rest, rest_shape).gradients[..points.len()].to_vec();
-    let numeric = central_difference(points, |p| family.evaluate(p, rest, rest_shape).value);
+    let evaluate = |p: &[DVec3]| families.evaluate(family, p, rest, rest_shape);
+    let analytic = evaluate(points).gradients[..points.len()].to_vec();
+    let numeric = central_difference(points, |p| evaluate(p).value);
     (analytic, numeric)
 }
 
@@ -148,6 +150,7 @@ pub fn analytic_and_numeric(
 /// formula evaluated on dual numbers, once per coordinate; the rest shape is held fixed. `None`
 /// where a derivative is not finite.
 pub fn automatic_gradient(
+    families: &Families,
     family: Family,
     points: &[DVec3],
     rest: f64,
@@ -163,7 +166,9 @@ pub fn automatic_gradient(
             c.evaluate(&p, Dual64::from_f64(self.1), &shape).value
         }
     }
-    crate::numbers::dual::gradient(points, |p| family.visit(Value(p, rest, rest_shape)))
+    crate::numbers::dual::gradient(points, |p| {
+        families.visit(family, Value(p, rest, rest_shape))
+    })
 }
 
 /// Whether `points` are far from degenerate: no two closer than [`CONDITIONING`] times the
@@ -229,7 +234,7 @@ fn draw_with_rest_shape(
 }
 
 /// What the check needs of a constraint: C, the gradient it gives, and ∇C by forward-mode AD.
-/// A built-in [`Family`] gives its analytic gradient for every particle; a constraint file
+/// A family of a table ([`TableFamily`]) gives its analytic gradient for every particle; a constraint file
 /// gives the gradients it writes (its `[gradient]` table), and none for the others.
 pub trait GradientSource {
     /// How many particles one constraint touches.
@@ -247,21 +252,35 @@ pub trait GradientSource {
     fn natural_rest(&self, points: &[DVec3], rest_shape: &[DVec3]) -> f64;
 }
 
-impl GradientSource for Family {
+/// A family of a table, as the check sees it: C by the family's formula, its analytic gradient,
+/// and AD over the same formula.
+#[derive(Clone, Copy)]
+pub struct TableFamily<'a> {
+    /// The table.
+    pub families: &'a Families,
+    /// The family.
+    pub family: Family,
+}
+
+impl GradientSource for TableFamily<'_> {
     fn arity(&self) -> usize {
-        Family::arity(*self)
+        self.families.arity(self.family)
     }
 
     fn uses_rest_shape(&self) -> bool {
-        Family::uses_rest_shape(*self)
+        self.families.uses_rest_shape(self.family)
     }
 
     fn value(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> f64 {
-        self.evaluate(points, rest, rest_shape).value
+        self.families
+            .evaluate(self.family, points, rest, rest_shape)
+            .value
     }
 
     fn given(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Vec<Option<DVec3>> {
-        let evaluation = self.evaluate(points, rest, rest_shape);
+        let evaluation = self
+            .families
+            .evaluate(self.family, points, rest, rest_shape);
         evaluation.gradients[..points.len()]
             .iter()
             .map(|&g| Some(g))
@@ -269,11 +288,11 @@ impl GradientSource for Family {
     }
 
     fn automatic(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Option<Vec<DVec3>> {
-        automatic_gradient(*self, points, rest, rest_shape)
+        automatic_gradient(self.families, self.family, points, rest, rest_shape)
     }
 
     fn natural_rest(&self, points: &[DVec3], rest_shape: &[DVec3]) -> f64 {
-        self.evaluate(points, 0.0, rest_shape).value
+        self.value(points, 0.0, rest_shape)
     }
 }
 
@@ -299,21 +318,28 @@ pub struct FamilyReport {
 /// in a cube of random size 10^U(−2, 2) around a random centre, rest value random in the range of
 /// the constraint's own values, and (for a family that reads one) a rest shape drawn the same
 /// way. Returns the error statistics.
-pub fn random_check(family: Family, samples: usize, seed: u64) -> FamilyReport {
+pub fn random_check(
+    families: &Families,
+    family: Family,
+    samples: usize,
+    seed: u64,
+) -> FamilyReport {
+    let source = TableFamily { families, family };
     let mut rng = SplitMix64::new(seed);
     let (mut compared, mut skipped) = (0, 0);
     let (mut max_error, mut sum_error, mut max_automatic) = (0.0_f64, 0.0, 0.0_f64);
     while compared < samples {
-        let (points, rest_shape, _) = draw_with_rest_shape(&mut rng, &family);
+        let (points, rest_shape, _) = draw_with_rest_shape(&mut rng, &source);
         if !well_conditioned(&points) || !well_conditioned(&rest_shape) {
             skipped += 1;
             continue;
         }
-        let rest = family.evaluate(&points, 0.0, &rest_shape).value * rng.range(-1.5, 1.5);
-        let (analytic, numeric) = analytic_and_numeric(family, &points, rest, &rest_shape);
+        let rest = source.natural_rest(&points, &rest_shape) * rng.range(-1.5, 1.5);
+        let (analytic, numeric) =
+            analytic_and_numeric(families, family, &points, rest, &rest_shape);
         let error = relative_error(&analytic, &numeric);
         max_error = max_error.max(error);
-        if let Some(automatic) = automatic_gradient(family, &points, rest, &rest_shape) {
+        if let Some(automatic) = automatic_gradient(families, family, &points, rest, &rest_shape) {
             max_automatic = max_automatic.max(relative_error(&analytic, &automatic));
         }
         sum_error += error;

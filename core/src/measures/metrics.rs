@@ -4,7 +4,7 @@
 //! nothing that is not a number is ever printed, plotted or recorded.
 
 use crate::constraints::volume::signed_volume;
-use crate::constraints::{Constraint, Family, PerFamily, Visit};
+use crate::constraints::{Constraint, Families, Family, PerFamily, Visit};
 use crate::simulation::divergence::{Cause, Divergence};
 use crate::simulation::{ConstraintSet, Simulation};
 use glam::DVec3;
@@ -51,7 +51,8 @@ impl Metrics {
 
     /// Ok when every measurement is finite; otherwise the first that is not, as the divergence
     /// of a state at `frame`.
-    pub fn check(&self, frame: u64) -> Result<(), Divergence> {
+    /// `families` names the families of the residuals.
+    pub fn check(&self, families: &Families, frame: u64) -> Result<(), Divergence> {
         let more = [
             ("max_displacement", self.max_displacement),
             ("max_speed", self.max_speed),
@@ -61,8 +62,14 @@ impl Metrics {
         if let Some((name, value)) = all.into_iter().find(|(_, v)| !v.is_finite()) {
             return Err(Divergence::new(frame, Cause::Metric { name, value }));
         }
-        match self.residual.iter().find(|(_, v)| !v.is_finite()) {
-            Some((family, value)) => Err(Divergence::new(frame, Cause::Residual { family, value })),
+        match families
+            .values(&self.residual)
+            .find(|(_, v)| !v.is_finite())
+        {
+            Some((family, value)) => {
+                let family = families.name(family).to_owned();
+                Err(Divergence::new(frame, Cause::Residual { family, value }))
+            }
             None => Ok(()),
         }
     }
@@ -72,7 +79,7 @@ impl Metrics {
     pub fn measure_sound(simulation: &Simulation) -> Result<Metrics, Divergence> {
         simulation.check()?;
         let metrics = Metrics::measure(simulation);
-        metrics.check(simulation.frame())?;
+        metrics.check(simulation.families(), simulation.frame())?;
         Ok(metrics)
     }
 
@@ -128,12 +135,15 @@ impl Metrics {
                 .map(|v| v.length())
                 .fold(0.0, larger),
             centre_of_mass: simulation.centre_of_mass(positions),
-            residual: PerFamily::from_fn(|family| {
-                family.visit(Rms {
-                    set: simulation.constraints(family),
-                    positions,
-                    rest_positions: simulation.rest_positions(),
-                })
+            residual: simulation.families().per_family(|family| {
+                simulation.families().visit(
+                    family,
+                    Rms {
+                        set: simulation.constraints(family),
+                        positions,
+                        rest_positions: simulation.rest_positions(),
+                    },
+                )
             }),
         }
     }

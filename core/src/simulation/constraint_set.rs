@@ -3,17 +3,21 @@
 //! XPBD multiplier λ), built once from the family's binding to the mesh, and the order a sweep
 //! projects them in (the binding's, or a permutation drawn from an order seed).
 
+use crate::constraint_file::ConstraintFile;
 use crate::constraints::material::Material;
-use crate::constraints::{Constraint, Family, Visit};
+use crate::constraints::{Constraint, Families, Family, Visit};
 use crate::scene::mesh::TetMesh;
 use glam::DVec3;
+use std::sync::Arc;
 
 /// One family's constraints.
 #[derive(Clone, Debug, Default)]
 pub struct ConstraintSet {
-    /// The family's definition it was built from ([`Family::generation`]); `None` before it is
-    /// built.
-    generation: Option<u64>,
+    /// Whether it was built (the sets of families a simulation does not use stay empty).
+    built: bool,
+    /// The file it was built from, for a file's family: a redefined family has another
+    /// ([`Families::same_definition`]).
+    file: Option<Arc<ConstraintFile>>,
     arity: usize,
     particles: Vec<u32>,
     rest: Vec<f64>,
@@ -29,24 +33,31 @@ pub struct ConstraintSet {
 impl ConstraintSet {
     /// The constraints of `family` on `mesh` ([`crate::constraints::Binding::particles`]), each
     /// with its rest value measured on the mesh's rest positions ([`Constraint::rest_value`]).
-    pub(crate) fn new(family: Family, mesh: &TetMesh, material: &Material) -> ConstraintSet {
-        let particles = family.row().binding.particles(mesh);
+    pub(crate) fn new(
+        families: &Families,
+        family: Family,
+        mesh: &TetMesh,
+        material: &Material,
+    ) -> ConstraintSet {
+        let arity = families.arity(family);
+        let particles = families.binding(family).particles(mesh);
         let size = particles
-            .chunks_exact(family.arity())
+            .chunks_exact(arity)
             .map(|idx| {
                 crate::scene::mesh::longest_edge(idx.iter().map(|&i| mesh.positions[i as usize]))
             })
             .collect();
         let mut set = ConstraintSet {
-            generation: Some(family.generation()),
-            arity: family.arity(),
-            lambda: vec![0.0; particles.len() / family.arity()],
+            built: true,
+            file: families.file(family).cloned(),
+            arity,
+            lambda: vec![0.0; particles.len() / arity],
             particles,
             rest: Vec::new(),
             size,
             order: Vec::new(),
         };
-        set.measure_rest(family, &mesh.positions, material);
+        set.measure_rest(families, family, &mesh.positions, material);
         set
     }
 
@@ -54,6 +65,7 @@ impl ConstraintSet {
     /// rest values depend on it, when the material changes).
     pub(crate) fn measure_rest(
         &mut self,
+        families: &Families,
         family: Family,
         rest_positions: &[DVec3],
         material: &Material,
@@ -70,18 +82,26 @@ impl ConstraintSet {
                     .collect()
             }
         }
-        self.rest = family.visit(RestValues(&self.particles, rest_positions, material));
+        self.rest = families.visit(
+            family,
+            RestValues(&self.particles, rest_positions, material),
+        );
     }
 
-    /// Whether it was built from the definition of `family` now in force.
-    pub(crate) fn is_current(&self, family: Family) -> bool {
-        self.generation == Some(family.generation())
+    /// Whether it was built from the definition of `family` in `families`.
+    pub(crate) fn is_current(&self, families: &Families, family: Family) -> bool {
+        self.built
+            && match (&self.file, families.file(family)) {
+                (None, None) => true,
+                (Some(built), Some(now)) => Arc::ptr_eq(built, now),
+                _ => false,
+            }
     }
 
     /// Whether it was built at all (the sets of families that joined the table after the
     /// simulation was made are built when they are switched on).
     pub(crate) fn is_built(&self) -> bool {
-        self.generation.is_some()
+        self.built
     }
 
     /// The number of constraints.

@@ -12,7 +12,7 @@
 use std::fmt;
 
 /// What left the sound range.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Cause {
     /// A coordinate of a particle reached `value` (metres), beyond `limit` or not a number.
     Position {
@@ -41,15 +41,15 @@ pub enum Cause {
     },
     /// The RMS residual of a family is not finite.
     Residual {
-        /// The family.
-        family: crate::constraints::Family,
+        /// The family's name.
+        family: String,
         /// Its value.
         value: f64,
     },
 }
 
 /// A simulation that diverged: which one, at which frame, and what left the range.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Divergence {
     /// What the message calls the simulation: "the simulation", "the comparison".
     pub subject: &'static str,
@@ -120,14 +120,15 @@ impl fmt::Display for Divergence {
     /// engine holds up to 1e30); more substeps or a shorter frame (dt) may keep it stable`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{} diverged at frame {}: ", self.subject, self.frame)?;
-        let number = |x: f64| {
+        let number = |x: &f64| {
+            let x = *x;
             if x.is_finite() {
                 format!("{x:.3e}")
             } else {
                 x.to_string()
             }
         };
-        match self.cause {
+        match &self.cause {
             Cause::Position {
                 particle,
                 value,

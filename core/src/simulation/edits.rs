@@ -62,7 +62,7 @@ impl Simulation {
         self.velocities.fill(DVec3::ZERO);
         self.corrections.fill(DVec3::ZERO);
         self.frame_corrections.fill(DVec3::ZERO);
-        for family in Family::all() {
+        for family in self.families.all() {
             self.sets[family].reset_lambda();
         }
     }

@@ -95,7 +95,6 @@ impl Simulation {
     /// The fast engine, built (and brought up to the current state) if it was not: for
     /// `tetlab bench`, which times it and reads its per-family timings.
     pub fn fast_solver(&mut self) -> &mut FastSimulation {
-        self.refresh_families();
         self.ready_fast();
         self.fast.solver.as_mut().expect("made ready above")
     }
@@ -110,6 +109,7 @@ impl Simulation {
             rest_positions: &self.rest_positions,
             forces: &self.forces,
             tets: &self.tets,
+            families: &self.families,
             constraints: &self.sets,
             plane_strain: self.plane_strain,
         }
@@ -134,7 +134,6 @@ impl Simulation {
     /// One frame on the fast engine: it takes up the state if an edit changed it, steps with
     /// the grab and the settling of an edit, and writes positions, velocities and Δp back.
     pub(super) fn step_fast(&mut self) {
-        self.refresh_families();
         self.ready_fast();
         let inputs = FrameInputs {
             grab: self
@@ -145,7 +144,9 @@ impl Simulation {
         };
         let solver = self.fast.solver.as_mut().expect("made ready above");
         solver.step_frame(&inputs);
-        for (family, counts) in solver.take_skipped().iter() {
+        let skipped = solver.take_skipped();
+        for family in self.families.all() {
+            let counts = skipped[family];
             self.skipped[family] = self.skipped[family] + counts;
         }
         solver.store(

@@ -10,7 +10,8 @@ impl Simulation {
     /// [`Settings::order_seed`], as (family, index in the family).
     pub fn projection_order(&self) -> impl Iterator<Item = (Family, usize)> + '_ {
         let active = self.settings.active;
-        Family::all()
+        self.families
+            .all()
             .filter(move |&f| active[f] && !f.projected_by_partner(&active))
             .flat_map(move |f| {
                 let set = &self.sets[f];
@@ -22,7 +23,9 @@ impl Simulation {
     /// four heights, or its volume ([`crate::constraints::Binding::of_tet`]).
     pub fn tet_constraints(&self, tet: usize, family: Family) -> impl Iterator<Item = usize> + '_ {
         let edges = self.sets[Family::EDGES].all_particles();
-        family.row().binding.of_tet(tet, self.tets[tet], edges)
+        self.families
+            .binding(family)
+            .of_tet(tet, self.tets[tet], edges)
     }
 
     /// The constraints of `family`: their particles, rest values and multipliers.
@@ -45,7 +48,7 @@ impl Simulation {
         let material_family = settings
             .active
             .families()
-            .find(|f| f.row().compliance_from_material.is_some())?;
+            .find(|f| f.compliance_from_material().is_some())?;
         let shortest = self.shortest_edge();
         let material = settings.material;
         let needed = material.substeps_needed(settings.dt, shortest, DENSITY);
@@ -54,7 +57,7 @@ impl Simulation {
                 "{} with material {} needs at least {needed} substeps per frame of {:.4} s on this \
                  mesh (pressure waves {:.3e} m/s, shortest edge {:.3e} m); with {} it may blow \
                  up",
-                material_family.row().group,
+                self.families.row(material_family).group,
                 material.describe(),
                 settings.dt,
                 material.wave_speed(DENSITY),
@@ -68,7 +71,7 @@ impl Simulation {
     /// constraints × substeps × iterations.
     pub fn projections_per_frame(&self) -> u64 {
         self.settings
-            .projections_per_frame(PerFamily::from_fn(|f| self.constraint_count(f)))
+            .projections_per_frame(self.families.per_family(|f| self.constraint_count(f)))
     }
 
     /// How many constraints `family` has.
@@ -84,15 +87,18 @@ impl Simulation {
     pub fn projection(&self, family: Family, c: usize) -> Projection {
         let h = self.substep_length();
         let rule = self.rule(family, h);
-        let mut projection = family.visit(Describe {
-            set: &self.sets[family],
-            positions: &self.positions,
-            rest_positions: &self.rest_positions,
-            inverse_masses: &self.inverse_masses,
-            rule,
-            c,
-            reach: self.settings.reach,
-        });
+        let mut projection = self.families.visit(
+            family,
+            Describe {
+                set: &self.sets[family],
+                positions: &self.positions,
+                rest_positions: &self.rest_positions,
+                inverse_masses: &self.inverse_masses,
+                rule,
+                c,
+                reach: self.settings.reach,
+            },
+        );
         if let Some(partner) = family.partner_in(&self.settings.active) {
             let pair = pair::Pair {
                 first: &self.sets[family],
@@ -103,7 +109,9 @@ impl Simulation {
                 rules: [rule, self.rule(partner, h)],
                 reach: self.settings.reach,
             };
-            let correction = family.visit_pair(partner, pair::PairAt { pair, c });
+            let correction = self
+                .families
+                .visit_pair(family, partner, pair::PairAt { pair, c });
             let skipped = projection.delta_lambda.is_none();
             projection.delta_lambda = (!skipped).then_some(correction.delta_lambda[0]);
             projection.delta_x = correction.delta_x;

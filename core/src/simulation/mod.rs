@@ -52,7 +52,7 @@ pub use settings::{
 };
 use substep::Projected;
 
-use crate::constraints::{Constraint, Family, PerFamily, Visit, distance};
+use crate::constraints::{Constraint, Families, Family, PerFamily, Visit, distance};
 use crate::scene::Scene;
 use crate::scene::mesh::TetMesh;
 use crate::simulation::divergence::Divergence;
@@ -109,8 +109,8 @@ pub struct Simulation {
     settling: Option<u32>,
     frame: u64,
     time: f64,
-    /// [`crate::constraints::registry::definitions`] when the sets were last brought up to date.
-    definitions: u64,
+    /// The table of families it simulates: the built-in ones and the files it was given.
+    families: Families,
     /// The fast engine, when [`Simulation::engine`] is [`Engine::Fast`] ([`engine`]).
     fast: engine::FastEngine,
     /// Threads for the fast engine.
@@ -124,11 +124,26 @@ pub struct Simulation {
 }
 
 impl Simulation {
-    /// A simulation of `scene` at rest, with masses lumped from density × rest volume / 4 per tet.
+    /// A simulation of `scene` at rest on the built-in families, with masses lumped from
+    /// density × rest volume / 4 per tet.
     pub fn new(scene: &Scene, settings: Settings) -> Simulation {
+        Simulation::with_families(scene, settings, Families::builtin())
+    }
+
+    /// [`Simulation::new`] on the families of `families`: the built-in ones and those of the
+    /// constraint files in it.
+    ///
+    /// Only families of the table are active: `settings.active` is kept to them (a
+    /// [`PerFamily::splat`] of `true` means every family the table has).
+    pub fn with_families(scene: &Scene, settings: Settings, families: Families) -> Simulation {
+        let settings = Settings {
+            active: families.per_family(|f| settings.active[f]),
+            ..settings
+        };
         let mesh = &scene.mesh;
         let positions = mesh.positions.clone();
-        let sets = PerFamily::build(|family| ConstraintSet::new(family, mesh, &settings.material));
+        let sets = families
+            .per_family(|family| ConstraintSet::new(&families, family, mesh, &settings.material));
         let lumped_inverse_masses = masses::lumped_inverse_masses(mesh);
         let edges = mesh.edges();
         let mean_edge = if edges.is_empty() {
@@ -160,7 +175,7 @@ impl Simulation {
             settling: None,
             frame: 0,
             time: 0.0,
-            definitions: crate::constraints::registry::definitions(),
+            families,
             fast: engine::FastEngine::default(),
             threads: 1,
             skipped: PerFamily::default(),
@@ -179,7 +194,7 @@ impl Simulation {
 
     /// Gives every family's constraints the order [`Settings::order_seed`] asks for.
     fn apply_orders(&mut self) {
-        for family in Family::all() {
+        for family in self.families.all() {
             let order = self
                 .settings
                 .projection_order(family, self.sets[family].len());
@@ -192,32 +207,43 @@ impl Simulation {
         &self.settings
     }
 
-    /// Brings the constraints up to date with the table when a family was defined since the
-    /// last look ([`Family::define`]: the workbench's editor redefines a constraint file's
-    /// family as you type): those of a redefined family are rebuilt. Nothing to do, and nothing
-    /// allocated, when no family was defined; every substep calls it.
-    pub fn refresh_families(&mut self) {
-        if crate::constraints::registry::definitions() != self.definitions {
-            self.rebuild_stale_sets();
-        }
+    /// The table of families it simulates.
+    pub fn families(&self) -> &Families {
+        &self.families
     }
 
-    /// Rebuilds the constraints of each family that were built from an older definition, and
-    /// builds those of an active family registered since the simulation was made. Allocates
-    /// only what it builds.
+    /// Simulates the families of `families` from now on (the workbench's editor redefines a
+    /// constraint file's family as you type): the constraints of a family whose definition
+    /// changed are rebuilt, those of an active family new to the table are built, and nothing
+    /// else is touched.
+    pub fn set_families(&mut self, families: Families) {
+        let active = families.per_family(|f| self.settings.active[f]);
+        if active != self.settings.active {
+            self.fast.solver = None;
+        }
+        self.settings.active = active;
+        self.families = families;
+        self.rebuild_stale_sets();
+    }
+
+    /// Rebuilds the constraints of each family that were built from another definition, and
+    /// builds those of an active family that joined the table since the simulation was made.
+    /// Allocates only what it builds.
     fn rebuild_stale_sets(&mut self) {
-        self.definitions = crate::constraints::registry::definitions();
         let mut mesh = None;
-        for family in Family::all() {
+        for family in self.families.all() {
             let set = &self.sets[family];
-            if set.is_current(family) || !(set.is_built() || self.settings.active[family]) {
+            if set.is_current(&self.families, family)
+                || !(set.is_built() || self.settings.active[family])
+            {
                 continue;
             }
             let mesh = mesh.get_or_insert_with(|| TetMesh {
                 positions: self.rest_positions.clone(),
                 tets: self.tets.clone(),
             });
-            self.sets[family] = ConstraintSet::new(family, mesh, &self.settings.material);
+            self.sets[family] =
+                ConstraintSet::new(&self.families, family, mesh, &self.settings.material);
             let order = self
                 .settings
                 .projection_order(family, self.sets[family].len());
@@ -231,9 +257,21 @@ impl Simulation {
     /// they switch on that the simulation has not built yet (one a file added to the table
     /// since) are built.
     pub fn set_settings(&mut self, settings: Settings) {
+        let settings = Settings {
+            active: self.families.per_family(|f| settings.active[f]),
+            ..settings
+        };
         if settings.material != self.settings.material {
-            for family in Family::all().filter(|f| f.rest_uses_material()) {
-                self.sets[family].measure_rest(family, &self.rest_positions, &settings.material);
+            for family in self.families.all() {
+                if self.families.rest_uses_material(family) {
+                    let rest = &self.rest_positions;
+                    self.sets[family].measure_rest(
+                        &self.families,
+                        family,
+                        rest,
+                        &settings.material,
+                    );
+                }
             }
         }
         self.fast.set_settings(&self.settings, &settings);
@@ -405,8 +443,8 @@ impl Simulation {
             + bytes(&self.frame_corrections)
             + self
                 .sets
-                .iter_ref()
-                .map(|(_, set)| set.heap_bytes())
+                .every_place()
+                .map(ConstraintSet::heap_bytes)
                 .sum::<usize>()
             + self.fast.solver.as_ref().map_or(0, |f| f.heap_bytes())
     }

@@ -4,7 +4,7 @@
 //! build their settings here.
 
 use crate::constraints::material::Material;
-use crate::constraints::{Family, PerFamily};
+use crate::constraints::{Families, Family, PerFamily};
 use crate::input::limits::{self, Bounds};
 
 /// How far one projection may move a particle by default ([`crate::simulation::Settings::reach`]),
@@ -196,15 +196,15 @@ impl Settings {
             && !self
                 .active
                 .families()
-                .any(|f| f.row().compliance_from_material.is_some())
+                .any(|f| f.compliance_from_material().is_some())
     }
 
     /// Sets the material, and the compliance of each family it gives one
     /// ([`crate::constraints::Row::compliance_from_material`]: 1/μ and 1/λ).
     pub fn set_material(&mut self, material: Material) {
         self.material = material;
-        for family in Family::all() {
-            if let Some(compliance) = family.row().compliance_from_material {
+        for family in Family::builtins() {
+            if let Some(compliance) = family.compliance_from_material() {
                 self.compliance[family] = compliance(&material);
             }
         }
@@ -223,8 +223,8 @@ impl Settings {
         limits::COMPLIANCE
             .check(self.grab_compliance)
             .map_err(|e| format!("grab {e}"))?;
-        for family in Family::all() {
-            let name = family.name();
+        for family in Family::places() {
+            let name = family;
             limits::COMPLIANCE
                 .check(self.compliance[family])
                 .map_err(|e| format!("{e} ({name})"))?;
@@ -284,7 +284,7 @@ impl Default for Settings {
     fn default() -> Self {
         let mut settings = Self {
             method: Method::Xpbd,
-            active: PerFamily::from_fn(|f| f == Family::EDGES || f == Family::VOLUME),
+            active: PerFamily::builtin_from_fn(|f| f == Family::EDGES || f == Family::VOLUME),
             compliance: PerFamily::splat(0.0),
             stiffness: PerFamily::splat(1.0),
             substeps: DEFAULT_SUBSTEPS,
@@ -316,31 +316,36 @@ fn stiffness_over_the_default<'de, D: serde::Deserializer<'de>>(
 /// `FAMILY=VALUE` (as in `--compliance edges=1e-6`), with the value checked against `bounds`.
 ///
 /// ```
-/// use tetlab_core::constraints::Family;
+/// use tetlab_core::constraints::{Families, Family};
 /// use tetlab_core::input::limits::COMPLIANCE;
 /// use tetlab_core::simulation::family_value;
-/// assert_eq!(family_value("volume=0.5", &COMPLIANCE), Ok((Family::VOLUME, 0.5)));
-/// assert!(family_value("edges=inf", &COMPLIANCE).unwrap_err().contains("out of range"));
+/// let families = Families::builtin();
+/// assert_eq!(family_value(&families, "volume=0.5", &COMPLIANCE), Ok((Family::VOLUME, 0.5)));
+/// assert!(family_value(&families, "edges=inf", &COMPLIANCE).unwrap_err().contains("out of range"));
 /// ```
-pub fn family_value(text: &str, bounds: &Bounds<f64>) -> Result<(Family, f64), String> {
+pub fn family_value(
+    families: &Families,
+    text: &str,
+    bounds: &Bounds<f64>,
+) -> Result<(Family, f64), String> {
     let (name, value) = text
         .split_once('=')
         .ok_or_else(|| format!("'{text}' is not FAMILY=VALUE (e.g. edges=1e-6)"))?;
-    let family = settable_family(name)?;
+    let family = settable_family(families, name)?;
     Ok((family, bounds.parse(value)?))
 }
 
 /// The family whose compliance or stiffness a user sets by `name` (`--compliance NAME=…`, a
 /// lesson's `compliance.NAME`): one that stands on its own and whose compliance no material
 /// gives.
-pub fn settable_family(name: &str) -> Result<Family, String> {
-    let members = PerFamily::parse_group(name)?;
+pub fn settable_family(families: &Families, name: &str) -> Result<Family, String> {
+    let members = families.parse_group(name)?;
     let family = members.families().next().expect("a group has a family");
-    if family.row().compliance_from_material.is_some() {
+    if family.compliance_from_material().is_some() {
         return Err(format!(
             "{}: its constraints take their compliance from the material: give --material \
              E=PA,nu=N (or material = \"E=…,nu=…\" in a lesson)",
-            family.row().group
+            families.row(family).group
         ));
     }
     Ok(family)

@@ -52,10 +52,9 @@ impl Simulation {
     /// The first part of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
     pub fn begin_substep(&mut self) {
         self.fast.edited();
-        self.refresh_families();
         let h = self.substep_length();
         self.predict(h);
-        for family in Family::all() {
+        for family in self.families.all() {
             self.sets[family].reset_lambda();
         }
         if let Some(grab) = &mut self.grab {
@@ -88,7 +87,7 @@ impl Simulation {
     /// plane-strain hold.
     pub(super) fn sweep(&mut self, h: f64) {
         let active = self.settings.active;
-        for family in Family::all() {
+        for family in self.families.all() {
             if !active[family] || family.projected_by_partner(&active) {
                 continue;
             }
@@ -115,19 +114,22 @@ impl Simulation {
                 which,
                 reach: self.settings.reach,
             };
-            family.visit_pair(partner, sweep);
+            self.families.visit_pair(family, partner, sweep);
             return;
         }
-        family.visit(Sweep {
-            set: &mut self.sets[family],
-            positions: &mut self.positions,
-            rest_positions: &self.rest_positions,
-            inverse_masses: &self.inverse_masses,
-            rule,
-            which,
-            skipped: &mut self.skipped[family],
-            reach: self.settings.reach,
-        });
+        self.families.visit(
+            family,
+            Sweep {
+                set: &mut self.sets[family],
+                positions: &mut self.positions,
+                rest_positions: &self.rest_positions,
+                inverse_masses: &self.inverse_masses,
+                rule,
+                which,
+                skipped: &mut self.skipped[family],
+                reach: self.settings.reach,
+            },
+        );
     }
 
     /// The end of one sweep, after the constraint families: the grab, then the ground y ≥ 0.

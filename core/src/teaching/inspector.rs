@@ -59,10 +59,12 @@ impl Inspection {
 pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection {
     let projection = simulation.projection(family, c);
     let (points, rest_shape) = particles_of(simulation, &projection);
-    let (analytic, numeric) = analytic_and_numeric(family, &points, projection.rest, &rest_shape);
+    let families = simulation.families();
+    let (analytic, numeric) =
+        analytic_and_numeric(families, family, &points, projection.rest, &rest_shape);
     let mut numeric_gradients = [DVec3::ZERO; 4];
     numeric_gradients[..numeric.len()].copy_from_slice(&numeric);
-    let file_gradients = family.file().map(|file| {
+    let file_gradients = families.file(family).map(|file| {
         let mut automatic = [DVec3::ZERO; 4];
         let mut at = [DVec3::ZERO; 4];
         at[..points.len()].copy_from_slice(&points);
@@ -86,11 +88,13 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
     }
 }
 
-/// What else the family shows of the inspected constraint ([`Family::describe_state`]: F and
+/// What else the family shows of the inspected constraint ([`crate::constraints::Families::describe_state`]: F and
 /// det F for the neo-Hookean pair), one line each.
 pub fn state_lines(simulation: &Simulation, projection: &Projection) -> Vec<String> {
     let (points, rest_shape) = particles_of(simulation, projection);
-    projection.family.describe_state(&points, &rest_shape)
+    simulation
+        .families()
+        .describe_state(projection.family, &points, &rest_shape)
 }
 
 /// The constraint's particles now and at rest.

@@ -3,8 +3,7 @@
 use super::{Context, Panel};
 use crate::gui::request::Request;
 use eframe::egui;
-use tetlab_core::constraints::Family;
-use tetlab_core::constraints::PerFamily;
+use tetlab_core::constraints::{Families, PerFamily};
 
 /// The comparison panel; it owns the families the second view will run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,14 +16,15 @@ impl Default for ComparePanel {
     /// The geometric families: the material ones are another model, added by choice.
     fn default() -> Self {
         ComparePanel {
-            families: PerFamily::from_fn(|f| f.row().compliance_from_material.is_none()),
+            families: PerFamily::builtin_from_fn(|f| f.compliance_from_material().is_none()),
         }
     }
 }
 
 impl Panel for ComparePanel {
     fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
-        if let Some(request) = show(ui, &mut self.families, context.comparison.is_some()) {
+        let table = context.bench.simulation.families();
+        if let Some(request) = show(ui, table, &mut self.families, context.comparison.is_some()) {
             requests.push(Request::Compare(request));
         }
     }
@@ -34,15 +34,16 @@ impl Panel for ComparePanel {
 /// `Some(None)` when "Stop comparing" is.
 fn show(
     ui: &mut egui::Ui,
+    table: &Families,
     families: &mut PerFamily<bool>,
     comparing: bool,
 ) -> Option<Option<PerFamily<bool>>> {
     ui.heading("Compare");
     ui.horizontal_wrapped(|ui| {
-        for (group, members) in Family::groups() {
+        for (group, members) in table.groups() {
             let mut on = members.families().all(|f| families[f]);
             if ui
-                .checkbox(&mut on, super::solver::group_label(group))
+                .checkbox(&mut on, super::solver::group_label(table, group))
                 .changed()
             {
                 for family in members.families() {

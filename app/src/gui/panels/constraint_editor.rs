@@ -8,9 +8,10 @@ use super::{Context, Panel};
 use crate::gui::request::Request;
 use eframe::egui;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use tetlab_core::constraint_file::check::{self, Report};
 use tetlab_core::constraint_file::{ConstraintFile, EXAMPLES};
-use tetlab_core::constraints::Family;
+use tetlab_core::constraints::{Families, Family};
 
 /// The name the editor's text has in errors until it comes from a file.
 pub const UNSAVED: &str = "editor.toml";
@@ -33,7 +34,7 @@ pub struct ConstraintEditor {
     /// Where that mistake is, line and column from 1, to mark it.
     pub error_at: Option<(usize, usize)>,
     /// The last "Check my gradient", for the family it checked.
-    pub report: Option<(Family, u64, Report)>,
+    pub report: Option<(Family, Arc<ConstraintFile>, Report)>,
 }
 
 impl Default for ConstraintEditor {
@@ -78,7 +79,12 @@ impl ConstraintEditor {
     /// typing) while it is open: the text on the left, what it defines and the gradient check on
     /// the right. Returns a newly compiled file when the text changed and compiles (the app
     /// defines its family).
-    fn show(&mut self, ui: &mut egui::Ui, exercise: bool) -> Option<ConstraintFile> {
+    fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        families: &Families,
+        exercise: bool,
+    ) -> Option<ConstraintFile> {
         if !self.open {
             return None;
         }
@@ -94,7 +100,7 @@ impl ConstraintEditor {
                         self.open = false;
                     }
                 });
-                compiled = self.contents(ui, exercise);
+                compiled = self.contents(ui, families, exercise);
             });
         compiled
     }
@@ -103,7 +109,12 @@ impl ConstraintEditor {
     /// left, what the text defines (or its mistake) and the gradient check on the right.
     /// `exercise`: the text's family is what the open lesson step asks the student to write or
     /// mend; its grade is shown with the status.
-    pub fn contents(&mut self, ui: &mut egui::Ui, exercise: bool) -> Option<ConstraintFile> {
+    pub fn contents(
+        &mut self,
+        ui: &mut egui::Ui,
+        families: &Families,
+        exercise: bool,
+    ) -> Option<ConstraintFile> {
         let mut compiled = None;
         let width = ui.available_width();
         let height = ui.available_height();
@@ -125,9 +136,9 @@ impl ConstraintEditor {
                             compiled = Some(file);
                         }
                         ui.separator();
-                        self.status(ui);
+                        self.status(ui, families);
                         if let Some(family) = self.family.filter(|_| exercise) {
-                            super::lesson::show_grade(ui, family, 14.0);
+                            super::lesson::show_grade(ui, families, family, 14.0);
                         }
                     });
             });
@@ -198,25 +209,29 @@ impl ConstraintEditor {
     }
 
     /// What the text defines now, or its mistake; then the gradient check.
-    fn status(&mut self, ui: &mut egui::Ui) {
+    fn status(&mut self, ui: &mut egui::Ui, families: &Families) {
+        // A family of another table (a lesson opened since) is not this text's any more.
+        if self.family.is_some_and(|f| !families.has(f)) {
+            self.family = None;
+        }
         match (&self.error, self.family) {
             (Some(error), _) => {
                 ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
                 if let Some(family) = self.family {
                     ui.label(format!(
                         "the view still shows the last text that compiled ({})",
-                        family.name()
+                        families.name(family)
                     ));
                 }
             }
             (None, Some(family)) => {
-                let used = match family.file() {
+                let used = match families.file(family) {
                     Some(file) if file.use_gradient => "your gradient",
                     _ => "the gradient by automatic differentiation",
                 };
                 ui.label(format!(
                     "family {}: on in the solver panel, projected with {used}",
-                    family.name()
+                    families.name(family)
                 ));
             }
             (None, None) => {
@@ -224,13 +239,13 @@ impl ConstraintEditor {
             }
         }
         if let Some(family) = self.family {
-            self.check(ui, family);
+            self.check(ui, families, family);
         }
     }
 
     /// "Check my gradient" and what it found.
-    fn check(&mut self, ui: &mut egui::Ui, family: Family) {
-        let Some(file) = family.file() else {
+    fn check(&mut self, ui: &mut egui::Ui, families: &Families, family: Family) {
+        let Some(file) = families.file(family) else {
             return;
         };
         let gives = (0..file.arity()).any(|k| file.gives_gradient(k));
@@ -244,13 +259,13 @@ impl ConstraintEditor {
             .on_disabled_hover_text("give [gradient] entries p0 = \"…\" to check them")
             .clicked()
         {
-            let report = check::check(&file, CHECK_CONFIGS, 1);
-            self.report = Some((family, family.generation(), report));
+            let report = check::check(file, CHECK_CONFIGS, 1);
+            self.report = Some((family, Arc::clone(file), report));
         }
-        let Some((checked, generation, report)) = &self.report else {
+        let Some((checked, definition, report)) = &self.report else {
             return;
         };
-        if *checked != family || *generation != family.generation() {
+        if *checked != family || !Arc::ptr_eq(definition, file) {
             ui.label("(the text changed since the last check)");
             return;
         }
@@ -275,7 +290,7 @@ impl Panel for ConstraintEditor {
                 .exercises()
                 .any(|family| Some(family) == self.family)
         });
-        if let Some(file) = self.show(ui, exercise) {
+        if let Some(file) = self.show(ui, context.bench.simulation.families(), exercise) {
             requests.push(Request::Constraint(Box::new(file)));
         }
     }

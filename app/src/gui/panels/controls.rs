@@ -74,7 +74,7 @@ fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, requests: &mut Vec<Request
             "sweep {}/{n}, {}/{total}: next projects {} #{c}",
             i + 1,
             done + 1,
-            family.name()
+            simulation.families().name(family)
         ),
         (Next::EndSweep { last }, Some((i, n))) => format!(
             "sweep {}/{n} done: next {}",
@@ -91,7 +91,7 @@ fn step_by_step(ui: &mut egui::Ui, bench: &Workbench, requests: &mut Vec<Request
         Some(Advanced::BeganSubstep) => "last: predicted x += v h (gravity)".to_owned(),
         Some(Advanced::Projected(p)) => format!(
             "last: projected {} #{}, C was {:+.3e}",
-            p.family.name(),
+            simulation.families().name(p.family),
             p.constraint,
             p.value
         ),

@@ -7,7 +7,7 @@ use crate::gui::request::Request;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
 use glam::DVec3;
-use tetlab_core::constraints::Family;
+use tetlab_core::constraints::Formula;
 use tetlab_core::simulation::{Method, Simulation};
 use tetlab_core::teaching::inspector::{Inspection, inspect, inspect_tet, state_lines};
 
@@ -41,7 +41,7 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
     if let Some(projection) = bench.stepping.and_then(|s| s.pending(simulation)) {
         ui.heading("Next projection");
         let inspection = inspect(simulation, projection.family, projection.constraint);
-        formula(ui, projection.family);
+        formula(ui, &simulation.families().row(projection.family).formula);
         // One id for whichever constraint is next, so the table keeps its column widths.
         constraint(ui, simulation, &inspection, method, "next projection");
         ui.separator();
@@ -56,7 +56,8 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
     if inspections.is_empty() {
         ui.label("No constraint family is active.");
     }
-    for family in Family::all() {
+    let families = simulation.families();
+    for family in families.all() {
         let of_family: Vec<&Inspection> = inspections
             .iter()
             .filter(|i| i.projection.family == family)
@@ -64,16 +65,17 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
         if of_family.is_empty() {
             continue;
         }
-        egui::CollapsingHeader::new(format!("{} ({})", family.row().title, of_family.len()))
-            .id_salt(family.name())
+        let row = families.row(family);
+        egui::CollapsingHeader::new(format!("{} ({})", row.title, of_family.len()))
+            .id_salt(families.name(family))
             // Open where the tet has one constraint of the family (volume, neo-Hookean).
             .default_open(of_family.len() == 1)
             .show(ui, |ui| {
-                formula(ui, family);
+                formula(ui, &row.formula);
                 for inspection in of_family {
                     ui.separator();
                     let p = &inspection.projection;
-                    let id = (p.family.name(), p.constraint);
+                    let id = (families.name(p.family), p.constraint);
                     constraint(ui, simulation, inspection, method, id);
                 }
             });
@@ -81,10 +83,10 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
 }
 
 /// The family's constraint and gradients, one line of math each.
-fn formula(ui: &mut egui::Ui, family: Family) {
+fn formula(ui: &mut egui::Ui, formula: &Formula) {
     egui::Frame::group(ui.style()).show(ui, |ui| {
-        for line in family.formula() {
-            ui.label(egui::RichText::new(*line).monospace().size(14.0));
+        for line in formula.lines() {
+            ui.label(egui::RichText::new(line).monospace().size(14.0));
         }
     });
 }
@@ -99,7 +101,8 @@ fn constraint(
     id: impl std::hash::Hash + std::fmt::Debug,
 ) {
     let p = &inspection.projection;
-    let rest_name = p.family.row().rest_symbol;
+    let families = simulation.families();
+    let rest_name = families.row(p.family).rest_symbol;
     let step = match (p.delta_lambda, method) {
         (Some(d), Method::Xpbd) => format!("next Δλ = {d:+.4e}"),
         (Some(d), Method::Pbd) => format!("next k′s = {d:+.4e}"),
@@ -109,7 +112,7 @@ fn constraint(
     ui.label(
         egui::RichText::new(format!(
             "{} #{}   C = {:+.4e}   {rest_name} = {:+.4e}   λ = {:+.4e}   {step}",
-            p.family.name(),
+            families.name(p.family),
             p.constraint,
             p.value,
             p.rest,
@@ -172,7 +175,7 @@ fn constraint(
                 ui.end_row();
             }
         });
-    if let Some(file) = p.family.file() {
+    if let Some(file) = families.file(p.family) {
         let used = if file.use_gradient {
             "the solver projects with your gradient (use_gradient = true)"
         } else {

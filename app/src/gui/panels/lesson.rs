@@ -4,7 +4,9 @@
 
 use super::{Context, Panel};
 use crate::gui::request::{LessonRequest, Request};
+use crate::gui::workbench::Workbench;
 use eframe::egui;
+use tetlab_core::constraints::{Families, Family};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::teaching::lesson::{BUILTIN, Lesson, Step};
 
@@ -73,7 +75,7 @@ impl Panel for LessonPanel {
             missing,
             &mut self.path,
             context.classroom,
-            &context.bench.metrics,
+            context.bench,
             comparison.as_ref(),
         );
         requests.extend(request.map(Request::Lesson));
@@ -81,16 +83,17 @@ impl Panel for LessonPanel {
 }
 
 /// Shows the lesson picker and, when a lesson is open, its current step. `large` is classroom
-/// mode. `metrics` and `comparison` are the current metrics of the two simulations.
+/// mode. `bench` is the workbench shown and `comparison` the metrics of the second simulation.
 fn show(
     ui: &mut egui::Ui,
     state: Option<&LessonState>,
     missing: &[Option<String>],
     path: &mut String,
     large: bool,
-    metrics: &Metrics,
+    bench: &Workbench,
     comparison: Option<&Metrics>,
 ) -> Option<LessonRequest> {
+    let (families, metrics) = (bench.simulation.families(), &bench.metrics);
     let mut request = None;
     let size = if large { 22.0 } else { 14.0 };
     if !large || state.is_none() {
@@ -155,7 +158,7 @@ fn show(
     ui.label(egui::RichText::new(&step.text).size(size));
     ui.add_space(size * 0.4);
     for expectation in &step.expect {
-        let (mark, colour, measured) = match expectation.check(metrics, comparison) {
+        let (mark, colour, measured) = match expectation.check(families, metrics, comparison) {
             Some((value, true)) => ("[ok]", egui::Color32::from_rgb(60, 180, 90), value),
             Some((value, false)) => ("[..]", egui::Color32::from_rgb(220, 160, 40), value),
             None => ("[..]", egui::Color32::GRAY, f64::NAN),
@@ -173,7 +176,7 @@ fn show(
         );
     }
     for family in step.exercises() {
-        show_grade(ui, family, size);
+        show_grade(ui, families, family, size);
     }
     ui.add_space(size * 0.4);
     ui.horizontal(|ui| {
@@ -217,15 +220,18 @@ fn show(
 /// automatic differentiation, and for a wrong one where it is furthest off (never AD's answer).
 /// Worked out again whenever the family is redefined (as the student types in the editor).
 /// The constraint editor shows it too, beside the text being typed.
-pub fn show_grade(ui: &mut egui::Ui, family: tetlab_core::constraints::Family, size: f32) {
-    let Some(grade) = tetlab_core::constraint_file::grade::of_family(family) else {
+pub fn show_grade(ui: &mut egui::Ui, families: &Families, family: Family, size: f32) {
+    let Some(grade) = tetlab_core::constraint_file::grade::of_family(families, family) else {
         return;
     };
     ui.add_space(size * 0.3);
     ui.label(
-        egui::RichText::new(format!("Your gradient of {}, graded:", family.name()))
-            .size(size * 0.9)
-            .strong(),
+        egui::RichText::new(format!(
+            "Your gradient of {}, graded:",
+            families.name(family)
+        ))
+        .size(size * 0.9)
+        .strong(),
     );
     for (line, good) in grade.lines() {
         let colour = if good {

@@ -6,7 +6,7 @@ use crate::gui::request::Request;
 use crate::gui::shortcuts::Action;
 use eframe::egui;
 use tetlab_core::constraints::material::{MAX_POISSON, YOUNG};
-use tetlab_core::constraints::{Family, PerFamily};
+use tetlab_core::constraints::{Families, PerFamily};
 use tetlab_core::simulation::{Engine, FAST_FROM_TETS, Method, Settings};
 
 /// The solver panel: it edits a copy of the simulation's settings and asks for the copy when
@@ -28,14 +28,14 @@ impl Panel for SolverPanel {
                 requests.push(Request::Act(Action::ConstraintEditor));
             }
         });
-        if let Some(settings) = edit(ui, current) {
+        if let Some(settings) = edit(ui, context.bench.simulation.families(), current) {
             requests.push(Request::Settings(Box::new(settings)));
         }
     }
 }
 
 /// The settings' widgets, on a copy of `current`; the copy when the user changed it.
-fn edit(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
+fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Settings> {
     let mut settings = *current;
     ui.horizontal(|ui| {
         ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");
@@ -66,14 +66,14 @@ fn edit(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
                 .on_hover_text(hover);
         }
     });
-    for (group, members) in Family::groups() {
+    for (group, members) in families.groups() {
         let family = members.families().next().expect("a group has a family");
-        if family.row().compliance_from_material.is_some() {
-            material_group(ui, &mut settings, group, members);
+        if family.compliance_from_material().is_some() {
+            material_group(ui, families, &mut settings, group, members);
             continue;
         }
         ui.horizontal(|ui| {
-            ui.checkbox(&mut settings.active[family], family.row().label);
+            ui.checkbox(&mut settings.active[family], &*families.row(family).label);
             match settings.method {
                 Method::Xpbd => {
                     ui.add(
@@ -112,6 +112,7 @@ fn edit(ui: &mut egui::Ui, current: &Settings) -> Option<Settings> {
 /// material's E and ν (which give their compliances, under XPBD and PBD alike).
 fn material_group(
     ui: &mut egui::Ui,
+    families: &Families,
     settings: &mut Settings,
     group: &str,
     members: PerFamily<bool>,
@@ -120,7 +121,7 @@ fn material_group(
     let mut material = settings.material;
     let speed = material.young * 0.01;
     ui.horizontal(|ui| {
-        if ui.checkbox(&mut on, group_label(group)).changed() {
+        if ui.checkbox(&mut on, group_label(families, group)).changed() {
             for family in members.families() {
                 settings.active[family] = on;
             }
@@ -150,10 +151,11 @@ fn material_group(
 
 /// "neo-Hookean" for `neohookean`: the table's label of a group's first family, up to its
 /// first space.
-pub fn group_label(group: &str) -> &'static str {
-    let family = Family::all()
-        .find(|f| f.row().group == group)
+pub fn group_label<'a>(families: &'a Families, group: &str) -> &'a str {
+    let family = families
+        .all()
+        .find(|&f| families.row(f).group == group)
         .expect("a group of the table");
-    let label = family.row().label;
+    let label: &str = &families.row(family).label;
     label.split(' ').next().unwrap_or(label)
 }

@@ -156,7 +156,7 @@ impl Rest {
 
 /// The neo-Hookean pair, and nothing else.
 pub fn neohookean() -> PerFamily<bool> {
-    PerFamily::from_fn(|f| {
+    PerFamily::builtin_from_fn(|f| {
         f == Family::NEOHOOKEAN_DEVIATORIC || f == Family::NEOHOOKEAN_HYDROSTATIC
     })
 }

@@ -33,7 +33,7 @@ pub use kernel::PARALLEL_MIN;
 
 use super::constraint_set::ConstraintSet;
 use super::settings::Settings;
-use crate::constraints::{Binding, Constraint, Family, PerFamily, Visit, VisitPair};
+use crate::constraints::{Binding, Constraint, Families, Family, PerFamily, Visit, VisitPair};
 use crate::input::limits::SOUND_LIMIT;
 use crate::simulation::divergence::Divergence;
 use crate::simulation::integrate;
@@ -68,6 +68,8 @@ fn residual(p: DVec3) -> Vec3A {
 
 /// The soft body, fast. See the module documentation.
 pub struct FastSimulation {
+    /// The table of families it projects.
+    families: Families,
     settings: Settings,
     /// Where the positions are measured from, in the scene's frame: a particle is at
     /// `origin + positions[i]`. It follows a body that travels far (thrown, falling), so that
@@ -256,6 +258,8 @@ pub struct Start<'a> {
     pub forces: &'a [DVec3],
     /// The mesh's tets.
     pub tets: &'a [[u32; 4]],
+    /// The table of families the constraints are of.
+    pub families: &'a Families,
     /// The constraints of each family, as the binding makes them (with their rest values).
     pub constraints: &'a PerFamily<ConstraintSet>,
     /// Whether every particle keeps its z.
@@ -296,8 +300,11 @@ impl FastSimulation {
         };
         // Only the families in use are built: the settings do not change after this.
         let active = simulation.settings.active;
-        let uses =
-            |binding: &dyn Fn(Binding) -> bool| active.families().any(|f| binding(f.row().binding));
+        let uses = |binding: &dyn Fn(Binding) -> bool| {
+            active
+                .families()
+                .any(|f| binding(simulation.families.binding(f)))
+        };
         let mut layouts = Layouts::default();
         if uses(&|b| b == Binding::Edges) {
             // In the order of the edge binding ([`Binding::particles`]), whose rest values they
@@ -337,12 +344,12 @@ impl FastSimulation {
             layouts.tet_vertices =
                 Layout::new_visiting(&constraints, visit, &inverse_masses, &rest_positions);
         }
-        let sets = PerFamily::build(|family| {
+        let sets = simulation.families.per_family(|family| {
             if !active[family] {
                 return Batches::default();
             }
             let rest = simulation.constraints[family].rest();
-            Batches::new(layouts.of(family.row().binding), |element| {
+            Batches::new(layouts.of(simulation.families.binding(family)), |element| {
                 rest[element as usize] as f32
             })
         });
@@ -354,8 +361,9 @@ impl FastSimulation {
         let positions = take(simulation.positions);
         #[cfg(not(feature = "parallel"))]
         let _ = threads;
-        let colour_orders = colour_orders(simulation.settings, &layouts);
+        let colour_orders = colour_orders(simulation.families, simulation.settings, &layouts);
         FastSimulation {
+            families: simulation.families.clone(),
             colour_orders,
             origin: DVec3::ZERO,
             settings: *simulation.settings,
@@ -449,7 +457,7 @@ impl FastSimulation {
     pub fn set_settings(&mut self, settings: Settings) {
         debug_assert!(settings.active == self.settings.active);
         if settings.order_seed != self.settings.order_seed {
-            self.colour_orders = colour_orders(&settings, &self.layouts);
+            self.colour_orders = colour_orders(&self.families, &settings, &self.layouts);
         }
         self.settings = settings;
     }
@@ -476,7 +484,7 @@ impl FastSimulation {
     /// The constraints of `family`, coloured and in batches (empty when it is not active).
     pub fn batches(&self, family: Family) -> FamilyBatches<'_> {
         FamilyBatches {
-            layout: self.layouts.of(family.row().binding),
+            layout: self.layouts.of(self.families.binding(family)),
             batches: &self.sets[family],
         }
     }
@@ -495,7 +503,7 @@ impl FastSimulation {
                 Some(Jacobi {
                     relaxation,
                     sums: vec![Vec3A::ZERO; self.positions.len()],
-                    factors: PerFamily::build(|family| {
+                    factors: self.families.per_family(|family| {
                         let n = self.positions.len();
                         factors(self.batches(family).constraints_per_particle(n))
                     }),
@@ -540,13 +548,16 @@ impl FastSimulation {
             }
         }
         let active = self.settings.active;
-        PerFamily::from_fn(|family| {
+        self.families.per_family(|family| {
             active[family].then(|| {
-                family.visit(RelativeError {
-                    batches: self.batches(family),
-                    positions: &self.positions,
-                    rest_positions: &self.rest_positions,
-                })
+                self.families.visit(
+                    family,
+                    RelativeError {
+                        batches: self.batches(family),
+                        positions: &self.positions,
+                        rest_positions: &self.rest_positions,
+                    },
+                )
             })
         })
     }
@@ -660,7 +671,7 @@ impl FastSimulation {
     /// Constraint projections one frame makes with the current settings.
     pub fn projections_per_frame(&self) -> u64 {
         self.settings
-            .projections_per_frame(PerFamily::from_fn(|f| self.batches(f).len()))
+            .projections_per_frame(self.families.per_family(|f| self.batches(f).len()))
     }
 
     /// The bytes of memory the solver's arrays take.
@@ -679,8 +690,8 @@ impl FastSimulation {
             + self.layouts.tet_vertices.heap_bytes()
             + self
                 .sets
-                .iter_ref()
-                .map(|(_, b)| b.heap_bytes())
+                .every_place()
+                .map(Batches::heap_bytes)
                 .sum::<usize>()
             + (self.corrections.predicted.capacity()
                 + self.corrections.last.capacity()
@@ -688,11 +699,7 @@ impl FastSimulation {
                 * size_of::<Vec3A>()
             + self.jacobi.as_ref().map_or(0, |j| {
                 j.sums.capacity() * size_of::<Vec3A>()
-                    + j.factors
-                        .iter_ref()
-                        .map(|(_, f)| f.capacity())
-                        .sum::<usize>()
-                        * size_of::<f32>()
+                    + j.factors.every_place().map(Vec::capacity).sum::<usize>() * size_of::<f32>()
             })
     }
 
@@ -891,10 +898,11 @@ impl FastSimulation {
                     }
                 }
                 let rules = [rule, Rule::for_settings(&self.settings, partner, h)];
-                let (count, skipped) = family.visit_pair(
+                let (count, skipped) = self.families.visit_pair(
+                    family,
                     partner,
                     ProjectPair {
-                        layout: self.layouts.of(family.row().binding),
+                        layout: self.layouts.of(self.families.binding(family)),
                         order: &self.colour_orders[family],
                         batches: self.sets.pair_mut(family, partner),
                         positions: (&mut self.positions, &mut self.residuals),
@@ -947,17 +955,20 @@ impl FastSimulation {
                     )
                 }
             }
-            let (count, skipped) = family.visit(Project {
-                layout: self.layouts.of(family.row().binding),
-                order: &self.colour_orders[family],
-                batches: &mut self.sets[family],
-                positions: (&mut self.positions, &mut self.residuals),
-                rest_positions: &mut self.rest_positions,
-                sums,
-                rule,
-                reach: self.settings.reach,
-                parallel,
-            });
+            let (count, skipped) = self.families.visit(
+                family,
+                Project {
+                    layout: self.layouts.of(self.families.binding(family)),
+                    order: &self.colour_orders[family],
+                    batches: &mut self.sets[family],
+                    positions: (&mut self.positions, &mut self.residuals),
+                    rest_positions: &mut self.rest_positions,
+                    sums,
+                    rule,
+                    reach: self.settings.reach,
+                    parallel,
+                },
+            );
             self.apply_jacobi(family);
             self.timings.time[family] += started.elapsed();
             self.timings.projections[family] += count as u64;
@@ -990,12 +1001,16 @@ impl FastSimulation {
 
 /// The order of each active family's colours that `settings` ask for ([`Settings::order_seed`]):
 /// empty (the layout's order) without a seed.
-fn colour_orders(settings: &Settings, layouts: &Layouts) -> PerFamily<Vec<u32>> {
-    PerFamily::build(|family| {
+fn colour_orders(
+    families: &Families,
+    settings: &Settings,
+    layouts: &Layouts,
+) -> PerFamily<Vec<u32>> {
+    families.per_family(|family| {
         if !settings.active[family] {
             return Vec::new();
         }
-        let colours = layouts.of(family.row().binding).colours.len();
+        let colours = layouts.of(families.binding(family)).colours.len();
         settings
             .projection_order(family, colours)
             .unwrap_or_default()

@@ -33,7 +33,7 @@ pub enum Action {
 }
 
 impl Action {
-    pub(super) fn parse(text: &str) -> Result<Action, String> {
+    pub(super) fn parse(families: &Families, text: &str) -> Result<Action, String> {
         let (name, argument) = match text.split_once(':') {
             Some((name, argument)) => (name.trim(), Some(argument.trim())),
             None => (text.trim(), None),
@@ -48,7 +48,7 @@ impl Action {
         };
         let family_value = |what: &str, bounds: &Bounds<f64>| -> Result<(Family, f64), String> {
             let argument = need(what)?;
-            crate::simulation::family_value(argument, bounds)
+            crate::simulation::family_value(families, argument, bounds)
                 .map_err(|e| format!("{e} in '{text}'"))
         };
         let setting = |what: &str, bounds: &Bounds<u32>| -> Result<u32, String> {
@@ -67,7 +67,7 @@ impl Action {
             },
             "mirror" | "flatten" | "scramble" => Action::Perturb(Perturbation::parse(text.trim())?),
             "select" => Action::Select(whole("K")? as usize),
-            "constraints" => Action::Constraints(PerFamily::parse_list(need("LIST")?)?),
+            "constraints" => Action::Constraints(families.parse_list(need("LIST")?)?),
             "solver" => Action::Solver(Method::parse(need("xpbd|pbd")?)?),
             "compliance" => {
                 let (family, alpha) = family_value("FAMILY=α", &limits::COMPLIANCE)?;
@@ -86,7 +86,7 @@ impl Action {
             ),
             "compare" => match need("LIST|off")? {
                 "off" => Action::Compare(None),
-                list => Action::Compare(Some(PerFamily::parse_list(list)?)),
+                list => Action::Compare(Some(families.parse_list(list)?)),
             },
             _ => {
                 return Err(format!(

@@ -8,7 +8,7 @@ use super::*;
 pub struct Expectation {
     /// Whether the metric is the comparison simulation's (written `compare.METRIC`).
     pub of_comparison: bool,
-    /// The metric's name, one of [`Metrics::headline`], or [`GRADIENT_ERROR`].
+    /// The metric's name, one of [`Metrics::headline`], or `gradient_error.NAME` ([`GRADIENT_ERROR`]).
     pub metric: String,
     /// For [`GRADIENT_ERROR`]: the family (of a constraint file) whose gradient it is about.
     pub gradient_of: Option<Family>,
@@ -75,9 +75,15 @@ pub const GRADIENT_ERROR: &str = "gradient_error";
 impl Expectation {
     /// The metric's current value, and whether the expectation holds for it (never for a value
     /// that is not finite); `None` when it is about the comparison and there is none.
-    pub fn check(&self, metrics: &Metrics, comparison: Option<&Metrics>) -> Option<(f64, bool)> {
+    /// `families` is the table the lesson simulates, whose files the gradient errors are of.
+    pub fn check(
+        &self,
+        families: &Families,
+        metrics: &Metrics,
+        comparison: Option<&Metrics>,
+    ) -> Option<(f64, bool)> {
         if let Some(family) = self.gradient_of {
-            let value = gradient_error(family);
+            let value = gradient_error(families, family);
             return Some((value, value.is_finite() && self.op.holds(value, self.value)));
         }
         let metrics = if self.of_comparison {
@@ -94,7 +100,7 @@ impl Expectation {
         Some((value, value.is_finite() && self.op.holds(value, self.value)))
     }
 
-    pub(super) fn parse(text: &str) -> Result<Expectation, String> {
+    pub(super) fn parse(families: &Families, text: &str) -> Result<Expectation, String> {
         let (symbol, op, at) = Op::ALL
             .iter()
             .find_map(|&(symbol, op)| text.find(symbol).map(|at| (symbol, op, at)))
@@ -106,8 +112,8 @@ impl Expectation {
             .strip_prefix(GRADIENT_ERROR)
             .and_then(|m| m.strip_prefix('.'))
         {
-            let family = Family::parse(name)?;
-            if family.file().is_none() {
+            let family = families.parse(name)?;
+            if families.file(family).is_none() {
                 return Err(format!(
                     "{GRADIENT_ERROR}.{name}: {name} is a built-in family; {GRADIENT_ERROR} is about \
                      the gradient a constraint file gives (name one in constraint_files)"
@@ -115,7 +121,7 @@ impl Expectation {
             }
             return Ok(Expectation {
                 of_comparison: false,
-                metric: GRADIENT_ERROR.to_owned(),
+                metric: format!("{GRADIENT_ERROR}.{name}"),
                 gradient_of: Some(family),
                 op,
                 value,
@@ -145,14 +151,14 @@ impl Expectation {
 /// The error of `family`'s gradient against AD as its grade gives it
 /// ([`crate::constraint_file::grade::Grade::error`], worked out once per definition of the
 /// family); infinite for a family without a file.
-fn gradient_error(family: Family) -> f64 {
-    crate::constraint_file::grade::of_family(family).map_or(f64::INFINITY, |g| g.error())
+fn gradient_error(families: &Families, family: Family) -> f64 {
+    crate::constraint_file::grade::of_family(families, family).map_or(f64::INFINITY, |g| g.error())
 }
 
 impl fmt::Display for Expectation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let prefix = match self.gradient_of {
-            Some(family) => format!("{GRADIENT_ERROR}.{}", family.name()),
+            Some(_) => self.metric.clone(),
             None if self.of_comparison => format!("compare.{}", self.metric),
             None => self.metric.clone(),
         };

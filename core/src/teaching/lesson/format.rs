@@ -110,19 +110,22 @@ impl Lesson {
         let at = |span: std::ops::Range<usize>| move |message: String| error(Some(span), message);
 
         // The constraint files first: the settings and steps may name their families.
-        let mut families = Vec::new();
+        let mut families = Families::builtin();
+        let mut file_families = Vec::new();
         for file in &raw.constraint_files {
             let resolved = resolve_path(path, file.get_ref());
             let family = ConstraintFile::load(Path::new(&resolved))
                 .map_err(|e| e.to_string())
-                .and_then(Family::define)
+                .and_then(|file| families.define(file))
                 .map_err(|e| error(Some(file.span()), format!("constraint file: {e}")))?;
-            families.push(family);
+            file_families.push(family);
         }
         let mut settings = Settings::default();
         let s = &raw.settings;
         if let Some(list) = &s.constraints {
-            settings.active = PerFamily::parse_list(list.get_ref()).map_err(at(list.span()))?;
+            settings.active = families
+                .parse_list(list.get_ref())
+                .map_err(at(list.span()))?;
         }
         if let Some(solver) = &s.solver {
             settings.method = Method::parse(solver.get_ref()).map_err(at(solver.span()))?;
@@ -186,7 +189,8 @@ impl Lesson {
             ),
         ] {
             for (name, value) in values {
-                let family = crate::simulation::settable_family(name).map_err(at(value.span()))?;
+                let family = crate::simulation::settable_family(&families, name)
+                    .map_err(at(value.span()))?;
                 let v = bounds.check(*value.get_ref()).map_err(|e| {
                     error(
                         Some(value.span()),
@@ -236,7 +240,8 @@ impl Lesson {
         for step in &raw.step {
             let mut actions = Vec::new();
             for action in &step.actions {
-                let parsed = Action::parse(action.get_ref()).map_err(at(action.span()))?;
+                let parsed =
+                    Action::parse(&families, action.get_ref()).map_err(at(action.span()))?;
                 if let Some(tet) = parsed.tet() {
                     check_tet(tet, action.span())?;
                 }
@@ -252,7 +257,7 @@ impl Lesson {
             let expect = step
                 .expect
                 .iter()
-                .map(|e| Expectation::parse(e.get_ref()).map_err(at(e.span())))
+                .map(|e| Expectation::parse(&families, e.get_ref()).map_err(at(e.span())))
                 .collect::<Result<Vec<_>, _>>()?;
             steps.push(Step {
                 text: reflow(&step.text),
@@ -266,6 +271,7 @@ impl Lesson {
             source: path.to_owned(),
             scene,
             resolution,
+            file_families,
             families,
             tet,
             settings,

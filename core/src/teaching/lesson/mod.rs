@@ -35,7 +35,7 @@
 
 use crate::constraint_file::ConstraintFile;
 use crate::constraints::material::Material;
-use crate::constraints::{Family, PerFamily};
+use crate::constraints::{Families, Family, PerFamily};
 use crate::input::limits::{self, Bounds};
 use crate::measures::metrics::Metrics;
 use crate::scene::{Perturbation, Scene, SceneError, reflect_through_opposite_face};
@@ -72,9 +72,12 @@ pub struct Lesson {
     pub scene: String,
     /// The resolution of a built-in scene.
     pub resolution: u32,
-    /// The families of the constraint files the lesson names (`constraint_files`), defined in
-    /// the table when the lesson was read ([`Family::define`]).
-    pub families: Vec<Family>,
+    /// The families of the constraint files the lesson names (`constraint_files`), in
+    /// [`Lesson::families`].
+    pub file_families: Vec<Family>,
+    /// The table of families the lesson simulates: the built-in ones and its constraint files
+    /// ([`Families::define`]).
+    pub families: Families,
     /// The tet whose arrows are shown at the start.
     pub tet: usize,
     /// The solver settings at the start.

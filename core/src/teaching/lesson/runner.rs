@@ -42,7 +42,8 @@ impl LessonRun {
     /// The lesson's scene at rest with its settings.
     pub fn new(lesson: &Lesson) -> LessonRun {
         let scene = lesson.scene();
-        let simulation = Simulation::new(&scene, lesson.settings);
+        let simulation =
+            Simulation::with_families(&scene, lesson.settings, lesson.families.clone());
         LessonRun {
             metrics: (Metrics::measure(&simulation), None),
             simulation,
@@ -64,7 +65,7 @@ impl LessonRun {
             .steps
             .iter()
             .flat_map(Step::exercises)
-            .any(|family| family.name() == answer.name);
+            .any(|family| lesson.families.name(family) == answer.name);
         if !asked {
             return Err(format!(
                 "{} defines {}, and no step of this lesson is an exercise about {0}",
@@ -142,16 +143,20 @@ impl LessonRun {
         let exercises: Vec<Family> = step.exercises().collect();
         let (taken, kept): (Vec<_>, Vec<_>) = std::mem::take(&mut self.answers)
             .into_iter()
-            .partition(|a| exercises.iter().any(|f| f.name() == a.name));
+            .partition(|a| {
+                let families = self.simulation.families();
+                exercises.iter().any(|&f| families.name(f) == a.name)
+            });
         self.answers = kept;
         for answer in taken {
             // Its name is a family's already (hand_in checked): it is redefined in place, which
             // cannot fail.
-            let _ = Family::define(answer);
-            self.simulation.refresh_families();
+            let mut families = self.simulation.families().clone();
+            let _ = families.define(answer);
             if let Some(comparison) = &mut self.comparison {
-                comparison.refresh_families();
+                comparison.set_families(families.clone());
             }
+            self.simulation.set_families(families);
         }
         for &action in &step.actions {
             self.apply(action);
@@ -174,10 +179,12 @@ impl LessonRun {
             checks: step
                 .expect
                 .iter()
-                .map(|e| match e.check(metrics, comparison) {
-                    Some((value, holds)) => (e.clone(), Some(value), holds),
-                    None => (e.clone(), None, false),
-                })
+                .map(
+                    |e| match e.check(self.simulation.families(), metrics, comparison) {
+                        Some((value, holds)) => (e.clone(), Some(value), holds),
+                        None => (e.clone(), None, false),
+                    },
+                )
                 .collect(),
         }
     }

@@ -26,7 +26,7 @@ expect = ["inverted_tets == 1", "max_edge_strain < 1e-9"]
     .unwrap();
     assert_eq!(
         lesson.settings.active,
-        PerFamily::parse_list("edges").unwrap()
+        PerFamily::builtin_list("edges").unwrap()
     );
     assert!(!lesson.settings.ground);
     let mut run = LessonRun::new(&lesson);
@@ -160,7 +160,7 @@ expect = ["compare.volume_error < 0.001"]
     let mut run = LessonRun::new(&lesson);
     // What no accepted setting can do: a compliance past the limits, so α / h² is infinite.
     run.apply(Action::Compare(Some(
-        PerFamily::parse_list("edges,volume").unwrap(),
+        PerFamily::builtin_list("edges,volume").unwrap(),
     )));
     let comparison = run.comparison.as_mut().unwrap();
     let mut settings = *comparison.settings();
@@ -178,8 +178,9 @@ expect = ["compare.volume_error < 0.001"]
         volume_error: f64::NAN,
         ..Metrics::default()
     };
-    let expectation = Expectation::parse("volume_error != 0").unwrap();
-    assert!(!expectation.check(&nan, None).unwrap().1);
+    let families = Families::builtin();
+    let expectation = Expectation::parse(&families, "volume_error != 0").unwrap();
+    assert!(!expectation.check(&families, &nan, None).unwrap().1);
 }
 
 /// A lesson can be listed, and its missing mesh named, even when it cannot be opened.
@@ -223,7 +224,9 @@ fn the_comparison_gets_the_same_edits_and_keeps_its_families() {
     run.apply(Action::Substeps(3));
     let comparison = run.comparison.as_ref().unwrap();
     assert_eq!(comparison.positions(), run.simulation.positions());
-    assert_eq!(comparison.settings().active, PerFamily::splat(true));
+    // Every family of the table: a simulation keeps its active families to its table's.
+    let every = comparison.families().per_family(|_| true);
+    assert_eq!(comparison.settings().active, every);
     assert_eq!(comparison.settings().substeps, 3);
     run.apply(Action::Compare(None));
     assert!(run.comparison.is_none());

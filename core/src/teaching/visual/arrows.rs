@@ -24,11 +24,11 @@ pub enum Quantity {
 impl Quantity {
     /// The arrow colour: [`family_colour`] for gradients, the same lightened halfway to white
     /// for the disagreeing one, [`CORRECTION`] for corrections.
-    pub fn colour(self) -> Rgba {
+    pub fn colour(self, families: &Families) -> Rgba {
         match self {
-            Quantity::Gradient(family) => family_colour(family),
+            Quantity::Gradient(family) => family_colour(families, family),
             Quantity::Disagreeing(family) => {
-                let [r, g, b, a] = family_colour(family);
+                let [r, g, b, a] = family_colour(families, family);
                 let light = |c: u8| c + (255 - c) / 2;
                 [light(r), light(g), light(b), a]
             }
@@ -38,16 +38,21 @@ impl Quantity {
 
     /// What it is, for legends: "grad C: heights", "grad C: my-height, yours, where it differs",
     /// "dp".
-    pub fn label(self) -> String {
+    pub fn label(self, families: &Families) -> String {
         match self {
-            Quantity::Gradient(family) => match family.file() {
-                Some(file) if file.use_gradient => format!("grad C: {} (yours)", family.name()),
-                Some(_) => format!("grad C: {} (AD)", family.name()),
-                None => format!("grad C: {}", family.row().label),
+            Quantity::Gradient(family) => match families.file(family) {
+                Some(file) if file.use_gradient => {
+                    format!("grad C: {} (yours)", families.name(family))
+                }
+                Some(_) => format!("grad C: {} (AD)", families.name(family)),
+                None => format!("grad C: {}", families.row(family).label),
             },
             Quantity::Disagreeing(family) => {
-                let other = Quantity::disagreeing_name(family);
-                format!("grad C: {}, {other}, where it differs", family.name())
+                let other = Quantity::disagreeing_name(families, family);
+                format!(
+                    "grad C: {}, {other}, where it differs",
+                    families.name(family)
+                )
             }
             Quantity::Correction => "dp".to_owned(),
         }
@@ -57,8 +62,8 @@ impl Quantity {
 impl Quantity {
     /// Which gradient the [`Quantity::Disagreeing`] arrows of `family` show: "yours", or "AD"
     /// when the file asks the solver to use its own (`use_gradient`).
-    pub fn disagreeing_name(family: Family) -> &'static str {
-        match family.file() {
+    pub fn disagreeing_name(families: &Families, family: Family) -> &'static str {
+        match families.file(family) {
             Some(file) if file.use_gradient => "AD",
             _ => "yours",
         }
@@ -66,9 +71,12 @@ impl Quantity {
 
     /// The gradient quantities a family's arrows can show: its ∇C, and for a constraint file
     /// that gives its own gradient, the one not in use ([`Quantity::Disagreeing`]).
-    pub fn of_family(family: Family) -> impl Iterator<Item = Quantity> {
-        let gives = family
-            .file()
+    pub fn of_family(
+        families: &Families,
+        family: Family,
+    ) -> impl Iterator<Item = Quantity> + use<> {
+        let gives = families
+            .file(family)
             .is_some_and(|file| (0..file.arity()).any(|k| file.gives_gradient(k)));
         [Quantity::Gradient(family)]
             .into_iter()
@@ -83,8 +91,13 @@ pub const DISAGREEMENT: f64 = 1e-6;
 /// The [`Quantity::Disagreeing`] arrows of one projection of a file family: at each particle the
 /// file gives a gradient for, the gradient the solver does not use, where it differs from the
 /// one it uses by more than [`DISAGREEMENT`]. Appends to `out`, unscaled.
-fn disagreeing_arrows(positions: &[DVec3], projection: &Projection, out: &mut Vec<Arrow>) {
-    let Some(file) = projection.family.file() else {
+fn disagreeing_arrows(
+    families: &Families,
+    positions: &[DVec3],
+    projection: &Projection,
+    out: &mut Vec<Arrow>,
+) {
+    let Some(file) = families.file(projection.family) else {
         return;
     };
     if projection.degenerate || !(0..projection.len).any(|k| file.gives_gradient(k)) {
@@ -167,7 +180,7 @@ pub fn tet_gradient_arrows(
                 vector: DVec3::ZERO,
             });
         }
-        disagreeing_arrows(positions, &projection, out);
+        disagreeing_arrows(simulation.families(), positions, &projection, out);
     }
     let length = gain * GRADIENT_ARROW_LENGTH * tet_size(positions, &simulation.tets()[tet]);
     scale_to_longest(&mut out[first..], length);
@@ -186,6 +199,7 @@ fn scale_to_longest(arrows: &mut [Arrow], length: f64) {
 /// particles, the longest drawn `gain` × [`GRADIENT_ARROW_LENGTH`] × the mean distance between
 /// them, and the Δx it will apply, `correction_gain` times its true length. Appends to `out`.
 pub fn projection_arrows(
+    families: &Families,
     positions: &[DVec3],
     projection: &Projection,
     gain: f64,
@@ -214,7 +228,7 @@ pub fn projection_arrows(
                 vector: DVec3::ZERO,
             });
         }
-        disagreeing_arrows(positions, projection, out);
+        disagreeing_arrows(families, positions, projection, out);
     }
     scale_to_longest(&mut out[first..], gain * GRADIENT_ARROW_LENGTH * size);
     for (&particle, &delta) in particles.iter().zip(&projection.delta_x) {

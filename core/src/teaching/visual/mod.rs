@@ -14,8 +14,8 @@ pub use surface::{
     particle_colours,
 };
 
-use crate::constraints::Family;
 use crate::constraints::volume::signed_volume;
+use crate::constraints::{Families, Family};
 use crate::scene::mesh::{TET_EDGES, TetMesh, bounds};
 use crate::simulation::{Projection, Simulation};
 use glam::DVec3;
@@ -32,8 +32,8 @@ pub const EDGE: Rgba = [60, 60, 70, 255];
 
 /// The colour of a constraint family's arrows ([`crate::constraints::Row::colour`]): edges
 /// orange, heights green, volume blue.
-pub fn family_colour(family: Family) -> Rgba {
-    family.row().colour
+pub fn family_colour(families: &Families, family: Family) -> Rgba {
+    families.row(family).colour
 }
 
 /// The colour map of V/V₀: red at ≤ 0 (flat or inverted), through yellow at ½, to white at ≥ 1.
@@ -105,7 +105,8 @@ mod tests {
             assert!((longest - 2.0 * GRADIENT_ARROW_LENGTH * size).abs() < 1e-12);
             for a in &arrows {
                 assert!(a.vector.cross(a.value).length() < 1e-12 && a.vector.dot(a.value) >= 0.0);
-                assert_eq!(a.quantity.colour(), family_colour(family));
+                let families = simulation.families();
+                assert_eq!(a.quantity.colour(families), family_colour(families, family));
             }
         }
     }
@@ -124,7 +125,7 @@ mod tests {
         for a in &arrows {
             assert_eq!(a.value, simulation.corrections()[a.particle as usize]);
             assert_eq!(a.vector, a.value * 10.0);
-            assert_eq!(a.quantity.colour(), CORRECTION);
+            assert_eq!(a.quantity.colour(simulation.families()), CORRECTION);
         }
     }
 
