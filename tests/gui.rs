@@ -5,6 +5,13 @@
 #[path = "support/gui.rs"]
 mod gui_support;
 
+// The constraint editor and an exercise: each workbench owns its table of families, so they run in
+// this process with the others.
+#[path = "gui/constraint_editor.rs"]
+mod constraint_editor;
+#[path = "gui/exercise.rs"]
+mod exercise;
+
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;

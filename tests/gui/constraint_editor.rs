@@ -6,13 +6,10 @@
 //! Each test's workbench owns its table of families: the examples are added to it, in the same
 //! order, before anything is drawn, so that the snapshots do not depend on which test ran first.
 
-#[path = "support/gui.rs"]
-mod gui_support;
-
+use crate::gui_support::{pixels_like, workbench};
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use gui_support::{pixels_like, workbench};
 use std::path::Path;
 use tetlab::gui::TetlabApp;
 use tetlab_core::constraint_file::ConstraintFile;

@@ -3,14 +3,11 @@
 //! and the lesson panel grades it as they type: a wrong p3 is named with a configuration, the
 //! mended one passes, and the step's checks then hold.
 //!
-//! A test binary of its own: the lesson defines a family in the table, which is the process's.
+//! The lesson brings its own table of families, so this runs beside the other GUI tests.
 
-#[path = "support/gui.rs"]
-mod gui_support;
-
+use crate::gui_support::{open_lesson_file, workbench};
 use eframe::egui;
 use egui_kittest::kittest::Queryable;
-use gui_support::{open_lesson_file, workbench};
 
 #[test]
 fn an_exercise_is_graded_in_the_lesson_panel_as_the_student_types() {
