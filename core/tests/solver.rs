@@ -2,41 +2,19 @@
 //! rest of tetlab relies on (determinism, no allocation per step, pins, grabs, the ground,
 //! masses, XPBD and PBD stiffness).
 
-// A counting global allocator needs `unsafe impl GlobalAlloc`; it only forwards to `System`.
-#![allow(unsafe_code)]
-
 use glam::DVec3;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
 use tetlab_core::simulation::{DEFAULT_SUBSTEPS, DENSITY, Engine, Method, Settings, Simulation};
 
-/// Counts the allocations of each thread, to check that a step makes none. Per thread, because
-/// the other tests of this binary run (and allocate) at the same time.
-struct CountingAllocator;
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-unsafe impl GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // During thread teardown the counter may be gone; those allocations are not a step's.
-        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
+// Counts each thread's allocations; the allocator needs `unsafe impl GlobalAlloc`.
+#[allow(unsafe_code)]
+#[path = "support/live_bytes.rs"]
+mod live_bytes;
 
-/// Allocations made so far by the calling thread.
-fn allocations() -> usize {
-    ALLOCATIONS.with(Cell::get)
-}
-#[global_allocator]
-static GLOBAL: CountingAllocator = CountingAllocator;
+use live_bytes::allocations;
 
 fn families(edges: bool, height: bool, volume: bool) -> PerFamily<bool> {
     let mut active = PerFamily::splat(false);

@@ -202,21 +202,11 @@ pub fn well_conditioned(points: &[DVec3]) -> bool {
     true
 }
 
-/// A random configuration of `arity` points: uniform in a cube of random size 10^U(−2, 2) around
-/// a random centre. Gives the points and the size.
-pub fn draw(rng: &mut SplitMix64, arity: usize) -> (Vec<DVec3>, f64) {
-    let size = 10f64.powf(rng.range(-2.0, 2.0));
-    let centre = rng.in_cube(size);
-    let points = (0..arity).map(|_| centre + rng.in_cube(size)).collect();
-    (points, size)
-}
-
-/// [`draw`], and for a source that reads a rest shape (the neo-Hookean pair's Dm) a rest shape
-/// drawn the same way around the same centre; otherwise the rest shape is the points.
-fn draw_with_rest_shape(
-    rng: &mut SplitMix64,
-    source: &impl GradientSource,
-) -> (Vec<DVec3>, Vec<DVec3>, f64) {
+/// A random configuration of `source`'s particles: uniform in a cube of random size
+/// 10^U(−2, 2) around a random centre; for a source that reads a rest shape (the neo-Hookean
+/// pair's Dm), a rest shape drawn the same way around the same centre, otherwise the points
+/// themselves. Gives the points, the rest shape and the size.
+pub fn draw(rng: &mut SplitMix64, source: &impl GradientSource) -> (Vec<DVec3>, Vec<DVec3>, f64) {
     let size = 10f64.powf(rng.range(-2.0, 2.0));
     let centre = rng.in_cube(size);
     let mut points = || -> Vec<DVec3> {
@@ -329,7 +319,7 @@ pub fn random_check(
     let (mut compared, mut skipped) = (0, 0);
     let (mut max_error, mut sum_error, mut max_automatic) = (0.0_f64, 0.0, 0.0_f64);
     while compared < samples {
-        let (points, rest_shape, _) = draw_with_rest_shape(&mut rng, &source);
+        let (points, rest_shape, _) = draw(&mut rng, &source);
         if !well_conditioned(&points) || !well_conditioned(&rest_shape) {
             skipped += 1;
             continue;
@@ -380,7 +370,7 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
     let mut attempts = 0usize;
     while report.compared < configs && attempts < configs.saturating_mul(100).max(1000) {
         attempts += 1;
-        let (points, shape, size) = draw_with_rest_shape(&mut rng, source);
+        let (points, shape, size) = draw(&mut rng, source);
         if !well_conditioned(&points) || !well_conditioned(&shape) {
             report.skipped += 1;
             continue;
