@@ -157,7 +157,7 @@ fn every_mistake_names_file_line_and_column() {
         (
             "value = \"length(p0 - p1\"",
             "mine.toml:3:24: ",
-            "expected an operator or `)`",
+            "expected an operator or a comparison or `)`",
         ),
         (
             "value = \"sqrt(p0)\"",

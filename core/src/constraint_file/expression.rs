@@ -1,7 +1,16 @@
 //! The expression language of constraint files, parsed into a syntax tree ([`Expr`]). The grammar
-//! is `expression.pest` (the pest crate): numbers, names, calls `f(a, b)`, unary −, and
-//! `+ − * /` with the usual precedence, left to right. Types are checked later, when the tree is
-//! compiled ([`super::program`]).
+//! is `expression.pest` (the pest crate): numbers, names, calls `f(a, b)`, components `v.x`,
+//! unary −, `+ − * /` with the usual precedence, left to right, and comparisons `< <= > >=` as
+//! the condition of `if(…)`. An expression may span lines. Types are checked later, when the
+//! tree is compiled ([`super::program`]).
+//!
+//! # Nothing the parser reads can crash it
+//! The parser and the compiler recurse into the tree, so a tree must be shallow enough for any
+//! stack, the browser's 1 MB included. Before pest sees the text, [`check_depth`] measures how
+//! deep its tree would be (one level per open parenthesis, unary −, and operator of a chain,
+//! which builds a left-leaning tree) in one pass that does not recurse, and refuses a text that
+//! would be deeper than [`MAX_DEPTH`] or longer than [`MAX_LENGTH`], at the byte where it
+//! becomes too deep.
 
 use pest::Parser;
 use pest::iterators::Pair;
@@ -68,6 +77,19 @@ impl BinaryOp {
     }
 }
 
+/// A comparison, the condition of `if(…)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CompareOp {
+    /// `<`
+    Less,
+    /// `<=`
+    LessOrEqual,
+    /// `>`
+    Greater,
+    /// `>=`
+    GreaterOrEqual,
+}
+
 /// A syntax tree.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
@@ -79,6 +101,10 @@ pub enum Expr {
     Neg(Box<Expr>, Span),
     /// a op b.
     Binary(BinaryOp, Box<Expr>, Box<Expr>, Span),
+    /// A component of a vector, `v.x`: the vector, the component's name and where it is.
+    Member(Box<Expr>, String, Span),
+    /// a < b and the like: only the condition of `if(…)`.
+    Compare(CompareOp, Box<Expr>, Box<Expr>, Span),
     /// f(args…); the span is the whole call, `name_span` the function's name.
     Call {
         /// The function's name.
@@ -96,7 +122,12 @@ impl Expr {
     /// Where the expression is in its source.
     pub fn span(&self) -> Span {
         match self {
-            Expr::Number(_, s) | Expr::Name(_, s) | Expr::Neg(_, s) | Expr::Binary(.., s) => *s,
+            Expr::Number(_, s)
+            | Expr::Name(_, s)
+            | Expr::Neg(_, s)
+            | Expr::Binary(.., s)
+            | Expr::Member(.., s)
+            | Expr::Compare(.., s) => *s,
             Expr::Call { span, .. } => *span,
         }
     }
@@ -116,7 +147,93 @@ static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
         .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
         .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
         .op(Op::prefix(Rule::neg))
+        .op(Op::postfix(Rule::member))
 });
+
+/// The deepest tree an expression may make: far more than a formula needs (the deepest of
+/// `assets/constraints` is under 20), and shallow enough that parsing and compiling it fit in a
+/// 1 MB stack with room to spare (`core/tests/constraint_language.rs` parses the deepest on one).
+pub const MAX_DEPTH: usize = 100;
+
+/// The longest text an expression (or the whole of `define`) may be, in bytes: a formula that
+/// fits in [`super::program::MAX_REGISTERS`] operations is a few kilobytes at most.
+pub const MAX_LENGTH: usize = 64 * 1024;
+
+/// Refuses a text whose tree would be deeper than [`MAX_DEPTH`] or that is longer than
+/// [`MAX_LENGTH`], naming the byte where it goes too deep; in one pass, with no recursion, so
+/// that it is safe on any input.
+///
+/// The depth counted is an upper bound of the tree's: each open parenthesis adds a level for
+/// what is inside it, and within a parenthesis (or a call's argument, or a definition) each
+/// unary − and each binary operator adds one, since `a + b + c` is `(a + b) + c`.
+///
+/// ```
+/// use tetlab_core::constraint_file::expression::{check_depth, MAX_DEPTH};
+/// assert!(check_depth("-(1 + 2) * sqrt(3)").is_ok());
+/// let deep = format!("{}1{}", "(".repeat(MAX_DEPTH + 1), ")".repeat(MAX_DEPTH + 1));
+/// let e = check_depth(&deep).unwrap_err();
+/// assert_eq!(e.offset, MAX_DEPTH);
+/// assert!(e.message.contains("too deeply"));
+/// ```
+pub fn check_depth(text: &str) -> Result<(), SyntaxError> {
+    // The depth of the enclosing parentheses, and within the innermost one the operators so far.
+    let mut open: Vec<(usize, usize)> = Vec::new();
+    let (mut level, mut chain) = (0usize, 0usize);
+    let bytes = text.as_bytes();
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'#' => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+                continue;
+            }
+            b'(' => {
+                open.push((level, chain));
+                level += chain + 1;
+                chain = 0;
+            }
+            b')' => {
+                if let Some((l, c)) = open.pop() {
+                    (level, chain) = (l, c);
+                }
+            }
+            b',' => chain = 0,
+            // `<=` and `>=` are one operator; `=` alone starts a definition.
+            b'=' if i == 0 || !matches!(bytes[i - 1], b'<' | b'>') => chain = 0,
+            b'+' | b'-' | b'*' | b'/' | b'<' | b'>' => chain += 1,
+            // A component, `.x`: one level each (a `.` in a number is not one).
+            b'.' if bytes
+                .get(i + 1)
+                .is_some_and(|b| b.is_ascii_alphabetic() || *b == b'_') =>
+            {
+                chain += 1
+            }
+            _ => {}
+        }
+        if level + chain > MAX_DEPTH {
+            return Err(SyntaxError {
+                offset: i,
+                message: format!(
+                    "the expression nests too deeply: more than {MAX_DEPTH} levels of parentheses, \
+                     unary minus and operators in one chain (split it with `define`)"
+                ),
+            });
+        }
+        i += 1;
+    }
+    if text.len() > MAX_LENGTH {
+        return Err(SyntaxError {
+            offset: MAX_LENGTH,
+            message: format!(
+                "the expression is {} bytes long; at most {MAX_LENGTH} are read (split it with `define`)",
+                text.len()
+            ),
+        });
+    }
+    Ok(())
+}
 
 /// Parses one expression.
 ///
@@ -128,6 +245,7 @@ static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
 /// assert!(matches!(*right, Expr::Binary(..)));
 /// ```
 pub fn parse_expression(text: &str) -> Result<Expr, SyntaxError> {
+    check_depth(text)?;
     let mut pairs = Grammar::parse(Rule::expression, text).map_err(|e| syntax_error(text, e))?;
     let expression = pairs.next().expect("the grammar's root");
     let expr = expression
@@ -139,6 +257,7 @@ pub fn parse_expression(text: &str) -> Result<Expr, SyntaxError> {
 
 /// Parses `define`: one `name = expression` per line, in order.
 pub fn parse_definitions(text: &str) -> Result<Vec<(String, Span, Expr)>, SyntaxError> {
+    check_depth(text)?;
     let mut pairs = Grammar::parse(Rule::definitions, text).map_err(|e| syntax_error(text, e))?;
     let root = pairs.next().expect("the grammar's root");
     Ok(root
@@ -181,8 +300,11 @@ fn syntax_error(text: &str, e: pest::error::Error<Rule>) -> SyntaxError {
 
 fn describe(rule: &Rule) -> Option<&'static str> {
     Some(match rule {
-        Rule::number | Rule::name | Rule::call | Rule::expr | Rule::neg => "a number, a name or (",
-        Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator",
+        Rule::number | Rule::name | Rule::call | Rule::expr | Rule::neg | Rule::argument => {
+            "a number, a name or ("
+        }
+        Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::member => "an operator",
+        Rule::le | Rule::lt | Rule::ge | Rule::gt => "a comparison",
         Rule::assignment => "`name = expression`",
         Rule::EOI => "the end of the expression",
         _ => return None,
@@ -195,6 +317,11 @@ fn build(expr: Pair<'_, Rule>) -> Expr {
         .map_prefix(|op, operand| {
             let span = Span::join(Span::of(&op), operand.span());
             Expr::Neg(Box::new(operand), span)
+        })
+        .map_postfix(|operand, member| {
+            let span = Span::join(operand.span(), Span::of(&member));
+            let name = member.as_str().trim_start_matches('.').trim().to_owned();
+            Expr::Member(Box::new(operand), name, span)
         })
         .map_infix(|left, op, right| {
             let op = match op.as_rule() {
@@ -222,10 +349,28 @@ fn primary(pair: Pair<'_, Rule>) -> Expr {
             Expr::Call {
                 name: name.as_str().to_owned(),
                 name_span: Span::of(&name),
-                args: inner.map(build).collect(),
+                args: inner.map(argument).collect(),
                 span,
             }
         }
         _ => build(pair),
     }
+}
+
+/// A call's argument: an expression, or a comparison of two.
+fn argument(pair: Pair<'_, Rule>) -> Expr {
+    let span = Span::of(&pair);
+    let mut inner = pair.into_inner();
+    let left = build(inner.next().expect("an argument holds an expression"));
+    let Some(op) = inner.next() else {
+        return left;
+    };
+    let op = match op.as_rule() {
+        Rule::lt => CompareOp::Less,
+        Rule::le => CompareOp::LessOrEqual,
+        Rule::gt => CompareOp::Greater,
+        _ => CompareOp::GreaterOrEqual,
+    };
+    let right = build(inner.next().expect("a comparison has two sides"));
+    Expr::Compare(op, Box::new(left), Box::new(right), span)
 }

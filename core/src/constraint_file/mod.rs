@@ -276,36 +276,47 @@ impl ConstraintFile {
             Binding::Tets | Binding::TetVertices => 4,
         };
         let Some(value) = raw.value else {
+            // Where it would go: after the last key before the first table (`[gradient]`).
+            let keys_end = text
+                .match_indices('\n')
+                .map(|(i, _)| i + 1)
+                .find(|&i| text[i..].trim_start_matches([' ', '\t']).starts_with('['))
+                .unwrap_or(text.len());
             return Err(error(
-                None,
-                "no `value`: give C as `value = \"…\"`".to_owned(),
+                Some(keys_end),
+                "no `value`: give C as `value = \"…\"` (before any [table])".to_owned(),
             ));
         };
-        // The definitions compile into both programs: C (with `rest`) and the rest value.
+        // The definitions compile into both programs: C (with `rest`) and the rest value. An
+        // expression's errors are placed by where its TOML string starts (`at`).
         let definitions = match &raw.define {
             Some(define) => {
-                let base = content_start(text, define.span().start);
+                let at = define.span().start;
                 let parsed = expression::parse_definitions(define.get_ref()).map_err(|e| {
-                    error(Some(base + e.offset), format!("in define: {}", e.message))
+                    error(
+                        Some(file_offset(text, at, e.offset)),
+                        format!("in define: {}", e.message),
+                    )
                 })?;
-                Some((base, parsed))
+                Some((at, parsed))
             }
             None => None,
         };
-        let compile_error = |base: usize, e: CompileError, source: &str, what: &str| {
+        let compile_error = |at: usize, e: CompileError, source: &str, what: &str| {
             let snippet = source.get(e.span.start..e.span.end).unwrap_or("").trim();
             error(
-                Some(base + e.span.start),
+                Some(file_offset(text, at, e.span.start)),
                 format!("in {what}: {} (`{snippet}`)", e.message),
             )
         };
         let build = |with_rest: bool| -> Result<Program, ConstraintFileError> {
             let mut program = Program::new(arity, with_rest);
-            if let (Some((base, parsed)), Some(define)) = (&definitions, &raw.define) {
+            if let (Some((at, parsed)), Some(define)) = (&definitions, &raw.define) {
+                program.at(*at);
                 for (name, span, expr) in parsed {
                     program
                         .define(name, *span, expr)
-                        .map_err(|e| compile_error(*base, e, define.get_ref(), "define"))?;
+                        .map_err(|e| compile_error(*at, e, define.get_ref(), "define"))?;
                 }
             }
             Ok(program)
@@ -315,12 +326,17 @@ impl ConstraintFile {
                        ty: Type,
                        what: &str|
          -> Result<usize, ConstraintFileError> {
-            let base = content_start(text, spanned.span().start);
-            let expr = expression::parse_expression(spanned.get_ref())
-                .map_err(|e| error(Some(base + e.offset), format!("in {what}: {}", e.message)))?;
+            let at = spanned.span().start;
+            let expr = expression::parse_expression(spanned.get_ref()).map_err(|e| {
+                error(
+                    Some(file_offset(text, at, e.offset)),
+                    format!("in {what}: {}", e.message),
+                )
+            })?;
+            program.at(at);
             program
                 .output(&expr, ty, what)
-                .map_err(|e| compile_error(base, e, spanned.get_ref(), what))
+                .map_err(|e| compile_error(at, e, spanned.get_ref(), what))
         };
         let mut program = build(true)?;
         let c = compile(&mut program, &value, Type::Scalar, "value")?;
@@ -528,6 +544,48 @@ impl ConstraintFile {
         if rest.is_finite() { rest } else { 0.0 }
     }
 
+    /// C and ∇C at `points` with rest value `rest` by reverse-mode AD alone, in any [`Real`]:
+    /// on [`Tangent`] numbers whose slopes are a direction, the slopes of ∇C are the Hessian of C
+    /// times that direction (forward over reverse).
+    pub fn reverse_gradient<T: Real, const N: usize>(
+        &self,
+        points: &[[T; 3]; N],
+        rest: T,
+    ) -> (T, [[T; 3]; N]) {
+        self.value.gradient(points, rest)
+    }
+
+    /// Where and why C is undefined at `points` with rest value `rest`: the first expression, in
+    /// the order C is worked out, whose value is not finite while what it reads is, named at
+    /// file:line:column (`acos of 1.0000001`, `division by zero`). `None` where C is finite.
+    pub fn undefined_at(&self, points: &[DVec3], rest: f64) -> Option<ConstraintFileError> {
+        let u = self.value.undefined_at(&self.coordinates(points), rest)?;
+        Some(ConstraintFileError {
+            path: self.path.clone(),
+            at: Some(self.place(u.base, u.offset)),
+            message: u.message,
+        })
+    }
+
+    /// Where C may have a kink or a jump (`abs`, `sign`, `min`, `max`, `clamp`, `if`), each at
+    /// its line and column, with the value at `points` whose zero is the kink.
+    pub fn switches_at(
+        &self,
+        points: &[DVec3],
+        rest: f64,
+    ) -> Vec<((usize, usize), &'static str, f64)> {
+        self.value
+            .switches_at(&self.coordinates(points), rest)
+            .into_iter()
+            .map(|s| (self.place(s.base, s.offset), s.what, s.decides))
+            .collect()
+    }
+
+    /// Line and column of byte `offset` of the expression whose TOML value starts at `base`.
+    fn place(&self, base: usize, offset: usize) -> (usize, usize) {
+        position(&self.source, file_offset(&self.source, base, offset))
+    }
+
     /// The instructions of C's tape and of the tape with the file's gradients, for the record
     /// of what an evaluation costs.
     pub fn tape_lengths(&self) -> (usize, usize) {
@@ -568,26 +626,70 @@ fn position(text: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
-/// The byte where a TOML string's content starts, given where the value starts: after `"`, `'`,
-/// or `"""` / `'''` and the newline that may follow them. Offsets within the content then map
-/// one to one onto the file, except after an escape sequence in a basic string.
-fn content_start(text: &str, value_start: usize) -> usize {
+/// The byte of `text` that byte `offset` of a TOML string's content comes from, the string's
+/// value starting at byte `value_start` (its opening quote). The content starts after `"`, `'`,
+/// or `"""` / `'''` and the newline that may follow them; in a basic (double-quoted) string an
+/// escape such as `\t` is two bytes of the file for one of the content, `\uXXXX` six, and a
+/// backslash at the end of a line of a `"""` string stands for the white space after it.
+fn file_offset(text: &str, value_start: usize, offset: usize) -> usize {
     let rest = &text[value_start.min(text.len())..];
-    let quote = if rest.starts_with("\"\"\"") || rest.starts_with("'''") {
-        3
-    } else if rest.starts_with('"') || rest.starts_with('\'') {
-        1
+    let (quote, escapes) = if rest.starts_with("\"\"\"") {
+        (3, true)
+    } else if rest.starts_with("'''") {
+        (3, false)
+    } else if rest.starts_with('"') {
+        (1, true)
+    } else if rest.starts_with('\'') {
+        (1, false)
     } else {
-        0
+        (0, false)
     };
-    let after = value_start + quote;
-    let tail = &text[after.min(text.len())..];
+    let mut at = value_start + quote;
     if quote == 3 {
+        let tail = &text[at.min(text.len())..];
         if tail.starts_with("\r\n") {
-            return after + 2;
+            at += 2;
         } else if tail.starts_with('\n') {
-            return after + 1;
+            at += 1;
         }
     }
-    after
+    let bytes = text.as_bytes();
+    let mut content = 0;
+    while content < offset && at < bytes.len() {
+        if escapes && bytes[at] == b'\\' {
+            match bytes.get(at + 1) {
+                Some(b'u') => {
+                    content += decoded_len(text.get(at + 2..).unwrap_or(""), 4);
+                    at += 6;
+                }
+                Some(b'U') => {
+                    content += decoded_len(text.get(at + 2..).unwrap_or(""), 8);
+                    at += 10;
+                }
+                Some(b' ' | b'\t' | b'\r' | b'\n') => {
+                    at += 1;
+                    while at < bytes.len() && matches!(bytes[at], b' ' | b'\t' | b'\r' | b'\n') {
+                        at += 1;
+                    }
+                }
+                _ => {
+                    content += 1;
+                    at += 2;
+                }
+            }
+        } else {
+            let width = text[at..].chars().next().map_or(1, char::len_utf8);
+            content += width;
+            at += width;
+        }
+    }
+    at.min(text.len())
+}
+
+/// The UTF-8 length of the character whose `digits` hex digits start `hex` (1 if they are not).
+fn decoded_len(hex: &str, digits: usize) -> usize {
+    hex.get(..digits)
+        .and_then(|h| u32::from_str_radix(h, 16).ok())
+        .and_then(char::from_u32)
+        .map_or(1, char::len_utf8)
 }

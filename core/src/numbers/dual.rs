@@ -129,6 +129,52 @@ impl<T: Real> Real for Tangent<T> {
             T::select(mask, if_true.slope, if_false.slope),
         )
     }
+    /// sin(a + a′ε) = sin a + a′ cos a ε.
+    #[inline]
+    fn sin(self) -> Self {
+        Tangent::new(self.value.sin(), self.slope * self.value.cos())
+    }
+    /// cos(a + a′ε) = cos a − a′ sin a ε.
+    #[inline]
+    fn cos(self) -> Self {
+        Tangent::new(self.value.cos(), -(self.slope * self.value.sin()))
+    }
+    /// exp(a + a′ε) = eᵃ + a′ eᵃ ε.
+    #[inline]
+    fn exp(self) -> Self {
+        let e = self.value.exp();
+        Tangent::new(e, self.slope * e)
+    }
+    /// ln(a + a′ε) = ln a + a′ / a ε.
+    #[inline]
+    fn ln(self) -> Self {
+        Tangent::new(self.value.ln(), self.slope / self.value)
+    }
+    /// atan2(y + y′ε, x + x′ε) = atan2(y, x) + (x y′ − y x′) / (x² + y²) ε.
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        let (y, x_) = (self.value, x.value);
+        let slope = (x_ * self.slope - y * x.slope) / (x_ * x_ + y * y);
+        Tangent::new(y.atan2(x_), slope)
+    }
+    /// asin(a + a′ε) = asin a + a′ / √(1 − a²) ε.
+    #[inline]
+    fn asin(self) -> Self {
+        let a = self.value;
+        Tangent::new(a.asin(), self.slope / (T::ONE - a * a).sqrt())
+    }
+    /// acos(a + a′ε) = acos a − a′ / √(1 − a²) ε.
+    #[inline]
+    fn acos(self) -> Self {
+        let a = self.value;
+        Tangent::new(a.acos(), -(self.slope / (T::ONE - a * a).sqrt()))
+    }
+    /// ∛(a + a′ε) = ∛a + a′ / (3 ∛a²) ε.
+    #[inline]
+    fn cbrt(self) -> Self {
+        let root = self.value.cbrt();
+        Tangent::new(root, self.slope / (T::from_f64(3.0) * root * root))
+    }
 }
 
 /// A dual number over f64.

@@ -188,6 +188,39 @@ impl Real for F32x8 {
     fn select(mask: Mask8, if_true: Self, if_false: Self) -> Self {
         F32x8(mask.0.bitselect(if_true.0, if_false.0))
     }
+    // The functions below are `wide`'s, in the lanes: no lane is computed on its own.
+    #[inline(always)]
+    fn sin(self) -> Self {
+        F32x8(self.0.sin_cos().0)
+    }
+    #[inline(always)]
+    fn cos(self) -> Self {
+        F32x8(self.0.sin_cos().1)
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        F32x8(self.0.exp())
+    }
+    #[inline(always)]
+    fn ln(self) -> Self {
+        F32x8(self.0.ln())
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        F32x8(self.0.atan2(x.0))
+    }
+    #[inline(always)]
+    fn asin(self) -> Self {
+        F32x8(self.0.asin())
+    }
+    #[inline(always)]
+    fn acos(self) -> Self {
+        F32x8(self.0.acos())
+    }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        F32x8(self.0.cbrt())
+    }
 }
 
 /// Eight 3-vectors, one per lane, stored as the eight x, the eight y and the eight z.

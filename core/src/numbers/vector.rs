@@ -74,6 +74,22 @@ pub trait Real:
     fn gt(self, other: Self) -> Self::Mask;
     /// `if_true` where `mask` is set, `if_false` elsewhere.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+    /// sin self (radians).
+    fn sin(self) -> Self;
+    /// cos self (radians).
+    fn cos(self) -> Self;
+    /// eˢᵉˡᶠ.
+    fn exp(self) -> Self;
+    /// The natural logarithm (NaN below 0, −∞ at 0).
+    fn ln(self) -> Self;
+    /// The angle of (x, y) = (`x`, self) from the x axis, in −π…π.
+    fn atan2(self, x: Self) -> Self;
+    /// arcsin self, in −π/2…π/2 (NaN outside −1…1).
+    fn asin(self) -> Self;
+    /// arccos self, in 0…π (NaN outside −1…1).
+    fn acos(self) -> Self;
+    /// The real cube root.
+    fn cbrt(self) -> Self;
 }
 
 macro_rules! impl_real {
@@ -107,6 +123,38 @@ macro_rules! impl_real {
             #[inline]
             fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
                 if mask { if_true } else { if_false }
+            }
+            #[inline]
+            fn sin(self) -> Self {
+                <$t>::sin(self)
+            }
+            #[inline]
+            fn cos(self) -> Self {
+                <$t>::cos(self)
+            }
+            #[inline]
+            fn exp(self) -> Self {
+                <$t>::exp(self)
+            }
+            #[inline]
+            fn ln(self) -> Self {
+                <$t>::ln(self)
+            }
+            #[inline]
+            fn atan2(self, x: Self) -> Self {
+                <$t>::atan2(self, x)
+            }
+            #[inline]
+            fn asin(self) -> Self {
+                <$t>::asin(self)
+            }
+            #[inline]
+            fn acos(self) -> Self {
+                <$t>::acos(self)
+            }
+            #[inline]
+            fn cbrt(self) -> Self {
+                <$t>::cbrt(self)
             }
         }
     };

@@ -1,0 +1,321 @@
+//! The constraint language beyond + − × ÷: its functions, components, `vec3`, `if`, and
+//! expressions over several lines, each derivative checked against central differences in both
+//! modes of automatic differentiation and in the fast engine's lanes; the domain errors, named
+//! at file:line:column; and the inputs that used to crash the parser (deep nesting, long
+//! chains, a megabyte of expression), each an error at its place, on a 1 MB stack as in the
+//! browser.
+
+use glam::DVec3;
+use std::path::Path;
+use tetlab_core::constraint_file::ConstraintFile;
+use tetlab_core::constraint_file::expression::MAX_DEPTH;
+use tetlab_core::numbers::lanes::{F32x8, Vec3x8};
+use tetlab_core::numbers::vector::Real;
+
+/// A file on edges (p0, p1) whose C is `value`, with `define` when given.
+fn edge_file(define: &str, value: &str) -> Result<ConstraintFile, String> {
+    let text = format!(
+        "name = \"c\"\napplies_to = \"edges\"\ndefine = \"\"\"\n{define}\n\"\"\"\nvalue = \"\"\"{value}\"\"\"\n"
+    );
+    ConstraintFile::parse(Path::new("mine.toml"), &text).map_err(|e| e.to_string())
+}
+
+/// A configuration where every function below is defined and smooth.
+const POINTS: [DVec3; 2] = [DVec3::new(0.31, 0.17, -0.23), DVec3::new(-0.12, 0.41, 0.29)];
+
+/// ∇C by central differences of C.
+fn central_difference(file: &ConstraintFile, points: &[DVec3; 2]) -> [DVec3; 2] {
+    let h = 1e-6;
+    std::array::from_fn(|i| {
+        let mut g = [0.0; 3];
+        for (axis, slot) in g.iter_mut().enumerate() {
+            let mut plus = *points;
+            let mut minus = *points;
+            plus[i][axis] += h;
+            minus[i][axis] -= h;
+            *slot = (file.value(&plus, 0.0) - file.value(&minus, 0.0)) / (2.0 * h);
+        }
+        DVec3::from_array(g)
+    })
+}
+
+#[test]
+fn every_function_differentiates_as_central_differences_say_in_both_modes_and_in_lanes() {
+    // Each is a scalar of the two points; x, y, z are components, a and b smooth scalars.
+    let define = "d = p1 - p0\nx = d.x\ny = d.y\nz = d.z\na = dot(p0, p1) + 0.5\nb = length(d)";
+    let cases = [
+        "sin(3 * x) + cos(2 * y)",
+        "tan(x)",
+        "exp(x * y) - log(b)",
+        "pow(b, 3) + pow(a, -2) + pow(b, 0.5) + pow(b, 1.7)",
+        "cbrt(z) + cbrt(-a)",
+        "asin(x) + acos(y / b)",
+        "atan2(y, x) + atan2(-z, -x)",
+        "clamp(x, -1, 1) + clamp(3 * y, -0.2, 0.2)",
+        "sign(x) * x + abs(z)",
+        "if(x < y, x * x, y * y * y) + if(z >= 0, z, -2 * z)",
+        "length(vec3(x * y, z, 1)) + dot(vec3(1, 2, 3), d)",
+        "if(a > 0, length(d), 0) + length(if(y <= x, p0, p1))",
+        "atan2(dot(cross(p0, p1), vec3(0, 0, 1)), dot(p0, p1))",
+    ];
+    for value in cases {
+        let file = edge_file(define, value).unwrap_or_else(|e| panic!("{value}: {e}"));
+        let numeric = central_difference(&file, &POINTS);
+        let forward = file.evaluate(&POINTS, 0.0).automatic.expect(value);
+        let reverse = file.evaluate_vectors(&POINTS, 0.0);
+        assert!(!reverse.degenerate, "{value}");
+        for k in 0..2 {
+            let scale = numeric[k].length().max(1.0);
+            assert!(
+                (forward[k] - numeric[k]).length() < 1e-7 * scale,
+                "{value}: p{k} forward {} against {}",
+                forward[k],
+                numeric[k]
+            );
+            assert!(
+                (reverse.gradients[k] - forward[k]).length() < 1e-12 * scale,
+                "{value}: p{k} reverse {} against forward {}",
+                reverse.gradients[k],
+                forward[k]
+            );
+        }
+        // The fast engine's lanes: eight copies in f32 agree with f32 alone (no lane is
+        // evaluated on its own: `wide`'s functions run on all eight).
+        let p32 = POINTS.map(|p| p.as_vec3a());
+        let single = file.evaluate_vectors(&p32, 0.0);
+        let lanes = p32.map(|p| Vec3x8::gather([p; 8]));
+        let eight = file.evaluate_vectors(&lanes, F32x8::ZERO);
+        let lane_value = eight.value.to_array()[3];
+        assert!(
+            (lane_value - single.value).abs() <= 1e-4 * single.value.abs().max(1.0),
+            "{value}: lanes {lane_value} against f32 {}",
+            single.value
+        );
+        let g = eight.gradients[1].lane(5);
+        assert!(
+            (g - single.gradients[1]).length() <= 1e-3 * single.gradients[1].length().max(1.0),
+            "{value}: lanes {g} against f32 {}",
+            single.gradients[1]
+        );
+    }
+}
+
+#[test]
+fn a_domain_error_is_named_where_it_happens() {
+    // At run time: acos of a number just above 1, at the line and column of `acos`.
+    let file = edge_file("k = length(p1 - p0)", "acos(k)").unwrap();
+    let points = [DVec3::ZERO, DVec3::new(1.000_000_1, 0.0, 0.0)];
+    assert!(file.value(&points, 0.0).is_nan());
+    let e = file.undefined_at(&points, 0.0).expect("undefined");
+    let text = e.to_string();
+    assert!(text.starts_with("mine.toml:6:12: "), "{text}");
+    assert!(text.contains("acos of 1.0000001"), "{text}");
+    let e = edge_file("k = length(p1 - p0) - 1", "log(k)")
+        .unwrap()
+        .undefined_at(&[DVec3::ZERO, DVec3::X], 0.0)
+        .expect("log of 0");
+    assert!(e.to_string().contains("log of 0"), "{e}");
+    assert!(
+        edge_file("", "acos(length(p1 - p0) / 2)")
+            .unwrap()
+            .undefined_at(&[DVec3::ZERO, DVec3::X], 0.0)
+            .is_none()
+    );
+}
+
+#[test]
+fn constants_that_are_undefined_are_errors_at_their_place() {
+    for (value, column, what) in [
+        ("length(p0 - p1) / 0", 30, "division by zero"),
+        ("length(p0 - p1) / (1 - 1)", 31, "division by zero"),
+        ("length(p0 - p1) + 1e308 * 10", 30, "too large"),
+        ("length(p0 - p1) + log(0)", 30, "log of 0"),
+        ("acos(1.5) * length(p0 - p1)", 12, "acos of 1.5"),
+        ("length(p0 - p1) * sqrt(-1)", 30, "sqrt of -1"),
+    ] {
+        let e = edge_file("", value).unwrap_err();
+        assert!(
+            e.starts_with(&format!("mine.toml:6:{column}: ")),
+            "{value}: {e}"
+        );
+        assert!(e.contains(what), "{value}: {e}");
+    }
+    // In a definition too, at its line.
+    let e = edge_file("a = 1\nb = 2 / (a - 1)", "length(p0 - p1) * b").unwrap_err();
+    assert!(e.starts_with("mine.toml:5:10: "), "{e}");
+}
+
+#[test]
+fn a_file_without_a_value_is_named_at_a_line() {
+    let e = ConstraintFile::parse(
+        Path::new("mine.toml"),
+        "name = \"c\"\napplies_to = \"edges\"\n\n[gradient]\np0 = \"p0\"\n",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("mine.toml:4:1: no `value`"), "{e}");
+}
+
+#[test]
+fn a_column_after_an_escape_is_the_column_in_the_file() {
+    // `\t` is two characters of the file and one of the string: q is at column 18.
+    let text = "name = \"c\"\napplies_to = \"edges\"\nvalue = \"length(\\tq)\"\n";
+    let e = ConstraintFile::parse(Path::new("mine.toml"), text)
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("mine.toml:3:19: "), "{e}");
+    // A literal string has no escapes.
+    let text = "name = \"c\"\napplies_to = \"edges\"\nvalue = 'length(\tq)'\n";
+    let e = ConstraintFile::parse(Path::new("mine.toml"), text)
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("mine.toml:3:18: "), "{e}");
+}
+
+#[test]
+fn expressions_may_span_lines() {
+    let file = edge_file(
+        "d = p1 -\n    p0\nk = dot(d,\n        d)",
+        "sqrt(k)\n  - 1\n  + 0 * (d.x\n         + d.y)",
+    )
+    .unwrap();
+    let points = [DVec3::ZERO, DVec3::new(0.0, 3.0, 4.0)];
+    assert_eq!(file.value(&points, 0.0), 4.0);
+    // A mistake on a later line of an expression is named on that line.
+    let e = edge_file("", "length(p0 - p1)\n  + q").unwrap_err();
+    assert!(e.starts_with("mine.toml:7:5: "), "{e}");
+}
+
+#[test]
+fn a_constraint_against_a_fixed_plane_and_point_can_be_written() {
+    // A wall at y = 0 and an attachment to (1, 2, 3), as written in a file.
+    let wall = edge_file("", "min(p0.y, 0)").unwrap();
+    let below = [DVec3::new(0.5, -0.25, 0.0), DVec3::ZERO];
+    assert_eq!(wall.value(&below, 0.0), -0.25);
+    let g = wall.evaluate_vectors(&below, 0.0).gradients;
+    assert_eq!(g[0], DVec3::Y);
+    let pin = edge_file("", "length(p0 - vec3(1, 2, 3))").unwrap();
+    let g = pin.evaluate_vectors(&[DVec3::new(1.0, 2.0, 5.0), DVec3::ZERO], 0.0);
+    assert_eq!((g.value, g.gradients[0]), (2.0, DVec3::Z));
+}
+
+#[test]
+fn the_reverse_tape_on_tangents_gives_second_derivatives() {
+    use tetlab_core::numbers::dual::Tangent;
+    // C = |p0 − p1|: its Hessian block ∂²C/∂p0² = (I − u uᵀ) / |d|, u = d / |d|.
+    let file = edge_file("", "length(p0 - p1) + 0.25 * pow(dot(p0, p0), 2)").unwrap();
+    let p = POINTS;
+    for axis in 0..3 {
+        // Tangent along p0's `axis` coordinate.
+        let points: [[Tangent<f64>; 3]; 2] = std::array::from_fn(|i| {
+            std::array::from_fn(|k| {
+                Tangent::new(p[i][k], if i == 0 && k == axis { 1.0 } else { 0.0 })
+            })
+        });
+        let (_, gradient) = file.reverse_gradient(&points, Tangent::new(0.0, 0.0));
+        let column = gradient.map(|g| DVec3::new(g[0].slope, g[1].slope, g[2].slope));
+        let h = 1e-6;
+        let mut plus = p;
+        let mut minus = p;
+        plus[0][axis] += h;
+        minus[0][axis] -= h;
+        let g = |q: &[DVec3; 2]| file.evaluate_vectors(q, 0.0).gradients;
+        for k in 0..2 {
+            let numeric = (g(&plus)[k] - g(&minus)[k]) / (2.0 * h);
+            assert!(
+                (column[k] - numeric).length() < 1e-6,
+                "axis {axis}, p{k}: {} against {numeric}",
+                column[k]
+            );
+        }
+    }
+}
+
+/// Runs `f` on a thread with a 1 MB stack, the size the browser gives.
+fn on_a_small_stack(f: impl FnOnce() + Send + 'static) {
+    std::thread::Builder::new()
+        .stack_size(1 << 20)
+        .spawn(f)
+        .expect("a thread")
+        .join()
+        .expect("no crash");
+}
+
+/// A file whose `key` expression (`value`, a definition, or a gradient entry) is `expression`.
+fn file_with(key: &str, expression: &str) -> String {
+    let header = "name = \"c\"\napplies_to = \"edges\"\n";
+    match key {
+        "value" => format!("{header}value = \"{expression}\"\n"),
+        "define" => format!("{header}define = \"k = {expression}\"\nvalue = \"k\"\n"),
+        _ => format!("{header}value = \"length(p0 - p1)\"\n[gradient]\np0 = \"{expression}\"\n"),
+    }
+}
+
+#[test]
+fn inputs_that_crashed_the_parser_are_errors_at_their_place_on_a_1_mb_stack() {
+    on_a_small_stack(|| {
+        let deep = |n: usize, open: &str, inner: &str| {
+            format!("{}{inner}{}", open.repeat(n), ")".repeat(n))
+        };
+        let sum = vec!["p0"; 55_000].join(" + ");
+        let cases = [
+            ("value", deep(10_000, "(", "1"), 3, "nests too deeply"),
+            ("define", deep(10_000, "(", "1"), 3, "nests too deeply"),
+            ("gradient", deep(10_000, "(", "p0"), 5, "nests too deeply"),
+            ("value", deep(10_000, "abs(", "1"), 3, "nests too deeply"),
+            (
+                "value",
+                format!("{}1", "-".repeat(20_000)),
+                3,
+                "nests too deeply",
+            ),
+            (
+                "value",
+                format!("{}1", "- ".repeat(20_000)),
+                3,
+                "nests too deeply",
+            ),
+            (
+                "value",
+                vec!["1"; 55_000].join(" + "),
+                3,
+                "nests too deeply",
+            ),
+            ("gradient", sum.clone(), 5, "nests too deeply"),
+            (
+                "value",
+                format!("{}1", "-(".repeat(5_000)),
+                3,
+                "nests too deeply",
+            ),
+            (
+                "value",
+                format!("p0{}", ".x".repeat(10_000)),
+                3,
+                "nests too deeply",
+            ),
+            ("value", "1 + ".repeat(300_000) + "1", 3, "nests too deeply"),
+            ("value", "a".repeat(1 << 20), 3, "bytes long"),
+        ];
+        for (key, expression, line, what) in cases {
+            let text = file_with(key, &expression);
+            let e = ConstraintFile::parse(Path::new("deep.toml"), &text)
+                .unwrap_err()
+                .to_string();
+            let head: String = expression.chars().take(20).collect();
+            assert!(
+                e.starts_with(&format!("deep.toml:{line}:")),
+                "{key} {head}: {e}"
+            );
+            assert!(e.contains(what), "{key} {head}: {e}");
+        }
+        // As deep as is allowed still parses and compiles, on this stack: the depth counts the
+        // parentheses, `length(` and its `-`.
+        let at_limit = deep(MAX_DEPTH - 2, "(", "length(p0 - p1)");
+        ConstraintFile::parse(Path::new("deep.toml"), &file_with("value", &at_limit))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let negations = format!("{}length(p0 - p1)", "-".repeat(MAX_DEPTH - 2));
+        ConstraintFile::parse(Path::new("deep.toml"), &file_with("value", &negations))
+            .unwrap_or_else(|e| panic!("{e}"));
+    });
+}
