@@ -120,14 +120,14 @@ fn constraint_file(c: &mut Criterion) {
         b.iter(|| height::evaluate::<DVec3>(black_box(&tet), 0.7))
     });
     group.bench_function("file, AD", |b| {
-        b.iter(|| file.evaluate_vectors(black_box(&tet), 0.7))
+        b.iter(|| file.evaluate_vectors(black_box(&tet), 0.7, &[]))
     });
     group.bench_function("file, forward-mode AD", |b| {
-        b.iter(|| file.evaluate(black_box(&tet), 0.7))
+        b.iter(|| file.evaluate(black_box(&tet), 0.7, &[]))
     });
     file.use_gradient = true;
     group.bench_function("file, its own gradient", |b| {
-        b.iter(|| file.evaluate_vectors(black_box(&tet), 0.7))
+        b.iter(|| file.evaluate_vectors(black_box(&tet), 0.7, &[]))
     });
     group.finish();
 }

@@ -84,7 +84,7 @@ fn a_flipped_sign_is_found_at_the_particle_it_is_in() {
     assert!(worst.particle == 3 || worst.particle == 0);
     // The configuration shown really shows it.
     let file = load("height-wrong-sign.toml");
-    let at = file.evaluate(&worst.points, worst.rest);
+    let at = file.evaluate(&worst.points, worst.rest, &[]);
     let automatic = at.automatic.unwrap();
     let yours = at.yours[worst.particle].unwrap();
     assert!((yours - automatic[worst.particle]).length() > 0.1 * automatic[1].length());
@@ -106,7 +106,7 @@ fn near_degenerate_configurations_are_flagged_never_nan() {
             assert!(report.undefined > 0, "{name}");
         }
         let flat = [glam::DVec3::ZERO; 4];
-        let e = file.evaluate(&flat[..file.arity()], 0.0);
+        let e = file.evaluate(&flat[..file.arity()], 0.0, &[]);
         if let Some(g) = &e.automatic {
             assert!(g.iter().all(|v| v.is_finite()), "{name}");
         }
@@ -210,10 +210,10 @@ fn the_same_program_evaluates_in_f64_f32_and_lanes() {
     let mut lanes = [[[0.0f32; 8]; 3]; 4];
     for (lane, points) in configs.iter().enumerate() {
         let rest = 0.1;
-        let checked = file.evaluate(points, rest);
+        let checked = file.evaluate(points, rest, &[]);
         let automatic = checked.automatic.unwrap();
         let p: [DVec3; 4] = std::array::from_fn(|k| points[k]);
-        let f64s = file.evaluate_vectors(&p, rest);
+        let f64s = file.evaluate_vectors(&p, rest, &[]);
         assert!((f64s.value - checked.value).abs() < 1e-14);
         assert!(!f64s.degenerate);
         let scale = automatic.iter().map(|g| g.length()).fold(0.0, f64::max);
@@ -221,7 +221,7 @@ fn the_same_program_evaluates_in_f64_f32_and_lanes() {
             assert!((*g - *a).length() < 1e-13 * scale);
         }
         let q: [Vec3A; 4] = std::array::from_fn(|k| points[k].as_vec3a());
-        let f32s = file.evaluate_vectors(&q, rest as f32);
+        let f32s = file.evaluate_vectors(&q, rest as f32, &[]);
         for (k, (g, a)) in f32s.gradients.iter().zip(&automatic).enumerate() {
             let g = g.as_dvec3();
             assert!((g - *a).length() < 1e-4 * scale, "{g} {a}");
@@ -231,10 +231,10 @@ fn the_same_program_evaluates_in_f64_f32_and_lanes() {
         }
     }
     let p: [Vec3x8; 4] = std::array::from_fn(|k| Vec3x8::from_array(lanes[k].map(F32x8::new)));
-    let wide = file.evaluate_vectors(&p, F32x8::from_f64(0.1));
+    let wide = file.evaluate_vectors(&p, F32x8::from_f64(0.1), &[]);
     for (lane, points) in configs.iter().enumerate() {
         let q: [Vec3A; 4] = std::array::from_fn(|k| points[k].as_vec3a());
-        let one = file.evaluate_vectors(&q, 0.1f32);
+        let one = file.evaluate_vectors(&q, 0.1f32, &[]);
         assert_eq!(wide.value.to_array()[lane], one.value);
         for (w, g) in wide.gradients.iter().zip(&one.gradients) {
             assert_eq!(w.lane(lane), *g);
@@ -246,7 +246,7 @@ fn the_same_program_evaluates_in_f64_f32_and_lanes() {
 fn a_simulation_gets_a_zero_gradient_where_it_is_undefined_and_yours_when_asked() {
     use glam::DVec3;
     let edge = load("edge.toml");
-    let e = edge.evaluate_vectors(&[DVec3::ONE, DVec3::ONE], 0.5);
+    let e = edge.evaluate_vectors(&[DVec3::ONE, DVec3::ONE], 0.5, &[]);
     assert!(e.degenerate);
     assert_eq!(e.gradients, [DVec3::ZERO; 2]);
     assert_eq!(e.value, -0.5);
@@ -263,8 +263,8 @@ fn a_simulation_gets_a_zero_gradient_where_it_is_undefined_and_yours_when_asked(
     );
     let points = &configurations(4, 1, 12)[0];
     let p: [DVec3; 4] = std::array::from_fn(|k| points[k]);
-    let used = wrong.evaluate_vectors(&p, 0.0);
-    let checked = wrong.evaluate(points, 0.0);
+    let used = wrong.evaluate_vectors(&p, 0.0, &[]);
+    let checked = wrong.evaluate(points, 0.0, &[]);
     for k in 0..4 {
         assert_eq!(
             used.gradients[k],
@@ -281,30 +281,37 @@ fn a_simulation_gets_a_zero_gradient_where_it_is_undefined_and_yours_when_asked(
 fn reverse_and_forward_mode_agree_on_every_example() {
     use glam::DVec3;
     use tetlab_core::constraint_file::EXAMPLES;
+    let material = tetlab_core::constraints::material::Material::default();
     for example in EXAMPLES {
-        let file = ConstraintFile::parse(Path::new(example.path), example.text).unwrap();
-        let mut worst: f64 = 0.0;
-        for (k, points) in configurations(file.arity(), 300, 21).iter().enumerate() {
-            let rest = 0.1 * (k + 1) as f64 / 300.0; // never 0: C = V / rest − 1 needs one
-            let forward = file
-                .evaluate(points, rest)
-                .automatic
-                .expect("well conditioned");
-            let reverse: Vec<DVec3> = match file.arity() {
-                2 => file
-                    .evaluate_by(&[points[0], points[1]], rest, false)
-                    .gradients
-                    .to_vec(),
-                _ => {
-                    let p: [DVec3; 4] = std::array::from_fn(|i| points[i]);
-                    file.evaluate_by(&p, rest, false).gradients.to_vec()
+        for file in ConstraintFile::parse_all(Path::new(example.path), example.text).unwrap() {
+            let mut worst: f64 = 0.0;
+            for (k, points) in configurations(file.arity(), 300, 21).iter().enumerate() {
+                let rest = 0.1 * (k + 1) as f64 / 300.0; // never 0: C = V / rest − 1 needs one
+                // A rest shape for a file that reads one: a sheared copy of the points.
+                let shape: Vec<DVec3> = points.iter().map(|p| *p + DVec3::X * p.y * 0.3).collect();
+                let stored = file.store(&shape, &material);
+                let forward = file
+                    .evaluate(points, rest, &stored)
+                    .automatic
+                    .expect("well conditioned");
+                let reverse: Vec<DVec3> = match file.arity() {
+                    2 => file
+                        .evaluate_by(&[points[0], points[1]], rest, &stored, false)
+                        .gradients
+                        .to_vec(),
+                    _ => {
+                        let p: [DVec3; 4] = std::array::from_fn(|i| points[i]);
+                        file.evaluate_by(&p, rest, &stored, false)
+                            .gradients
+                            .to_vec()
+                    }
+                };
+                let scale = forward.iter().map(|g| g.length()).fold(0.0, f64::max);
+                for (f, r) in forward.iter().zip(&reverse) {
+                    worst = worst.max((*f - *r).length() / scale);
                 }
-            };
-            let scale = forward.iter().map(|g| g.length()).fold(0.0, f64::max);
-            for (f, r) in forward.iter().zip(&reverse) {
-                worst = worst.max((*f - *r).length() / scale);
             }
+            assert!(worst < 1e-12, "{}: {worst:e}", example.file);
         }
-        assert!(worst < 1e-12, "{}: {worst:e}", example.file);
     }
 }

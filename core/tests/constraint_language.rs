@@ -33,7 +33,7 @@ fn central_difference(file: &ConstraintFile, points: &[DVec3; 2]) -> [DVec3; 2] 
             let mut minus = *points;
             plus[i][axis] += h;
             minus[i][axis] -= h;
-            *slot = (file.value(&plus, 0.0) - file.value(&minus, 0.0)) / (2.0 * h);
+            *slot = (file.value(&plus, 0.0, &[]) - file.value(&minus, 0.0, &[])) / (2.0 * h);
         }
         DVec3::from_array(g)
     })
@@ -61,8 +61,8 @@ fn every_function_differentiates_as_central_differences_say_in_both_modes_and_in
     for value in cases {
         let file = edge_file(define, value).unwrap_or_else(|e| panic!("{value}: {e}"));
         let numeric = central_difference(&file, &POINTS);
-        let forward = file.evaluate(&POINTS, 0.0).automatic.expect(value);
-        let reverse = file.evaluate_vectors(&POINTS, 0.0);
+        let forward = file.evaluate(&POINTS, 0.0, &[]).automatic.expect(value);
+        let reverse = file.evaluate_vectors(&POINTS, 0.0, &[]);
         assert!(!reverse.degenerate, "{value}");
         for k in 0..2 {
             let scale = numeric[k].length().max(1.0);
@@ -82,9 +82,9 @@ fn every_function_differentiates_as_central_differences_say_in_both_modes_and_in
         // The fast engine's lanes: eight copies in f32 agree with f32 alone (no lane is
         // evaluated on its own: `wide`'s functions run on all eight).
         let p32 = POINTS.map(|p| p.as_vec3a());
-        let single = file.evaluate_vectors(&p32, 0.0);
+        let single = file.evaluate_vectors(&p32, 0.0, &[]);
         let lanes = p32.map(|p| Vec3x8::gather([p; 8]));
-        let eight = file.evaluate_vectors(&lanes, F32x8::ZERO);
+        let eight = file.evaluate_vectors(&lanes, F32x8::ZERO, &[]);
         let lane_value = eight.value.to_array()[3];
         assert!(
             (lane_value - single.value).abs() <= 1e-4 * single.value.abs().max(1.0),
@@ -105,20 +105,20 @@ fn a_domain_error_is_named_where_it_happens() {
     // At run time: acos of a number just above 1, at the line and column of `acos`.
     let file = edge_file("k = length(p1 - p0)", "acos(k)").unwrap();
     let points = [DVec3::ZERO, DVec3::new(1.000_000_1, 0.0, 0.0)];
-    assert!(file.value(&points, 0.0).is_nan());
-    let e = file.undefined_at(&points, 0.0).expect("undefined");
+    assert!(file.value(&points, 0.0, &[]).is_nan());
+    let e = file.undefined_at(&points, 0.0, &[]).expect("undefined");
     let text = e.to_string();
     assert!(text.starts_with("mine.toml:6:12: "), "{text}");
     assert!(text.contains("acos of 1.0000001"), "{text}");
     let e = edge_file("k = length(p1 - p0) - 1", "log(k)")
         .unwrap()
-        .undefined_at(&[DVec3::ZERO, DVec3::X], 0.0)
+        .undefined_at(&[DVec3::ZERO, DVec3::X], 0.0, &[])
         .expect("log of 0");
     assert!(e.to_string().contains("log of 0"), "{e}");
     assert!(
         edge_file("", "acos(length(p1 - p0) / 2)")
             .unwrap()
-            .undefined_at(&[DVec3::ZERO, DVec3::X], 0.0)
+            .undefined_at(&[DVec3::ZERO, DVec3::X], 0.0, &[])
             .is_none()
     );
 }
@@ -180,7 +180,7 @@ fn expressions_may_span_lines() {
     )
     .unwrap();
     let points = [DVec3::ZERO, DVec3::new(0.0, 3.0, 4.0)];
-    assert_eq!(file.value(&points, 0.0), 4.0);
+    assert_eq!(file.value(&points, 0.0, &[]), 4.0);
     // A mistake on a later line of an expression is named on that line.
     let e = edge_file("", "length(p0 - p1)\n  + q").unwrap_err();
     assert!(e.starts_with("mine.toml:7:5: "), "{e}");
@@ -191,11 +191,11 @@ fn a_constraint_against_a_fixed_plane_and_point_can_be_written() {
     // A wall at y = 0 and an attachment to (1, 2, 3), as written in a file.
     let wall = edge_file("", "min(p0.y, 0)").unwrap();
     let below = [DVec3::new(0.5, -0.25, 0.0), DVec3::ZERO];
-    assert_eq!(wall.value(&below, 0.0), -0.25);
-    let g = wall.evaluate_vectors(&below, 0.0).gradients;
+    assert_eq!(wall.value(&below, 0.0, &[]), -0.25);
+    let g = wall.evaluate_vectors(&below, 0.0, &[]).gradients;
     assert_eq!(g[0], DVec3::Y);
     let pin = edge_file("", "length(p0 - vec3(1, 2, 3))").unwrap();
-    let g = pin.evaluate_vectors(&[DVec3::new(1.0, 2.0, 5.0), DVec3::ZERO], 0.0);
+    let g = pin.evaluate_vectors(&[DVec3::new(1.0, 2.0, 5.0), DVec3::ZERO], 0.0, &[]);
     assert_eq!((g.value, g.gradients[0]), (2.0, DVec3::Z));
 }
 
@@ -212,14 +212,14 @@ fn the_reverse_tape_on_tangents_gives_second_derivatives() {
                 Tangent::new(p[i][k], if i == 0 && k == axis { 1.0 } else { 0.0 })
             })
         });
-        let (_, gradient) = file.reverse_gradient(&points, Tangent::new(0.0, 0.0));
+        let (_, gradient) = file.reverse_gradient(&points, Tangent::new(0.0, 0.0), &[]);
         let column = gradient.map(|g| DVec3::new(g[0].slope, g[1].slope, g[2].slope));
         let h = 1e-6;
         let mut plus = p;
         let mut minus = p;
         plus[0][axis] += h;
         minus[0][axis] -= h;
-        let g = |q: &[DVec3; 2]| file.evaluate_vectors(q, 0.0).gradients;
+        let g = |q: &[DVec3; 2]| file.evaluate_vectors(q, 0.0, &[]).gradients;
         for k in 0..2 {
             let numeric = (g(&plus)[k] - g(&minus)[k]) / (2.0 * h);
             assert!(

@@ -243,11 +243,14 @@ fn a_wrong_gradient_in_use_is_what_the_projection_follows() {
         .iter()
         .map(|&i| simulation.positions()[i as usize])
         .collect();
-    let yours = file.yours(&points, projection.rest);
+    let yours = file.yours(&points, projection.rest, &[]);
     for (k, yours) in yours.iter().enumerate() {
         assert_eq!(Some(projection.gradients[k]), *yours, "p{k}: yours is used");
     }
-    let automatic = file.evaluate(&points, projection.rest).automatic.unwrap();
+    let automatic = file
+        .evaluate(&points, projection.rest, &[])
+        .automatic
+        .unwrap();
     assert!(
         (projection.gradients[3] - automatic[3]).length() > 1e-3,
         "p3's gradient is the wrong one"

@@ -579,7 +579,7 @@ fn a_constraint_file_evaluates_without_allocating() {
     let before = allocations();
     let mut sum = 0.0;
     for _ in 0..100 {
-        let e = file.evaluate_vectors(&p, 0.5);
+        let e = file.evaluate_vectors(&p, 0.5, &[]);
         sum += e.value + e.gradients[1].z;
     }
     assert_eq!(allocations(), before, "allocations in 100 evaluations");

@@ -35,12 +35,12 @@ fuzz_target!(|data: &[u8]| {
                 for own in [false, true] {
                     let (value, gradients, degenerate) = match points.len() {
                         2 => {
-                            let e = file.evaluate_by(&[points[0], points[1]], rest, own);
+                            let e = file.evaluate_by(&[points[0], points[1]], rest, &[], own);
                             (e.value, e.gradients.to_vec(), e.degenerate)
                         }
                         _ => {
                             let p = [points[0], points[1], points[2], points[3]];
-                            let e = file.evaluate_by(&p, rest, own);
+                            let e = file.evaluate_by(&p, rest, &[], own);
                             (e.value, e.gradients.to_vec(), e.degenerate)
                         }
                     };

@@ -74,12 +74,18 @@ struct FileOutput {
     agrees: bool,
     compared: usize,
     skipped_near_degenerate: usize,
-    /// Keyed p0…; null for a particle the file gives no gradient for.
-    max_relative_error: BTreeMap<String, Option<f64>>,
+    /// Keyed p0…; null for a particle the file gives no gradient for, "non_finite" where the
+    /// file's gradient is NaN or infinite where AD's is finite.
+    max_relative_error: BTreeMap<String, Figure>,
     worst: Option<WorstOutput>,
     automatic_vs_finite_difference: f64,
+    /// Of AD's gradient.
     translation_invariant: bool,
+    /// Of the file's gradient; null unless it gives every particle's.
+    your_gradient_translation_invariant: Option<bool>,
     rotation_invariant: bool,
+    /// Where C has a kink or a jump, found by sampling near it: each with where it is.
+    kinks: Vec<KinkOutput>,
     reflection: &'static str,
     near_degenerate: usize,
     undefined_near_degenerate: usize,
@@ -90,20 +96,103 @@ struct WorstOutput {
     particle: String,
     points: Vec<[f64; 3]>,
     rest: f64,
-    relative_error: f64,
+    relative_error: Figure,
+    /// Whether AD's gradient is zero there, so that the error is absolute.
+    absolute: bool,
     command: String,
 }
 
+#[derive(Serialize)]
+struct KinkOutput {
+    what: &'static str,
+    line: usize,
+    column: usize,
+    lines_tried: usize,
+    lines_crossing: usize,
+    largest_jump: f64,
+    random_configurations_on_it: usize,
+}
+
+/// A figure as JSON gives it: a number, `"non_finite"` for NaN or ±∞ (JSON has neither; serde
+/// would write `null`, which means "not given" here), or `null` for none.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Figure {
+    Number(f64),
+    Word(&'static str),
+    None(Option<()>),
+}
+
+impl Figure {
+    fn of(x: Option<f64>) -> Figure {
+        match x {
+            Some(x) if x.is_finite() => Figure::Number(x),
+            Some(_) => Figure::Word("non_finite"),
+            None => Figure::None(None),
+        }
+    }
+}
+
+/// `x` with two significant digits, in scientific notation below 0.01 (`1.0e-4`).
+fn two_digits(x: f64) -> String {
+    if !x.is_finite() {
+        "non-finite (NaN or infinite)".to_owned()
+    } else if x == 0.0 || (0.01..1000.0).contains(&x.abs()) {
+        let decimals = if x == 0.0 {
+            1
+        } else {
+            (1 - x.abs().log10().floor() as i32).max(0) as usize
+        };
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.1e}")
+    }
+}
+
+/// `path` as a shell reads it back: quoted when it holds a space or another special character.
+fn shell_word(path: &std::path::Path) -> String {
+    let text = path.display().to_string();
+    shlex::try_quote(&text).map_or(text.clone(), |q| q.into_owned())
+}
+
+/// Checks every constraint of the file in turn (one, or each `[[constraint]]`); `Ok(false)`
+/// when the gradient of any disagrees.
 fn run_file(args: &Args, path: &std::path::Path, out: &mut impl Write) -> Result<bool, UsageError> {
-    let file = ConstraintFile::load(path).map_err(|e| UsageError(e.to_string()))?;
-    let report = check(&file, args.samples as usize, args.seed);
+    let files = ConstraintFile::load_all(path).map_err(|e| UsageError(e.to_string()))?;
+    let mut agrees = true;
+    for (k, file) in files.iter().enumerate() {
+        if k > 0 && !args.json {
+            writeln!(out).map_err(UsageError::stdout)?;
+        }
+        agrees &= run_one_file(args, path, file, out)?;
+    }
+    Ok(agrees)
+}
+
+fn run_one_file(
+    args: &Args,
+    path: &std::path::Path,
+    file: &ConstraintFile,
+    out: &mut impl Write,
+) -> Result<bool, UsageError> {
+    let report = check(file, args.samples as usize, args.seed);
     if report.compared == 0 {
+        // Where it is undefined, at the first configuration that the check drew.
+        let mut rng = tetlab_core::numbers::random::SplitMix64::new(args.seed);
+        let (points, shape, _) = tetlab_core::constraints::verify::draw(&mut rng, file);
+        let material = tetlab_core::constraints::material::Material::default();
+        let stored = file.store(&shape, &material);
+        let rest = file.rest_value(&shape, &material);
+        let why = file
+            .undefined_at(&points, rest, &stored)
+            .map_or_else(String::new, |e| format!(": {e}"));
         return Err(UsageError(format!(
-            "{}: C or its gradient is undefined at every random configuration tried",
+            "{}: C or its gradient is undefined at every random configuration tried{why}",
             path.display()
         )));
     }
-    let output = file_output(path, &file, &report);
+    let kinks = tetlab_core::constraint_file::check::kinks(file, 200, args.seed);
+    let output = file_output(path, file, &report, &kinks);
     let written = if args.json {
         serde_json::to_writer(&mut *out, &output)
             .map_err(std::io::Error::from)
@@ -115,7 +204,12 @@ fn run_file(args: &Args, path: &std::path::Path, out: &mut impl Write) -> Result
     Ok(output.agrees)
 }
 
-fn file_output(path: &std::path::Path, file: &ConstraintFile, report: &Report) -> FileOutput {
+fn file_output(
+    path: &std::path::Path,
+    file: &ConstraintFile,
+    report: &Report,
+    kinks: &[tetlab_core::constraint_file::check::Kink],
+) -> FileOutput {
     let worst = report
         .worst
         .as_ref()
@@ -124,10 +218,11 @@ fn file_output(path: &std::path::Path, file: &ConstraintFile, report: &Report) -
             particle: format!("p{}", w.particle),
             points: w.points.iter().map(|p| p.to_array()).collect(),
             rest: w.rest,
-            relative_error: w.relative_error,
+            relative_error: Figure::of(Some(w.relative_error)),
+            absolute: w.absolute,
             command: format!(
                 "tetlab gradient --constraint-file {} --points {} --rest {:?}",
-                path.display(),
+                shell_word(path),
                 w.points
                     .iter()
                     .map(|p| format!("{:?},{:?},{:?}", p.x, p.y, p.z))
@@ -146,12 +241,27 @@ fn file_output(path: &std::path::Path, file: &ConstraintFile, report: &Report) -
             .max_relative_error
             .iter()
             .enumerate()
-            .map(|(k, e)| (format!("p{k}"), *e))
+            .map(|(k, e)| (format!("p{k}"), Figure::of(*e)))
             .collect(),
         worst,
         automatic_vs_finite_difference: report.automatic_vs_finite_difference,
         translation_invariant: report.translation_invariant(),
+        your_gradient_translation_invariant: report
+            .translation_given
+            .map(|t| t <= tetlab_core::constraint_file::check::INVARIANCE),
         rotation_invariant: report.rotation_invariant(),
+        kinks: kinks
+            .iter()
+            .map(|k| KinkOutput {
+                what: k.what,
+                line: k.at.0,
+                column: k.at.1,
+                lines_tried: k.tried,
+                lines_crossing: k.crossed,
+                largest_jump: k.jump,
+                random_configurations_on_it: k.landed,
+            })
+            .collect(),
         reflection: report.reflection.describe(),
         near_degenerate: report.near_degenerate,
         undefined_near_degenerate: report.undefined,
@@ -178,9 +288,13 @@ fn write_file_report(
     )?;
     for (particle, error) in &o.max_relative_error {
         match error {
-            Some(e) if *e <= AGREEMENT => writeln!(out, "  {particle}  {e:.2e}  agrees")?,
-            Some(e) => writeln!(out, "  {particle}  {e:.2e}  WRONG")?,
-            None => writeln!(out, "  {particle}  not given, not checked")?,
+            Figure::Number(e) if *e <= AGREEMENT => writeln!(out, "  {particle}  {e:.2e}  agrees")?,
+            Figure::Number(e) => writeln!(out, "  {particle}  {e:.2e}  WRONG")?,
+            Figure::Word(_) => writeln!(
+                out,
+                "  {particle}  non-finite  WRONG (NaN or infinite where AD's is finite)"
+            )?,
+            Figure::None(_) => writeln!(out, "  {particle}  not given, not checked")?,
         }
     }
     writeln!(
@@ -190,10 +304,26 @@ fn write_file_report(
     )?;
     writeln!(
         out,
-        "translation invariant (sum of the gradients = 0): {} ({:.1e})",
+        "translation invariant (sum of the gradients = 0): AD's {} ({:.1e})",
         yes(o.translation_invariant),
         report.translation
     )?;
+    match report.translation_given {
+        Some(t) => writeln!(
+            out,
+            "  and yours {} ({})",
+            yes(o.your_gradient_translation_invariant == Some(true)),
+            if t.is_finite() {
+                format!("{t:.1e}")
+            } else {
+                "non-finite".to_owned()
+            }
+        )?,
+        None => writeln!(
+            out,
+            "  yours is not checked for it: it does not give every particle's gradient"
+        )?,
+    }
     writeln!(
         out,
         "rotation invariant (sum of p x gradient = 0): {} ({:.1e})",
@@ -211,22 +341,63 @@ fn write_file_report(
     )?;
     writeln!(out)?;
     match &o.worst {
-        None if o.max_relative_error.values().all(Option::is_none) => writeln!(
-            out,
-            "the file gives no gradient: nothing of yours to check (add [gradient] p0 = \"...\")"
-        ),
+        None if o
+            .max_relative_error
+            .values()
+            .all(|e| matches!(e, Figure::None(_))) =>
+        {
+            writeln!(
+                out,
+                "the file gives no gradient: nothing of yours to check (add [gradient] p0 = \"...\")"
+            )
+        }
         None => writeln!(
             out,
             "agrees: your gradient matches AD within {AGREEMENT:.0e}"
         ),
         Some(w) => {
+            let off = match &w.relative_error {
+                Figure::Number(e) if w.absolute => {
+                    format!("{} (absolute: AD's gradient is zero there)", two_digits(*e))
+                }
+                Figure::Number(e) => format!("{} of the gradient's size", two_digits(*e)),
+                _ => "a non-finite amount (NaN or infinite where AD's is finite)".to_owned(),
+            };
             writeln!(
                 out,
-                "DISAGREES: {} is off by {:.3} of the gradient's size; see it with\n  {}",
-                w.particle, w.relative_error, w.command
+                "DISAGREES: {} is off by {off}; see it with\n  {}",
+                w.particle, w.command
             )
         }
+    }?;
+    if !o.kinks.is_empty() {
+        writeln!(out)?;
+        writeln!(
+            out,
+            "C has kinks, where its gradient jumps (random configurations land on none, so the \
+             figures above are away from them):"
+        )?;
+        for k in &o.kinks {
+            writeln!(
+                out,
+                "  {} at {}:{}:{}: crossed by {} of {} random lines; there ∇C jumps by up to {} \
+                 of its size",
+                k.what,
+                o.constraint_file,
+                k.line,
+                k.column,
+                k.lines_crossing,
+                k.lines_tried,
+                two_digits(k.largest_jump)
+            )?;
+        }
+        writeln!(
+            out,
+            "  on a kink a projection takes one side's gradient; `tetlab gradient` at a point on \
+             one says so"
+        )?;
     }
+    Ok(())
 }
 
 fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()> {

@@ -182,14 +182,33 @@ struct FileOutput {
     given: Vec<bool>,
     finite_difference: Vec<[f64; 3]>,
     degenerate: bool,
+    /// The kinks of C this configuration is on (`abs at FILE:LINE:COLUMN`): there AD gives one
+    /// side's gradient and central differences the mean of the two.
+    kinks: Vec<String>,
 }
 
+/// Every constraint of the file (one, or each of its `[[constraint]]` tables in turn).
 fn run_file(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let path = args
         .constraint_file
         .as_ref()
         .expect("clap requires one of the two");
-    let file = ConstraintFile::load(path).map_err(|e| UsageError(e.to_string()))?;
+    let files = ConstraintFile::load_all(path).map_err(|e| UsageError(e.to_string()))?;
+    for (k, file) in files.iter().enumerate() {
+        if k > 0 && !args.json {
+            writeln!(out).map_err(UsageError::stdout)?;
+        }
+        run_one_file(args, path, file, out)?;
+    }
+    Ok(())
+}
+
+fn run_one_file(
+    args: &Args,
+    path: &std::path::Path,
+    file: &ConstraintFile,
+    out: &mut impl Write,
+) -> Result<(), UsageError> {
     if args.points.len() != file.arity() {
         return Err(UsageError(format!(
             "--points: {} applies to {} points, got {}",
@@ -198,13 +217,38 @@ fn run_file(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             args.points.len()
         )));
     }
-    if !args.rest_shape.is_empty() {
-        return Err(UsageError(
-            "--rest-shape: a constraint file's rest value is given by --rest".into(),
-        ));
-    }
-    let evaluation = file.evaluate(&args.points, args.rest);
-    let numeric = central_difference(&args.points, |p| file.value(p, args.rest));
+    let rest_shape = if args.rest_shape.is_empty() {
+        &args.points
+    } else if !file.reads_rest_shape() {
+        return Err(UsageError(format!(
+            "--rest-shape: {} reads no rest shape (q0…, Dm, F, V0); its rest value is --rest",
+            file.name
+        )));
+    } else if args.rest_shape.len() != args.points.len() {
+        return Err(UsageError(format!(
+            "--rest-shape: {} points, as many as --points ({})",
+            args.rest_shape.len(),
+            args.points.len()
+        )));
+    } else {
+        &args.rest_shape
+    };
+    // What the element stores, from the rest shape and the default material.
+    let stored = file.store(
+        rest_shape,
+        &tetlab_core::constraints::material::Material::default(),
+    );
+    let evaluation = file.evaluate(&args.points, args.rest, &stored);
+    let numeric = central_difference(&args.points, |p| file.value(p, args.rest, &stored));
+    // At a kink of abs, min, max, sign or if, AD takes one side and central differences
+    // average the two: say so, where.
+    let scale = args.points.iter().map(|p| p.length()).fold(1.0, f64::max);
+    let kinks: Vec<String> = file
+        .switches_at(&args.points, args.rest, &stored)
+        .into_iter()
+        .filter(|(_, _, decides)| decides.abs() <= 1e-9 * scale)
+        .map(|((line, column), what, _)| format!("{what} at {}:{line}:{column}", path.display()))
+        .collect();
     let finite = |v: &DVec3| v.is_finite();
     let output = FileOutput {
         constraint_file: path.display().to_string(),
@@ -226,6 +270,7 @@ fn run_file(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             .map(|&v| without_negative_zero(if v.is_finite() { v } else { DVec3::ZERO }))
             .collect(),
         degenerate: evaluation.automatic.is_none(),
+        kinks,
     };
     let written = if args.json {
         serde_json::to_writer(&mut *out, &output)
@@ -248,6 +293,15 @@ fn write_file_table(o: &FileOutput, out: &mut impl Write) -> std::io::Result<()>
              or a division by zero)",
         ),
     )?;
+    if !o.kinks.is_empty() {
+        writeln!(
+            out,
+            "kink        yes: on the kink of {}; C has two one-sided gradients here, AD gives one \
+             side's and central differences average the two",
+            o.kinks.join(", ")
+        )?;
+        writeln!(out)?;
+    }
     writeln!(
         out,
         "{:<9}{:<46}{:<46}∇C central difference",

@@ -104,20 +104,21 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     // exercise; any other joins the active families now.
     let mut answers = Vec::new();
     for path in &args.constraint_files {
-        let file =
-            ConstraintFile::load(path).map_err(|e| UsageError(format!("--constraint-file {e}")))?;
-        if lesson
-            .file_families
-            .iter()
-            .any(|&f| lesson.families.name(f) == file.name)
-        {
-            answers.push(file);
-        } else {
-            let family = lesson
-                .families
-                .register(file)
-                .map_err(|e| UsageError(format!("--constraint-file {}: {e}", path.display())))?;
-            lesson.settings.active.set(family, true);
+        let files = ConstraintFile::load_all(path)
+            .map_err(|e| UsageError(format!("--constraint-file {e}")))?;
+        for file in files {
+            if lesson
+                .file_families
+                .iter()
+                .any(|&f| lesson.families.name(f) == file.name)
+            {
+                answers.push(file);
+            } else {
+                let family = lesson.families.register(file).map_err(|e| {
+                    UsageError(format!("--constraint-file {}: {e}", path.display()))
+                })?;
+                lesson.settings.active.set(family, true);
+            }
         }
     }
     if let Some(engine) = args.engine {

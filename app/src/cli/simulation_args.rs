@@ -173,12 +173,16 @@ impl SolverArgs {
         Ok((settings, families))
     }
 
-    /// Loads every `--constraint-file` and adds its family to `families`.
+    /// Loads every `--constraint-file` and adds its families (one per constraint of the file)
+    /// to `families`.
     fn load_constraint_files(&self, families: &mut Families) -> Result<Vec<Family>, UsageError> {
-        self.constraint_files
-            .iter()
-            .map(|path| load_constraint_file(path, |file| families.register(file)))
-            .collect()
+        let mut all = Vec::new();
+        for path in &self.constraint_files {
+            all.extend(load_constraint_file(path, |files| {
+                families.register_all(files)
+            })?);
+        }
+        Ok(all)
     }
 
     /// The threads the fast engine runs on: `--threads`, or every core the machine has.
@@ -212,10 +216,7 @@ impl SolverArgs {
         for NamedValue { name, value } in &self.stiffness {
             text += &format!(", stiffness {name}={value}");
         }
-        let uses_material = s
-            .active
-            .families()
-            .any(|f| f.compliance_from_material().is_some());
+        let uses_material = s.active.families().any(|f| s.from_material[f]);
         if uses_material || self.material.is_some() {
             text += &format!(", material {}", s.material.describe());
         }
@@ -321,15 +322,16 @@ pub fn describe_skipped(simulation: &Simulation) -> Vec<String> {
         .collect()
 }
 
-/// Loads the constraint file of `--constraint-file PATH` and adds its family to a table with
-/// `add` ([`Families::register`], or [`Families::define`] to replace a family of the same name).
+/// Loads the constraint file of `--constraint-file PATH` and adds its families (one per
+/// constraint) to a table with `add` ([`Families::register_all`], or [`Families::define_all`]
+/// to replace families of the same names).
 pub fn load_constraint_file(
     path: &std::path::Path,
-    add: impl FnOnce(ConstraintFile) -> Result<Family, String>,
-) -> Result<Family, UsageError> {
-    let file =
-        ConstraintFile::load(path).map_err(|e| UsageError(format!("--constraint-file {e}")))?;
-    add(file).map_err(|e| UsageError(format!("--constraint-file {}: {e}", path.display())))
+    add: impl FnOnce(Vec<ConstraintFile>) -> Result<Vec<Family>, String>,
+) -> Result<Vec<Family>, UsageError> {
+    let files =
+        ConstraintFile::load_all(path).map_err(|e| UsageError(format!("--constraint-file {e}")))?;
+    add(files).map_err(|e| UsageError(format!("--constraint-file {}: {e}", path.display())))
 }
 
 /// Prints [`Simulation::stability_warning`] on stderr, if there is one.

@@ -24,19 +24,20 @@
 pub mod check;
 pub mod expression;
 pub mod grade;
+mod parse;
 pub mod program;
 
 use crate::constraints::Binding;
+use crate::constraints::material::Material;
 use crate::input::text_file;
 use crate::numbers::dual::Tangent;
 use crate::numbers::vector::{Real, Vector3};
 use arrayvec::ArrayVec;
 use glam::DVec3;
-use program::{CompileError, Program, Tape, Type};
-use std::collections::BTreeMap;
+use parse::{file_offset, position};
+use program::{Inputs, MAX_STORED, Tape};
 use std::fmt;
 use std::path::{Path, PathBuf};
-use toml::Spanned;
 
 /// A mistake in a constraint file: where (line and column from 1, when one is to blame) and what,
 /// quoting the offending text. Shown on one line, `FILE:LINE:COLUMN: message`.
@@ -66,37 +67,31 @@ impl fmt::Display for ConstraintFileError {
 
 impl std::error::Error for ConstraintFileError {}
 
-#[derive(serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Raw {
-    name: Spanned<String>,
-    applies_to: Spanned<String>,
-    #[serde(default)]
-    define: Option<Spanned<String>>,
-    value: Option<Spanned<String>>,
-    #[serde(default)]
-    rest: Option<Spanned<String>>,
-    #[serde(default)]
-    gradient: BTreeMap<Spanned<String>, Spanned<String>>,
-    #[serde(default)]
-    use_gradient: bool,
-}
-
 /// A loaded, compiled constraint file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConstraintFile {
     /// Where it was read from.
     pub path: PathBuf,
-    /// Its `name`.
+    /// Its family's name: the file's `name`, or `FILE-CONSTRAINT` for one of several.
     pub name: String,
+    /// The file's `name` when it holds several constraints: the group of their families.
+    pub group: Option<String>,
     /// How it binds to a mesh (`applies_to`).
     pub binding: Binding,
     /// Whether the simulation uses the file's gradient rather than AD's (`use_gradient`).
     pub use_gradient: bool,
+    /// Where its compliance comes from (`stiffness`): 1/μ or 1/λ of `--material`.
+    pub stiffness: Option<Stiffness>,
+    /// The constraint of the same file it is projected together with (`pair`).
+    pub pair: Option<String>,
     /// The file's text, as read.
     pub source: String,
     /// The lines of `define` and `value`, as written (what the workbench shows as its formula).
     pub formula: Vec<String>,
+    /// What an element stores, worked out once from its rest shape and the material.
+    prelude: Tape,
+    /// How many numbers that is.
+    stored: usize,
     /// C alone: what AD differentiates.
     value: Tape,
     /// C, then the gradient entries the file gives.
@@ -107,6 +102,30 @@ pub struct ConstraintFile {
     /// Its grade as an exercise, worked out the first time it is asked for ([`ConstraintFile::grade`]).
     grade: GradeOnce,
 }
+
+/// Where a constraint's compliance comes from: `stiffness = "mu"` gives α = 1/μ, `"lambda"`
+/// α = 1/λ, of the material (`--material`), as the built-in neo-Hookean pair's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stiffness {
+    /// α = 1/μ.
+    Mu,
+    /// α = 1/λ.
+    Lambda,
+}
+
+impl Stiffness {
+    /// The compliance it gives.
+    pub fn compliance(self) -> fn(&Material) -> f64 {
+        match self {
+            Stiffness::Mu => |m| 1.0 / m.mu(),
+            Stiffness::Lambda => |m| 1.0 / m.lambda(),
+        }
+    }
+}
+
+/// What an element stores ([`ConstraintFile::store`]): numbers worked out once from its rest
+/// shape and the material.
+pub type Stored = ArrayVec<f64, MAX_STORED>;
 
 /// A grade worked out once per compiled file: a cache that belongs to the file, so that a file
 /// redefined (the editor, as a student types) starts with none and the old one goes with the old
@@ -195,7 +214,13 @@ impl ConstraintFile {
     /// Reads and compiles `path`. A path to one of the [`EXAMPLES`] that is not on disk (in the
     /// browser, or a tetlab built elsewhere) reads the copy built into tetlab.
     pub fn load(path: &Path) -> Result<ConstraintFile, ConstraintFileError> {
-        let text = match text_file::read(path) {
+        let text = ConstraintFile::read(path)?;
+        ConstraintFile::parse(path, &text)
+    }
+
+    /// The text of `path`, or of the example it names.
+    fn read(path: &Path) -> Result<String, ConstraintFileError> {
+        Ok(match text_file::read(path) {
             Ok(text) => text,
             Err(e) => match Example::at(path) {
                 Some(example) => example.text.to_owned(),
@@ -207,8 +232,7 @@ impl ConstraintFile {
                     });
                 }
             },
-        };
-        ConstraintFile::parse(path, &text)
+        })
     }
 
     /// Whether TOML `text` is meant as a constraint file (it says what it `applies_to`) rather
@@ -229,173 +253,58 @@ impl ConstraintFile {
         }
     }
 
-    /// Compiles the text of a constraint file (`path` names it in errors).
+    /// Compiles the text of a constraint file of one constraint (`path` names it in errors);
+    /// [`ConstraintFile::parse_all`] reads one of several.
     pub fn parse(path: &Path, text: &str) -> Result<ConstraintFile, ConstraintFileError> {
-        let text = text_file::without_byte_order_mark(text);
-        let error = |offset: Option<usize>, message: String| {
-            let at = offset.map(|o| position(text, o));
-            ConstraintFileError {
+        let mut all = parse::parse_all(path, text)?;
+        if all.len() > 1 {
+            return Err(ConstraintFileError {
                 path: path.to_owned(),
-                at,
-                message,
-            }
-        };
-        let raw: Raw = toml::from_str(text).map_err(|e| {
-            let message = e.message().trim().replace('\n', " ");
-            error(e.span().map(|s| s.start), message)
-        })?;
-        let binding = match raw.applies_to.get_ref().as_str() {
-            "edges" => Binding::Edges,
-            "tets" => Binding::Tets,
-            "tet-vertices" => Binding::TetVertices,
-            other => {
-                return Err(error(
-                    Some(raw.applies_to.span().start),
-                    format!(
-                        "applies_to is \"{other}\": expected \"edges\" (p0 p1), \"tets\" \
-                         (p0..p3) or \"tet-vertices\" (p0..p3, four per tet)"
-                    ),
-                ));
-            }
-        };
-        let name = raw.name.get_ref().trim().to_owned();
-        if name.is_empty()
-            || !name
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
-        {
-            return Err(error(
-                Some(raw.name.span().start),
-                format!(
-                    "name \"{name}\": use letters, digits, - and _ (it names the family on the command line)"
+                at: None,
+                message: format!(
+                    "the file holds {} constraints ({}): this asks for one",
+                    all.len(),
+                    all.iter()
+                        .map(|f| f.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
-            ));
+            });
         }
-        let arity = match binding {
-            Binding::Edges => 2,
-            Binding::Tets | Binding::TetVertices => 4,
-        };
-        let Some(value) = raw.value else {
-            // Where it would go: after the last key before the first table (`[gradient]`).
-            let keys_end = text
-                .match_indices('\n')
-                .map(|(i, _)| i + 1)
-                .find(|&i| text[i..].trim_start_matches([' ', '\t']).starts_with('['))
-                .unwrap_or(text.len());
-            return Err(error(
-                Some(keys_end),
-                "no `value`: give C as `value = \"…\"` (before any [table])".to_owned(),
-            ));
-        };
-        // The definitions compile into both programs: C (with `rest`) and the rest value. An
-        // expression's errors are placed by where its TOML string starts (`at`).
-        let definitions = match &raw.define {
-            Some(define) => {
-                let at = define.span().start;
-                let parsed = expression::parse_definitions(define.get_ref()).map_err(|e| {
-                    error(
-                        Some(file_offset(text, at, e.offset)),
-                        format!("in define: {}", e.message),
-                    )
-                })?;
-                Some((at, parsed))
-            }
-            None => None,
-        };
-        let compile_error = |at: usize, e: CompileError, source: &str, what: &str| {
-            let snippet = source.get(e.span.start..e.span.end).unwrap_or("").trim();
-            error(
-                Some(file_offset(text, at, e.span.start)),
-                format!("in {what}: {} (`{snippet}`)", e.message),
-            )
-        };
-        let build = |with_rest: bool| -> Result<Program, ConstraintFileError> {
-            let mut program = Program::new(arity, with_rest);
-            if let (Some((at, parsed)), Some(define)) = (&definitions, &raw.define) {
-                program.at(*at);
-                for (name, span, expr) in parsed {
-                    program
-                        .define(name, *span, expr)
-                        .map_err(|e| compile_error(*at, e, define.get_ref(), "define"))?;
-                }
-            }
-            Ok(program)
-        };
-        let compile = |program: &mut Program,
-                       spanned: &Spanned<String>,
-                       ty: Type,
-                       what: &str|
-         -> Result<usize, ConstraintFileError> {
-            let at = spanned.span().start;
-            let expr = expression::parse_expression(spanned.get_ref()).map_err(|e| {
-                error(
-                    Some(file_offset(text, at, e.offset)),
-                    format!("in {what}: {}", e.message),
-                )
-            })?;
-            program.at(at);
-            program
-                .output(&expr, ty, what)
-                .map_err(|e| compile_error(at, e, spanned.get_ref(), what))
-        };
-        let mut program = build(true)?;
-        let c = compile(&mut program, &value, Type::Scalar, "value")?;
-        let mut outputs = vec![c];
-        let mut gradient_outputs = [None; 4];
-        for (key, entry) in &raw.gradient {
-            let particle = key
-                .get_ref()
-                .strip_prefix('p')
-                .and_then(|k| k.parse::<usize>().ok())
-                .filter(|&k| k < arity && key.get_ref().len() == 2);
-            let Some(k) = particle else {
-                return Err(error(
-                    Some(key.span().start),
-                    format!(
-                        "gradient entry `{}`: this binding has particles p0…p{} only",
-                        key.get_ref(),
-                        arity - 1
-                    ),
-                ));
-            };
-            let what = format!("gradient.{}", key.get_ref());
-            outputs.push(compile(&mut program, entry, Type::Vector, &what)?);
-            gradient_outputs[k] = Some(outputs.len() - 1);
-        }
-        let rest = match &raw.rest {
-            Some(rest) => {
-                let mut program = build(false)?;
-                let r = compile(&mut program, rest, Type::Scalar, "rest")?;
-                Some(program.tape(&[r]))
-            }
-            None => None,
-        };
-        let mut formula: Vec<String> = raw
-            .define
-            .as_ref()
-            .map(|d| {
-                d.get_ref()
-                    .lines()
-                    .map(str::trim)
-                    .filter(|l| !l.is_empty())
-                    .map(str::to_owned)
-                    .collect()
-            })
-            .unwrap_or_default();
-        formula.push(format!("C = {}", value.get_ref().trim()));
-        Ok(ConstraintFile {
-            path: path.to_owned(),
-            name,
-            binding,
-            use_gradient: raw.use_gradient,
-            source: text.to_owned(),
-            formula,
-            value: program.tape(&[c]),
-            yours: program.tape(&outputs),
-            gradient_outputs,
-            rest,
-            grade: GradeOnce::default(),
-        })
+        Ok(all.remove(0))
+    }
+
+    /// Every constraint of a constraint file, in the order written: one, or one per
+    /// `[[constraint]]` table.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use tetlab_core::constraint_file::ConstraintFile;
+    /// let text = r#"
+    /// name = "two"
+    /// applies_to = "edges"
+    /// define = "d = length(p1 - p0)"
+    /// pair = ["stretch", "squash"]
+    /// [[constraint]]
+    /// name = "stretch"
+    /// value = "max(d - rest, 0)"
+    /// [[constraint]]
+    /// name = "squash"
+    /// value = "min(d - rest, 0)"
+    /// "#;
+    /// let files = ConstraintFile::parse_all(Path::new("two.toml"), text).unwrap();
+    /// assert_eq!(files[0].name, "two-stretch");
+    /// assert_eq!(files[1].pair.as_deref(), Some("two-stretch"));
+    /// assert_eq!(files[1].group.as_deref(), Some("two"));
+    /// ```
+    pub fn parse_all(path: &Path, text: &str) -> Result<Vec<ConstraintFile>, ConstraintFileError> {
+        parse::parse_all(path, text)
+    }
+
+    /// Reads and compiles every constraint of `path` ([`ConstraintFile::load`] for one).
+    pub fn load_all(path: &Path) -> Result<Vec<ConstraintFile>, ConstraintFileError> {
+        let text = ConstraintFile::read(path)?;
+        parse::parse_all(path, &text)
     }
 
     /// Its grade as an exercise ([`grade::Grade::of`]), worked out once for this file: the
@@ -410,10 +319,44 @@ impl ConstraintFile {
 
     /// How many particles a constraint of this file has.
     pub fn arity(&self) -> usize {
-        match self.binding {
-            Binding::Edges => 2,
-            Binding::Tets | Binding::TetVertices => 4,
+        self.binding.arity()
+    }
+
+    /// How many numbers an element of this constraint stores ([`ConstraintFile::store`]).
+    pub fn stored_len(&self) -> usize {
+        self.stored
+    }
+
+    /// Whether what an element stores, or its rest value, reads the rest shape (q0…, Dm, F,
+    /// V0): then the rest positions must be given, not the current ones.
+    pub fn reads_rest_shape(&self) -> bool {
+        self.prelude.reads_rest_shape() || self.rest.as_ref().is_some_and(Tape::reads_rest_shape)
+    }
+
+    /// What an element at rest at `rest_shape` stores: the parts of C that depend only on the
+    /// rest shape and `material`, worked out once (for `F = Ds inverse(Dm)`, inverse(Dm)).
+    pub fn store(&self, rest_shape: &[DVec3], material: &Material) -> Stored {
+        self.store_in(&self.coordinates(rest_shape), material)
+    }
+
+    /// [`ConstraintFile::store`] in any precision.
+    pub fn store_in<T: Real>(
+        &self,
+        rest_shape: &[[T; 3]],
+        material: &Material,
+    ) -> ArrayVec<T, MAX_STORED> {
+        let mut out = ArrayVec::new();
+        for _ in 0..self.stored {
+            out.push(T::ZERO);
         }
+        if self.stored > 0 {
+            let inputs = Inputs {
+                material: material_values(material).map(T::from_f64),
+                ..Inputs::of(rest_shape, T::ZERO)
+            };
+            self.prelude.run(&inputs, |r| r.write_all(&mut out));
+        }
+        out
     }
 
     /// Whether the file gives its own gradient for particle `k`.
@@ -421,35 +364,54 @@ impl ConstraintFile {
         self.gradient_outputs.get(k).is_some_and(Option::is_some)
     }
 
-    /// C at `points` with rest value `rest` (NaN where it is undefined).
-    pub fn value(&self, points: &[DVec3], rest: f64) -> f64 {
+    /// C at `points` with rest value `rest` and what the element stores (NaN where it is
+    /// undefined).
+    pub fn value(&self, points: &[DVec3], rest: f64, stored: &[f64]) -> f64 {
         let points = self.coordinates(points);
-        self.value.run(&points, rest, |r| r.scalar(0))
+        self.value
+            .run(&self.inputs(&points, rest, stored), |r| r.scalar(0))
     }
 
-    /// C, its gradient by forward-mode AD and the file's own, at `points` with rest value `rest`:
-    /// what `tetlab check-gradients` and `tetlab gradient` compare.
-    pub fn evaluate(&self, points: &[DVec3], rest: f64) -> Evaluation {
-        let value = self.value(points, rest);
+    /// C, its gradient by forward-mode AD and the file's own, at `points` with rest value `rest`
+    /// and what the element stores: what `tetlab check-gradients` and `tetlab gradient`
+    /// compare.
+    pub fn evaluate(&self, points: &[DVec3], rest: f64, stored: &[f64]) -> Evaluation {
+        let value = self.value(points, rest, stored);
         let automatic = match self.arity() {
-            2 => self.forward_mode::<2>(points, rest),
-            _ => self.forward_mode::<4>(points, rest),
+            2 => self.forward_mode::<2>(points, rest, stored),
+            3 => self.forward_mode::<3>(points, rest, stored),
+            _ => self.forward_mode::<4>(points, rest, stored),
         };
         Evaluation {
             value,
             automatic: automatic.filter(|_| value.is_finite()),
-            yours: self.yours(points, rest)[..self.arity()].to_vec(),
+            yours: self.yours(points, rest, stored)[..self.arity()].to_vec(),
         }
     }
 
     /// The file's own gradient for each particle it gives one for, at `points` with rest value
-    /// `rest`.
-    pub fn yours(&self, points: &[DVec3], rest: f64) -> [Option<DVec3>; 4] {
+    /// `rest` and what the element stores.
+    pub fn yours(&self, points: &[DVec3], rest: f64, stored: &[f64]) -> [Option<DVec3>; 4] {
         let points = self.coordinates(points);
-        self.yours.run(&points, rest, |r| {
+        self.yours.run(&self.inputs(&points, rest, stored), |r| {
             self.gradient_outputs
                 .map(|o| o.map(|o| DVec3::from_array(r.vector(o))))
         })
+    }
+
+    /// The inputs of a tape that runs at each projection.
+    fn inputs<'a, T: Real>(&self, points: &'a [[T; 3]], rest: T, stored: &'a [T]) -> Inputs<'a, T> {
+        assert!(
+            stored.len() >= self.stored,
+            "{} stores {} numbers per element, and {} are given",
+            self.name,
+            self.stored,
+            stored.len()
+        );
+        Inputs {
+            stored,
+            ..Inputs::of(points, rest)
+        }
     }
 
     /// C and ∇C at `p` with rest value `rest`, in the precision of `V` (f64, f32, the fast
@@ -469,10 +431,10 @@ impl ConstraintFile {
     /// let text = "name = \"e\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p1) - rest\"\n";
     /// let file = ConstraintFile::parse(Path::new("e.toml"), text).unwrap();
     /// // The 3-4-5 edge: C = 5 − 1, ∇p0 C the unit vector from p1 to p0, in f64 and in f32.
-    /// let e = file.evaluate_vectors(&[DVec3::new(3.0, 0.0, 4.0), DVec3::ZERO], 1.0);
+    /// let e = file.evaluate_vectors(&[DVec3::new(3.0, 0.0, 4.0), DVec3::ZERO], 1.0, &[]);
     /// assert_eq!(e.value, 4.0);
     /// assert!((e.gradients[0] - DVec3::new(0.6, 0.0, 0.8)).length() < 1e-15);
-    /// let e = file.evaluate_vectors(&[glam::Vec3::new(3.0, 0.0, 4.0), glam::Vec3::ZERO], 1.0);
+    /// let e = file.evaluate_vectors(&[glam::Vec3::new(3.0, 0.0, 4.0), glam::Vec3::ZERO], 1.0, &[]);
     /// assert!((e.gradients[1] + glam::Vec3::new(0.6, 0.0, 0.8)).length() < 1e-6);
     /// ```
     #[inline]
@@ -480,8 +442,9 @@ impl ConstraintFile {
         &self,
         p: &[V; N],
         rest: V::Real,
+        stored: &[V::Real],
     ) -> crate::constraints::Evaluation<V, N> {
-        self.evaluate_by(p, rest, self.use_gradient)
+        self.evaluate_by(p, rest, stored, self.use_gradient)
     }
 
     /// [`ConstraintFile::evaluate_vectors`] with the file's own gradient (`own`) or AD's,
@@ -492,6 +455,7 @@ impl ConstraintFile {
         &self,
         p: &[V; N],
         rest: V::Real,
+        stored: &[V::Real],
         own: bool,
     ) -> crate::constraints::Evaluation<V, N> {
         assert_eq!(
@@ -502,12 +466,13 @@ impl ConstraintFile {
             self.arity()
         );
         let coordinates: [[V::Real; 3]; N] = std::array::from_fn(|i| p[i].to_array());
+        let inputs = self.inputs(&coordinates, rest, stored);
         let (value, gradients) = if own {
             // Where the file gives no gradient, AD's: a student may write one particle's at a
             // time (the exercise of lesson 9 starts with none).
             let missing = self.gradient_outputs[..N].iter().any(Option::is_none);
-            let automatic = missing.then(|| self.value.gradient(&coordinates, rest).1);
-            self.yours.run(&coordinates, rest, |r| {
+            let automatic = missing.then(|| self.value.gradient::<_, N>(&inputs).1);
+            self.yours.run(&inputs, |r| {
                 let gradients = std::array::from_fn(|k| match self.gradient_outputs[k] {
                     Some(o) => r.vector(o),
                     None => automatic.map_or([V::Real::ZERO; 3], |g: [[V::Real; 3]; N]| g[k]),
@@ -515,31 +480,46 @@ impl ConstraintFile {
                 (r.scalar(0), gradients)
             })
         } else {
-            self.value.gradient(&coordinates, rest)
+            self.value.gradient(&inputs)
         };
         sound(value, gradients)
     }
 
     /// ∇C by forward-mode AD in f64 over [`Tangent`] numbers, one pass per coordinate; `None`
     /// where it is undefined.
-    fn forward_mode<const N: usize>(&self, points: &[DVec3], rest: f64) -> Option<Vec<DVec3>> {
-        let rest = Tangent::new(rest, 0.0);
+    fn forward_mode<const N: usize>(
+        &self,
+        points: &[DVec3],
+        rest: f64,
+        stored: &[f64],
+    ) -> Option<Vec<DVec3>> {
+        let tangent_rest = Tangent::new(rest, 0.0);
+        let tangents: ArrayVec<Tangent<f64>, MAX_STORED> =
+            stored.iter().map(|&x| Tangent::new(x, 0.0)).collect();
         let gradients = crate::numbers::dual::gradient(points, |p| {
             let p: [[Tangent<f64>; 3]; N] = std::array::from_fn(|k| p[k].to_array());
-            self.value.run(&p, rest, |r| r.scalar(0))
+            self.value
+                .run(&self.inputs(&p, tangent_rest, &tangents), |r| r.scalar(0))
         })?;
         let gradients: [[f64; 3]; N] = std::array::from_fn(|k| gradients[k].to_array());
-        let e = sound::<DVec3, N>(self.value(points, rest.value), gradients);
+        let e = sound::<DVec3, N>(self.value(points, rest, stored), gradients);
         (!e.degenerate).then(|| e.gradients.to_vec())
     }
 
     /// The rest value for particles at rest at `rest_points`: `rest = "…"` when the file gives
     /// it, otherwise C there with rest = 0; 0 where that is not finite (a rest shape on which C
     /// is undefined, such as a flat tet's height).
-    pub fn rest_value(&self, rest_points: &[DVec3]) -> f64 {
+    pub fn rest_value(&self, rest_points: &[DVec3], material: &Material) -> f64 {
         let rest = match &self.rest {
-            Some(tape) => tape.run(&self.coordinates(rest_points), 0.0, |r| r.scalar(0)),
-            None => self.value(rest_points, 0.0),
+            Some(tape) => {
+                let shape = self.coordinates(rest_points);
+                let inputs = Inputs {
+                    material: material_values(material),
+                    ..Inputs::of(&shape, 0.0)
+                };
+                tape.run(&inputs, |r| r.scalar(0))
+            }
+            None => self.value(rest_points, 0.0, &self.store(rest_points, material)),
         };
         if rest.is_finite() { rest } else { 0.0 }
     }
@@ -551,15 +531,24 @@ impl ConstraintFile {
         &self,
         points: &[[T; 3]; N],
         rest: T,
+        stored: &[T],
     ) -> (T, [[T; 3]; N]) {
-        self.value.gradient(points, rest)
+        self.value.gradient(&self.inputs(points, rest, stored))
     }
 
     /// Where and why C is undefined at `points` with rest value `rest`: the first expression, in
     /// the order C is worked out, whose value is not finite while what it reads is, named at
     /// file:line:column (`acos of 1.0000001`, `division by zero`). `None` where C is finite.
-    pub fn undefined_at(&self, points: &[DVec3], rest: f64) -> Option<ConstraintFileError> {
-        let u = self.value.undefined_at(&self.coordinates(points), rest)?;
+    pub fn undefined_at(
+        &self,
+        points: &[DVec3],
+        rest: f64,
+        stored: &[f64],
+    ) -> Option<ConstraintFileError> {
+        let points = self.coordinates(points);
+        let u = self
+            .value
+            .undefined_at(&self.inputs(&points, rest, stored))?;
         Some(ConstraintFileError {
             path: self.path.clone(),
             at: Some(self.place(u.base, u.offset)),
@@ -573,9 +562,11 @@ impl ConstraintFile {
         &self,
         points: &[DVec3],
         rest: f64,
+        stored: &[f64],
     ) -> Vec<((usize, usize), &'static str, f64)> {
+        let points = self.coordinates(points);
         self.value
-            .switches_at(&self.coordinates(points), rest)
+            .switches_at(&self.inputs(&points, rest, stored))
             .into_iter()
             .map(|s| (self.place(s.base, s.offset), s.what, s.decides))
             .collect()
@@ -617,79 +608,8 @@ fn sound<V: Vector3, const N: usize>(
     }
 }
 
-/// Line and column (from 1, in characters) of byte `offset` of `text`.
-fn position(text: &str, offset: usize) -> (usize, usize) {
-    let offset = offset.min(text.len());
-    let before = &text[..text.floor_char_boundary(offset)];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
-}
-
-/// The byte of `text` that byte `offset` of a TOML string's content comes from, the string's
-/// value starting at byte `value_start` (its opening quote). The content starts after `"`, `'`,
-/// or `"""` / `'''` and the newline that may follow them; in a basic (double-quoted) string an
-/// escape such as `\t` is two bytes of the file for one of the content, `\uXXXX` six, and a
-/// backslash at the end of a line of a `"""` string stands for the white space after it.
-fn file_offset(text: &str, value_start: usize, offset: usize) -> usize {
-    let rest = &text[value_start.min(text.len())..];
-    let (quote, escapes) = if rest.starts_with("\"\"\"") {
-        (3, true)
-    } else if rest.starts_with("'''") {
-        (3, false)
-    } else if rest.starts_with('"') {
-        (1, true)
-    } else if rest.starts_with('\'') {
-        (1, false)
-    } else {
-        (0, false)
-    };
-    let mut at = value_start + quote;
-    if quote == 3 {
-        let tail = &text[at.min(text.len())..];
-        if tail.starts_with("\r\n") {
-            at += 2;
-        } else if tail.starts_with('\n') {
-            at += 1;
-        }
-    }
-    let bytes = text.as_bytes();
-    let mut content = 0;
-    while content < offset && at < bytes.len() {
-        if escapes && bytes[at] == b'\\' {
-            match bytes.get(at + 1) {
-                Some(b'u') => {
-                    content += decoded_len(text.get(at + 2..).unwrap_or(""), 4);
-                    at += 6;
-                }
-                Some(b'U') => {
-                    content += decoded_len(text.get(at + 2..).unwrap_or(""), 8);
-                    at += 10;
-                }
-                Some(b' ' | b'\t' | b'\r' | b'\n') => {
-                    at += 1;
-                    while at < bytes.len() && matches!(bytes[at], b' ' | b'\t' | b'\r' | b'\n') {
-                        at += 1;
-                    }
-                }
-                _ => {
-                    content += 1;
-                    at += 2;
-                }
-            }
-        } else {
-            let width = text[at..].chars().next().map_or(1, char::len_utf8);
-            content += width;
-            at += width;
-        }
-    }
-    at.min(text.len())
-}
-
-/// The UTF-8 length of the character whose `digits` hex digits start `hex` (1 if they are not).
-fn decoded_len(hex: &str, digits: usize) -> usize {
-    hex.get(..digits)
-        .and_then(|h| u32::from_str_radix(h, 16).ok())
-        .and_then(char::from_u32)
-        .map_or(1, char::len_utf8)
+/// μ, λ and γ = 1 + μ/λ of `material`, as a tape reads them.
+fn material_values(material: &Material) -> [f64; 3] {
+    let (mu, lambda) = (material.mu(), material.lambda());
+    [mu, lambda, 1.0 + mu / lambda]
 }

@@ -92,8 +92,8 @@ fn row_of(file: &ConstraintFile, slot: usize) -> Row {
         rest_symbol: "rest",
         arity: file.arity(),
         binding: file.binding,
-        group: Cow::Owned(file.name.clone()),
-        compliance_from_material: None,
+        group: Cow::Owned(file.group.clone().unwrap_or_else(|| file.name.clone())),
+        compliance_from_material: file.stiffness.map(|s| s.compliance()),
         projected_with: None,
         kind: Kind::File,
     }
@@ -216,7 +216,47 @@ impl Families {
         self.add(file, true)
     }
 
+    /// [`Families::register`] for every constraint of one file ([`ConstraintFile::load_all`]),
+    /// in order; a `pair` of the file joins its two families.
+    pub fn register_all(&mut self, files: Vec<ConstraintFile>) -> Result<Vec<Family>, String> {
+        files.into_iter().map(|file| self.register(file)).collect()
+    }
+
+    /// [`Families::define`] for every constraint of one file.
+    pub fn define_all(&mut self, files: Vec<ConstraintFile>) -> Result<Vec<Family>, String> {
+        files.into_iter().map(|file| self.define(file)).collect()
+    }
+
     fn add(&mut self, file: ConstraintFile, redefine: bool) -> Result<Family, String> {
+        let family = self.add_one(file, redefine)?;
+        self.link_pairs();
+        Ok(family)
+    }
+
+    /// Sets each file family's partner ([`Row::projected_with`]) to the family its file's
+    /// `pair` names, when the table has it.
+    fn link_pairs(&mut self) {
+        let partners: Vec<Option<Family>> = self
+            .files
+            .iter()
+            .map(|f| {
+                let wanted = f.file.pair.as_deref()?;
+                let slot = self.files.iter().position(|g| g.row.name == wanted)?;
+                Some(Family::from_index(TABLE.len() + slot))
+            })
+            .collect();
+        if partners
+            .iter()
+            .zip(self.files.iter())
+            .any(|(p, f)| *p != f.row.projected_with)
+        {
+            for (f, partner) in Arc::make_mut(&mut self.files).iter_mut().zip(partners) {
+                f.row.projected_with = partner;
+            }
+        }
+    }
+
+    fn add_one(&mut self, file: ConstraintFile, redefine: bool) -> Result<Family, String> {
         if let Some(why) = clashes_with_builtin(&file.name) {
             return Err(why);
         }
@@ -427,9 +467,11 @@ impl Families {
             Kind::Hydrostatic => visitor.visit(family, &Hydrostatic),
             Kind::File => {
                 let file = self.file(family).expect("a family of kind File has a file");
-                match file.arity() {
-                    2 => visitor.visit(family, &FileConstraint::<2>(file)),
-                    _ => visitor.visit(family, &FileConstraint::<4>(file)),
+                match (file.arity(), file.reads_rest_shape()) {
+                    (2, false) => visitor.visit(family, &FileConstraint::<2, false>(file)),
+                    (2, true) => visitor.visit(family, &FileConstraint::<2, true>(file)),
+                    (_, false) => visitor.visit(family, &FileConstraint::<4, false>(file)),
+                    (_, true) => visitor.visit(family, &FileConstraint::<4, true>(file)),
                 }
             }
         }
@@ -578,6 +620,48 @@ impl Families {
         }
         assert_eq!(points.len(), self.arity(family), "wrong number of points");
         self.visit(family, State(points, rest_shape))
+    }
+
+    /// Among `active` families, the one `family` is projected together with, if `family` leads
+    /// the pair ([`Row::projected_with`]: the built-in neo-Hookean pair, a file's `pair`).
+    pub fn partner_in(&self, family: Family, active: &PerFamily<bool>) -> Option<Family> {
+        self.row(family)
+            .projected_with
+            .filter(|&partner| active[partner] && family < partner)
+    }
+
+    /// Whether, among `active` families, `family` is projected by the family it is paired with
+    /// (which comes first in the table) rather than on its own.
+    pub fn projected_by_partner(&self, family: Family, active: &PerFamily<bool>) -> bool {
+        self.row(family)
+            .projected_with
+            .is_some_and(|partner| active[partner] && partner < family)
+    }
+
+    /// The compliance of `family` when the material gives it ([`Row::compliance_from_material`]:
+    /// the built-in neo-Hookean pair's, and a file's `stiffness`).
+    pub fn compliance_from_material(&self, family: Family) -> Option<fn(&Material) -> f64> {
+        self.row(family).compliance_from_material
+    }
+
+    /// `compliance` with that of every file family that has a `stiffness` taken from
+    /// `material` (the built-in ones are by [`crate::simulation::Settings::set_material`]).
+    pub fn with_file_stiffness(
+        &self,
+        mut compliance: PerFamily<f64>,
+        material: &Material,
+    ) -> PerFamily<f64> {
+        for family in self.all().skip(TABLE.len()) {
+            if let Some(c) = self.compliance_from_material(family) {
+                compliance[family] = c(material);
+            }
+        }
+        compliance
+    }
+
+    /// Which of its families take their compliance from the material.
+    pub fn from_material(&self) -> PerFamily<bool> {
+        self.per_family(|f| self.compliance_from_material(f).is_some())
     }
 
     /// How `family` binds to a mesh.

@@ -62,22 +62,6 @@ impl Family {
     pub fn compliance_from_material(self) -> Option<fn(&super::material::Material) -> f64> {
         self.builtin_row()?.compliance_from_material
     }
-
-    /// Among `active` families, the one this family is projected together with, if this one
-    /// leads the pair ([`Row::projected_with`]).
-    pub fn partner_in(self, active: &PerFamily<bool>) -> Option<Family> {
-        self.builtin_row()
-            .and_then(|row| row.projected_with)
-            .filter(|&partner| active[partner] && self < partner)
-    }
-
-    /// Whether, among `active` families, this one is projected by the family it is paired with
-    /// (which comes first in the table) rather than on its own.
-    pub fn projected_by_partner(self, active: &PerFamily<bool>) -> bool {
-        self.builtin_row()
-            .and_then(|row| row.projected_with)
-            .is_some_and(|partner| active[partner] && partner < self)
-    }
 }
 
 /// A built-in family by its name; a file's by its place (its name is its table's:
@@ -98,6 +82,14 @@ impl fmt::Display for Family {
 }
 
 impl Binding {
+    /// How many particles each of its constraints has.
+    pub fn arity(self) -> usize {
+        match self {
+            Binding::Edges => 2,
+            Binding::Tets | Binding::TetVertices => 4,
+        }
+    }
+
     /// The particles of every constraint of this binding on `mesh`, flat: `arity` indices per
     /// constraint, in constraint order.
     pub fn particles(self, mesh: &TetMesh) -> Vec<u32> {

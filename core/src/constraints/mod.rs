@@ -35,6 +35,7 @@ pub use families::{Families, Named};
 pub use family::{Binding, Family, MAX_FAMILIES, PerFamily, Row, TABLE, Visit, VisitPair};
 pub use table::Formula;
 
+use crate::constraint_file::Stored;
 use crate::constraints::material::Material;
 use crate::numbers::vector::{Real, Vector3};
 use glam::DVec3;
@@ -65,6 +66,36 @@ pub trait Constraint<const N: usize>: Sync {
     fn rest_value(&self, rest_shape: &[DVec3; N], material: &Material) -> f64 {
         let _ = material;
         self.evaluate(rest_shape, 0.0, rest_shape).value
+    }
+
+    /// How many numbers each constraint stores beyond its rest value: what depends only on its
+    /// rest shape and the material, worked out once per element ([`Constraint::store`]). The
+    /// built-in families store none (they work everything out at each projection); a
+    /// constraint file's stores what its prelude computes
+    /// ([`crate::constraint_file::program::Compiled`]).
+    fn stored_len(&self) -> usize {
+        0
+    }
+
+    /// What a constraint at rest at `rest_shape` stores, with `material`: [`Constraint::stored_len`]
+    /// numbers.
+    fn store(&self, rest_shape: &[DVec3; N], material: &Material) -> Stored {
+        let _ = (rest_shape, material);
+        Stored::new()
+    }
+
+    /// C and ∇C at `p` given what the element stores ([`Constraint::store`], in the precision of
+    /// `V`): what the solvers call. Unless the family stores something, [`Constraint::evaluate`].
+    #[inline(always)]
+    fn evaluate_stored<V: Vector3>(
+        &self,
+        p: &[V; N],
+        rest: V::Real,
+        rest_shape: &[V; N],
+        stored: &[V::Real],
+    ) -> Evaluation<V, N> {
+        let _ = stored;
+        self.evaluate(p, rest, rest_shape)
     }
 
     /// What else a reader should see of the constraint's particles at `p` (rest shape

@@ -38,8 +38,11 @@ pub struct Worst {
     pub points: Vec<DVec3>,
     /// Its rest value.
     pub rest: f64,
-    /// That particle's error: |yours − AD|∞ / maxⱼ |∇ⱼC|.
+    /// That particle's error: |yours − AD|∞ / maxⱼ |∇ⱼC|; where AD's gradient is zero, the
+    /// absolute |yours − AD|∞ ([`Worst::absolute`]).
     pub relative_error: f64,
+    /// Whether AD's gradient is zero there, so that the error is absolute, not relative.
+    pub absolute: bool,
 }
 
 /// What C does when the configuration is mirrored (x → −x).
@@ -84,6 +87,8 @@ pub struct Report {
     pub automatic_vs_finite_difference: f64,
     /// The largest |Σᵢ ∇ᵢC| / maxᵢ |∇ᵢC| (AD).
     pub translation: f64,
+    /// The same of the gradient the source gives, when it gives every particle's.
+    pub translation_given: Option<f64>,
     /// The largest |Σᵢ (pᵢ − centre) × ∇ᵢC| / (maxᵢ |∇ᵢC| · size) (AD).
     pub rotation: f64,
     /// What a reflection does to C (with rest 0).
@@ -361,6 +366,7 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
         worst: None,
         automatic_vs_finite_difference: 0.0,
         translation: 0.0,
+        translation_given: None,
         rotation: 0.0,
         reflection: Reflection::Unchanged,
         near_degenerate: 0,
@@ -392,7 +398,15 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
         report.automatic_vs_finite_difference = report
             .automatic_vs_finite_difference
             .max(relative_error(&automatic, &numeric));
-        for (k, yours) in source.given(&points, rest, &shape).iter().enumerate() {
+        let given = source.given(&points, rest, &shape);
+        if scale > 0.0 && given.iter().all(Option::is_some) {
+            let sum: DVec3 = given.iter().flatten().sum();
+            let off = sum.length() / scale;
+            let off = if off.is_finite() { off } else { f64::INFINITY };
+            let slot = report.translation_given.get_or_insert(0.0);
+            *slot = slot.max(off);
+        }
+        for (k, yours) in given.iter().enumerate() {
             let Some(yours) = yours else { continue };
             let difference = (*yours - automatic[k]).abs().max_element();
             let error = if scale > 0.0 {
@@ -418,6 +432,7 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
                     points: points.clone(),
                     rest,
                     relative_error: error,
+                    absolute: scale == 0.0,
                 });
             }
         }

@@ -187,7 +187,10 @@ impl Visit for Rms<'_> {
                 let idx: [u32; N] = std::array::from_fn(|k| set.particles(c)[k]);
                 let p = idx.map(|i| self.positions[i as usize]);
                 let shape = idx.map(|i| self.rest_positions[i as usize]);
-                constraint.evaluate(&p, set.rest()[c], &shape).value.powi(2)
+                constraint
+                    .evaluate_stored(&p, set.rest()[c], &shape, set.stored(c))
+                    .value
+                    .powi(2)
             })
             .sum();
         (sum / set.len() as f64).sqrt()

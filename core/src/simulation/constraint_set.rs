@@ -21,6 +21,9 @@ pub struct ConstraintSet {
     arity: usize,
     particles: Vec<u32>,
     rest: Vec<f64>,
+    /// What each constraint stores ([`Constraint::store`]), `stored_len` numbers each.
+    stored: Vec<f64>,
+    stored_len: usize,
     lambda: Vec<f64>,
     /// The size of each constraint's element: the longest rest edge among its particles, what
     /// its reach is measured in ([`crate::simulation::Settings::reach`]).
@@ -54,6 +57,8 @@ impl ConstraintSet {
             lambda: vec![0.0; particles.len() / arity],
             particles,
             rest: Vec::new(),
+            stored: Vec::new(),
+            stored_len: 0,
             size,
             order: Vec::new(),
         };
@@ -72,17 +77,26 @@ impl ConstraintSet {
     ) {
         struct RestValues<'a>(&'a [u32], &'a [DVec3], &'a Material);
         impl Visit for RestValues<'_> {
-            type Output = Vec<f64>;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Vec<f64> {
+            type Output = (Vec<f64>, Vec<f64>, usize);
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
                 let (particles, positions, material) = (self.0, self.1, self.2);
                 let (groups, _) = particles.as_chunks::<N>();
-                groups
-                    .iter()
-                    .map(|idx| c.rest_value(&idx.map(|i| positions[i as usize]), material))
-                    .collect()
+                let shapes = || groups.iter().map(|idx| idx.map(|i| positions[i as usize]));
+                let rest = shapes()
+                    .map(|shape| c.rest_value(&shape, material))
+                    .collect();
+                let stored_len = c.stored_len();
+                let stored = if stored_len == 0 {
+                    Vec::new()
+                } else {
+                    shapes()
+                        .flat_map(|shape| c.store(&shape, material))
+                        .collect()
+                };
+                (rest, stored, stored_len)
             }
         }
-        self.rest = families.visit(
+        (self.rest, self.stored, self.stored_len) = families.visit(
             family,
             RestValues(&self.particles, rest_positions, material),
         );
@@ -138,6 +152,17 @@ impl ConstraintSet {
     }
 
     /// The rest value (d, V) of each constraint.
+    /// What constraint `c` stores ([`Constraint::store`]; empty for a built-in family).
+    pub fn stored(&self, c: usize) -> &[f64] {
+        &self.stored[c * self.stored_len..(c + 1) * self.stored_len]
+    }
+
+    /// How many numbers each constraint stores.
+    pub fn stored_len(&self) -> usize {
+        self.stored_len
+    }
+
+    /// The rest values.
     pub fn rest(&self) -> &[f64] {
         &self.rest
     }

@@ -12,7 +12,7 @@ impl Simulation {
         let active = self.settings.active;
         self.families
             .all()
-            .filter(move |&f| active[f] && !f.projected_by_partner(&active))
+            .filter(move |&f| active[f] && !self.families.projected_by_partner(f, &active))
             .flat_map(move |f| {
                 let set = &self.sets[f];
                 (0..set.len()).map(move |k| (f, set.in_order(k)))
@@ -48,7 +48,7 @@ impl Simulation {
         let material_family = settings
             .active
             .families()
-            .find(|f| f.compliance_from_material().is_some())?;
+            .find(|&f| settings.from_material[f])?;
         let shortest = self.shortest_edge();
         let material = settings.material;
         let needed = material.substeps_needed(settings.dt, shortest, DENSITY);
@@ -82,7 +82,7 @@ impl Simulation {
     /// What projecting constraint `c` of `family` now would do, with the current λ and the rule
     /// (XPBD or PBD) of the current settings: C, ∇C, the inverse masses, Δλ and Δx.
     ///
-    /// A family projected together with another ([`Family::partner_in`]) shows its own C and
+    /// A family projected together with another ([`Families::partner_in`]) shows its own C and
     /// ∇C, and the Δλ and Δx of the pair's projection.
     pub fn projection(&self, family: Family, c: usize) -> Projection {
         let h = self.substep_length();
@@ -99,7 +99,7 @@ impl Simulation {
                 reach: self.settings.reach,
             },
         );
-        if let Some(partner) = family.partner_in(&self.settings.active) {
+        if let Some(partner) = self.families.partner_in(family, &self.settings.active) {
             let pair = pair::Pair {
                 first: &self.sets[family],
                 second: &self.sets[partner],
@@ -127,6 +127,13 @@ impl Simulation {
     }
 }
 
+impl Projection {
+    /// What the element stores.
+    pub fn stored(&self) -> &[f64] {
+        &self.stored[..self.stored_len]
+    }
+}
+
 /// One constraint, described for a reader: see [`Simulation::projection`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Projection {
@@ -142,6 +149,11 @@ pub struct Projection {
     pub value: f64,
     /// The rest value, d or V.
     pub rest: f64,
+    /// What the element stores ([`crate::constraints::Constraint::store`]), the first
+    /// `stored_len`: read them with [`Projection::stored`].
+    pub stored: [f64; crate::constraint_file::program::MAX_STORED],
+    /// How many numbers it stores.
+    pub stored_len: usize,
     /// ∇ₚC for each particle.
     pub gradients: [DVec3; 4],
     /// The inverse mass w of each particle (0 if pinned or held).
@@ -185,7 +197,8 @@ impl Visit for Describe<'_> {
         let idx = self.set.indices::<N>(c);
         let p = idx.map(|i| self.positions[i as usize]);
         let shape = idx.map(|i| self.rest_positions[i as usize]);
-        let evaluation = constraint.evaluate(&p, self.set.rest()[c], &shape);
+        let evaluation =
+            constraint.evaluate_stored(&p, self.set.rest()[c], &shape, self.set.stored(c));
         let weights = idx.map(|i| self.inverse_masses[i as usize]);
         let lambda = self.set.lambda()[c];
         let reach = self.reach * self.set.size()[c];
@@ -197,6 +210,8 @@ impl Visit for Describe<'_> {
             len: N,
             value: evaluation.value,
             rest: self.set.rest()[c],
+            stored: std::array::from_fn(|k| self.set.stored(c).get(k).copied().unwrap_or(0.0)),
+            stored_len: self.set.stored_len(),
             gradients: [DVec3::ZERO; 4],
             inverse_masses: [0.0; 4],
             weighted_norm: crate::simulation::projection::weighted_norm(

@@ -138,6 +138,8 @@ impl Simulation {
     pub fn with_families(scene: &Scene, settings: Settings, families: Families) -> Simulation {
         let settings = Settings {
             active: families.per_family(|f| settings.active[f]),
+            compliance: families.with_file_stiffness(settings.compliance, &settings.material),
+            from_material: families.from_material(),
             ..settings
         };
         let mesh = &scene.mesh;
@@ -222,6 +224,9 @@ impl Simulation {
             self.fast.solver = None;
         }
         self.settings.active = active;
+        self.settings.compliance =
+            families.with_file_stiffness(self.settings.compliance, &self.settings.material);
+        self.settings.from_material = families.from_material();
         self.families = families;
         self.rebuild_stale_sets();
     }
@@ -259,6 +264,10 @@ impl Simulation {
     pub fn set_settings(&mut self, settings: Settings) {
         let settings = Settings {
             active: self.families.per_family(|f| settings.active[f]),
+            compliance: self
+                .families
+                .with_file_stiffness(settings.compliance, &settings.material),
+            from_material: self.families.from_material(),
             ..settings
         };
         if settings.material != self.settings.material {

@@ -32,10 +32,10 @@ impl Pair<'_> {
         let idx = self.first.indices::<N>(c);
         let p = idx.map(|i| self.positions[i as usize]);
         let shape = idx.map(|i| self.rest_positions[i as usize]);
-        let a = first.evaluate(&p, self.first.rest()[c], &shape);
+        let a = first.evaluate_stored(&p, self.first.rest()[c], &shape, self.first.stored(c));
         let p2: [DVec3; M] = std::array::from_fn(|k| p[k]);
         let shape2: [DVec3; M] = std::array::from_fn(|k| shape[k]);
-        let b = second.evaluate(&p2, self.second.rest()[c], &shape2);
+        let b = second.evaluate_stored(&p2, self.second.rest()[c], &shape2, self.second.stored(c));
         let b = Evaluation {
             value: b.value,
             gradients: std::array::from_fn(|k| b.gradients[k]),

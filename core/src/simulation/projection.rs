@@ -58,7 +58,7 @@ impl Rule<f64> {
             Method::Xpbd => Rule::Xpbd {
                 alpha_tilde: settings.compliance[family] / (h * h),
             },
-            Method::Pbd if family.compliance_from_material().is_some() => Rule::CompliantPbd {
+            Method::Pbd if settings.from_material[family] => Rule::CompliantPbd {
                 alpha_tilde: settings.compliance[family] / (h * h),
             },
             Method::Pbd => {

@@ -135,6 +135,11 @@ pub struct Settings {
     /// with [`Settings::set_material`], which sets their compliances too.
     #[serde(default)]
     pub material: Material,
+    /// Which families take their compliance from the material: the built-in neo-Hookean pair,
+    /// and a constraint file's with a `stiffness` (a simulation marks these from its table). Not
+    /// stored: it follows from the table.
+    #[serde(skip, default = "builtin_material_families")]
+    pub from_material: PerFamily<bool>,
     /// PBD stiffness k ∈ [0, 1] per family.
     #[serde(deserialize_with = "stiffness_over_the_default")]
     pub stiffness: PerFamily<f64>,
@@ -192,11 +197,7 @@ impl Settings {
     /// mirrored tet's way back passes close to F = 0, where its hydrostatic gradient vanishes);
     /// capping the speed there leaves the body squashed to a point.
     pub fn edits_settle(&self) -> bool {
-        self.settle_edits
-            && !self
-                .active
-                .families()
-                .any(|f| f.compliance_from_material().is_some())
+        self.settle_edits && !self.active.families().any(|f| self.from_material[f])
     }
 
     /// Sets the material, and the compliance of each family it gives one
@@ -296,6 +297,7 @@ impl Default for Settings {
             grab_compliance: 0.0,
             settle_edits: false,
             material: Material::default(),
+            from_material: builtin_material_families(),
             engine: Engine::Auto,
             order_seed: None,
             reach: DEFAULT_REACH,
@@ -303,6 +305,11 @@ impl Default for Settings {
         settings.set_material(Material::default());
         settings
     }
+}
+
+/// The built-in families whose compliance the material gives (the neo-Hookean pair).
+fn builtin_material_families() -> PerFamily<bool> {
+    PerFamily::builtin_from_fn(|f| f.compliance_from_material().is_some())
 }
 
 /// Stiffnesses as stored (the workbench's preferences): a family the stored map lacks keeps the

@@ -88,7 +88,7 @@ impl Simulation {
     pub(super) fn sweep(&mut self, h: f64) {
         let active = self.settings.active;
         for family in self.families.all() {
-            if !active[family] || family.projected_by_partner(&active) {
+            if !active[family] || self.families.projected_by_partner(family, &active) {
                 continue;
             }
             self.project_range(family, Projected::All, h);
@@ -99,7 +99,7 @@ impl Simulation {
     /// Projects the constraints `which` of `family` in turn, alone or with its partner.
     pub(super) fn project_range(&mut self, family: Family, which: Projected, h: f64) {
         let rule = self.rule(family, h);
-        if let Some(partner) = family.partner_in(&self.settings.active) {
+        if let Some(partner) = self.families.partner_in(family, &self.settings.active) {
             let rules = [rule, self.rule(partner, h)];
             let (first, second) = self.sets.pair_mut(family, partner);
             let (skipped_first, skipped_second) = self.skipped.pair_mut(family, partner);
@@ -276,7 +276,8 @@ impl Visit for Sweep<'_> {
             } else {
                 p
             };
-            let evaluation = constraint.evaluate(&p, self.set.rest()[c], &shape);
+            let evaluation =
+                constraint.evaluate_stored(&p, self.set.rest()[c], &shape, self.set.stored(c));
             let weights = idx.map(|i| self.inverse_masses[i as usize]);
             let (lambda, reach) = (self.set.lambda()[c], self.reach * self.set.size()[c]);
             let (skipped, correction) =

@@ -70,14 +70,19 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
         at[..points.len()].copy_from_slice(&points);
         match points.len() {
             2 => {
-                let e = file.evaluate_by(&[at[0], at[1]], projection.rest, false);
+                let e =
+                    file.evaluate_by(&[at[0], at[1]], projection.rest, projection.stored(), false);
                 automatic[..2].copy_from_slice(&e.gradients);
             }
-            _ => automatic = file.evaluate_by(&at, projection.rest, false).gradients,
+            _ => {
+                automatic = file
+                    .evaluate_by(&at, projection.rest, projection.stored(), false)
+                    .gradients
+            }
         }
         FileGradients {
             automatic,
-            yours: file.yours(&points, projection.rest),
+            yours: file.yours(&points, projection.rest, projection.stored()),
         }
     });
     Inspection {

@@ -55,6 +55,47 @@ pub struct Layout {
 pub struct Batches {
     rest: Vec<F32x8>,
     lambda: Vec<F32x8>,
+    /// What each element stores ([`crate::constraints::Constraint::store`]), `stored_len` rows
+    /// per batch.
+    stored: Vec<F32x8>,
+    stored_len: usize,
+}
+
+/// The rest values of a family's batches, a row each, and what their elements store,
+/// `len` rows per batch: what the kernels read.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RestRows<'a> {
+    values: &'a [F32x8],
+    stored: &'a [F32x8],
+    len: usize,
+}
+
+impl<'a> RestRows<'a> {
+    /// The rows of batches `range`.
+    #[inline]
+    pub(crate) fn batches(self, range: std::ops::Range<usize>) -> RestRows<'a> {
+        RestRows {
+            values: &self.values[range.clone()],
+            stored: &self.stored[range.start * self.len..range.end * self.len],
+            len: self.len,
+        }
+    }
+
+    /// Batch `b`'s rest values and what its elements store.
+    #[inline(always)]
+    pub(crate) fn of(self, b: usize) -> (F32x8, &'a [F32x8]) {
+        (
+            self.values[b],
+            &self.stored[b * self.len..(b + 1) * self.len],
+        )
+    }
+
+    /// How many batches.
+    #[inline]
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    pub(crate) fn len(self) -> usize {
+        self.values.len()
+    }
 }
 
 /// A layout with its arity N known: what the kernels read.
@@ -246,8 +287,23 @@ impl Layout {
 }
 
 impl Batches {
-    /// A family's batches on `layout`: the constraint of element e has rest value `rest(e)`.
-    pub(crate) fn new(layout: &Layout, rest: impl Fn(u32) -> f32) -> Self {
+    /// A family's batches on `layout`: the constraint of element e has rest value `rest(e)`
+    /// and stores `stored(e)` (`stored_len` numbers).
+    pub(crate) fn new(
+        layout: &Layout,
+        rest: impl Fn(u32) -> f32,
+        stored_len: usize,
+        stored: impl Fn(u32) -> Vec<f32>,
+    ) -> Self {
+        let mut rows = Vec::with_capacity(layout.elements.len() * stored_len);
+        if stored_len > 0 {
+            for lanes in &layout.elements {
+                let values = lanes.map(&stored);
+                for k in 0..stored_len {
+                    rows.push(F32x8::new(std::array::from_fn(|lane| values[lane][k])));
+                }
+            }
+        }
         Batches {
             rest: layout
                 .elements
@@ -255,6 +311,8 @@ impl Batches {
                 .map(|lanes| F32x8::new(lanes.map(&rest)))
                 .collect(),
             lambda: vec![F32x8::ZERO; layout.batch_count()],
+            stored: rows,
+            stored_len,
         }
     }
 
@@ -264,9 +322,22 @@ impl Batches {
         self.rest.is_empty()
     }
 
-    /// The rest values (a row per batch) and the multipliers, for the kernels.
-    pub(crate) fn rows(&mut self) -> (&[F32x8], &mut [F32x8]) {
-        (&self.rest, &mut self.lambda)
+    /// The rest values and stored numbers, and the multipliers, for the kernels.
+    pub(crate) fn rows(&mut self) -> (RestRows<'_>, &mut [F32x8]) {
+        (
+            RestRows {
+                values: &self.rest,
+                stored: &self.stored,
+                len: self.stored_len,
+            },
+            &mut self.lambda,
+        )
+    }
+
+    /// What the element at (batch, lane) stores.
+    pub(crate) fn stored_at(&self, (batch, lane): (usize, usize)) -> Vec<f32> {
+        let rows = &self.stored[batch * self.stored_len..(batch + 1) * self.stored_len];
+        rows.iter().map(|row| row.to_array()[lane]).collect()
     }
 
     /// The rest value of the constraint of the element at (batch, lane).
@@ -281,6 +352,7 @@ impl Batches {
 
     /// The bytes its arrays take (their capacities).
     pub(crate) fn heap_bytes(&self) -> usize {
-        (self.rest.capacity() + self.lambda.capacity()) * size_of::<F32x8>()
+        (self.rest.capacity() + self.lambda.capacity() + self.stored.capacity())
+            * size_of::<F32x8>()
     }
 }

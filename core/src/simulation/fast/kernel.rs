@@ -5,7 +5,7 @@
 //! A batch's particles are gathered into registers, its constraints projected there, and the
 //! corrections added to the positions (Gauss–Seidel) or to the Jacobi sums.
 
-use super::batches::{Batches, Layout, Typed};
+use super::batches::{Batches, Layout, RestRows, Typed};
 use super::particles::Particles;
 use crate::constraints::Constraint;
 use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
@@ -76,7 +76,7 @@ fn project_batches<const N: usize, C: Constraint<N>>(
     particles: &[[[u32; LANES]; N]],
     weights: &[[F32x8; N]],
     (size, reach): (&[F32x8], F32x8),
-    rest: &[F32x8],
+    rest: RestRows,
     lambda: &mut [F32x8],
     access: Access,
     rule: Rule<F32x8>,
@@ -87,13 +87,14 @@ fn project_batches<const N: usize, C: Constraint<N>>(
     // The next batch is gathered before this one is written (they share no particle), so that
     // its loads overlap this one's arithmetic.
     let mut next = particles.first().map(|indices| gather_batch(read, indices));
-    for (b, (((indices, weights), size), (rest, lambda))) in particles
+    for (b, (((indices, weights), size), lambda)) in particles
         .iter()
         .zip(weights)
         .zip(size)
-        .zip(rest.iter().zip(lambda.iter_mut()))
+        .zip(lambda.iter_mut())
         .enumerate()
     {
+        let (rest, stored) = rest.of(b);
         let Some(p) = next else { break };
         next = particles
             .get(b + 1)
@@ -103,7 +104,7 @@ fn project_batches<const N: usize, C: Constraint<N>>(
         } else {
             p
         };
-        let evaluation = constraint.evaluate(&p, *rest, &shape);
+        let evaluation = constraint.evaluate_stored(&p, rest, &shape, stored);
         let (skipped, d) = correction_lanes(evaluation, *weights, *lambda, rule, *size * reach);
         skips.add(skipped);
         *lambda += d.delta_lambda;
@@ -162,25 +163,27 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
             &particles[range.clone()],
             &weights[range.clone()],
             &size[range.clone()],
-            &rest[range.clone()],
+            rest.batches(range.clone()),
             &mut lambda[range],
         );
         let skipped = match parallel && colour.elements >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
             true => {
                 use rayon::prelude::*;
+                let batches = rest.len();
                 lambda
                     .par_chunks_mut(CHUNK)
                     .zip(particles.par_chunks(CHUNK))
                     .zip(weights.par_chunks(CHUNK))
-                    .zip(size.par_chunks(CHUNK).zip(rest.par_chunks(CHUNK)))
-                    .map(|(((lambda, particles), weights), (size, rest))| {
+                    .zip(size.par_chunks(CHUNK))
+                    .enumerate()
+                    .map(|(i, (((lambda, particles), weights), size))| {
                         project_batches::<N, C>(
                             constraint,
                             particles,
                             weights,
                             (size, reach),
-                            rest,
+                            rest.batches(i * CHUNK..((i + 1) * CHUNK).min(batches)),
                             lambda,
                             access,
                             rule,
@@ -214,7 +217,7 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
     (first, second): (&A, &B),
     particles: &[[[u32; LANES]; N]],
     (weights, size, reach): (&[[F32x8; N]], &[F32x8], F32x8),
-    (rest_a, rest_b): (&[F32x8], &[F32x8]),
+    (rest_a, rest_b): (RestRows, RestRows),
     (lambda_a, lambda_b): (&mut [F32x8], &mut [F32x8]),
     access: Access,
     rules: [Rule<F32x8>; 2],
@@ -228,10 +231,11 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
         } else {
             p
         };
-        let first_evaluation = first.evaluate(&p, rest_a[b], &shape);
+        let ((rest_first, stored_a), (rest_second, stored_b)) = (rest_a.of(b), rest_b.of(b));
+        let first_evaluation = first.evaluate_stored(&p, rest_first, &shape, stored_a);
         let p2: [Vec3x8; M] = std::array::from_fn(|k| p[k]);
         let shape2: [Vec3x8; M] = std::array::from_fn(|k| shape[k]);
-        let e = second.evaluate(&p2, rest_b[b], &shape2);
+        let e = second.evaluate_stored(&p2, rest_second, &shape2, stored_b);
         let second_evaluation = crate::constraints::Evaluation {
             value: e.value,
             gradients: std::array::from_fn(|k| e.gradients[k]),
@@ -300,25 +304,27 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         let range = colour.batches.clone();
         let (particles, weights) = (&particles[range.clone()], &weights[range.clone()]);
         let size = &size[range.clone()];
-        let rest = (&rest_a[range.clone()], &rest_b[range.clone()]);
+        let rest = (rest_a.batches(range.clone()), rest_b.batches(range.clone()));
         let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
         let skipped = match parallel && colour.elements >= PARALLEL_MIN {
             #[cfg(feature = "parallel")]
             true => {
                 use rayon::prelude::*;
+                let batches = rest.0.len();
                 lambda_a
                     .par_chunks_mut(CHUNK)
                     .zip(lambda_b.par_chunks_mut(CHUNK))
                     .zip(particles.par_chunks(CHUNK))
                     .zip(weights.par_chunks(CHUNK).zip(size.par_chunks(CHUNK)))
-                    .zip(rest.0.par_chunks(CHUNK).zip(rest.1.par_chunks(CHUNK)))
+                    .enumerate()
                     .map(
-                        |((((lambda_a, lambda_b), particles), (weights, size)), rest)| {
+                        |(i, (((lambda_a, lambda_b), particles), (weights, size)))| {
+                            let range = i * CHUNK..((i + 1) * CHUNK).min(batches);
                             project_pair_batches::<N, A, M, B>(
                                 constraints,
                                 particles,
                                 (weights, size, reach),
-                                rest,
+                                (rest.0.batches(range.clone()), rest.1.batches(range)),
                                 (lambda_a, lambda_b),
                                 access,
                                 rules,

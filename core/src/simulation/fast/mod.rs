@@ -194,12 +194,18 @@ impl<'a> FamilyBatches<'a> {
     /// The particles (the first arity of four, in the constraint's order) and rest value of each
     /// constraint, colour by colour, padding left out.
     pub fn constraints(&self) -> impl Iterator<Item = ([u32; 4], f32)> + 'a {
+        self.constraints_storing()
+            .map(|(particles, rest, _)| (particles, rest))
+    }
+
+    /// [`FamilyBatches::constraints`] with what each stores.
+    pub fn constraints_storing(&self) -> impl Iterator<Item = ([u32; 4], f32, Vec<f32>)> + 'a {
         let batches = self.batches;
         let elements = (!batches.is_empty()).then(|| self.layout.elements());
         elements
             .into_iter()
             .flatten()
-            .map(move |(_, particles, at)| (particles, batches.rest_at(at)))
+            .map(move |(_, particles, at)| (particles, batches.rest_at(at), batches.stored_at(at)))
     }
 
     /// Whether every colour of its layout really shares no particle.
@@ -348,10 +354,19 @@ impl FastSimulation {
             if !active[family] {
                 return Batches::default();
             }
-            let rest = simulation.constraints[family].rest();
-            Batches::new(layouts.of(simulation.families.binding(family)), |element| {
-                rest[element as usize] as f32
-            })
+            let set = &simulation.constraints[family];
+            let rest = set.rest();
+            Batches::new(
+                layouts.of(simulation.families.binding(family)),
+                |element| rest[element as usize] as f32,
+                set.stored_len(),
+                |element| {
+                    set.stored(element as usize)
+                        .iter()
+                        .map(|&x| x as f32)
+                        .collect()
+                },
+            )
         });
         debug_assert!(
             layouts.edges.colouring_is_valid(n)
@@ -534,12 +549,17 @@ impl FastSimulation {
             type Output = f64;
             fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> f64 {
                 let mut sum = 0.0;
-                for (particles, rest) in self.batches.constraints() {
+                for (particles, rest, stored) in self.batches.constraints_storing() {
                     let at = |positions: &[Vec3A]| -> [Vec3A; N] {
                         std::array::from_fn(|k| positions[particles[k] as usize])
                     };
                     let value = c
-                        .evaluate(&at(self.positions), rest, &at(self.rest_positions))
+                        .evaluate_stored(
+                            &at(self.positions),
+                            rest,
+                            &at(self.rest_positions),
+                            &stored,
+                        )
                         .value;
                     let scale = if rest == 0.0 { 1.0 } else { rest.abs() };
                     sum += (f64::from(value) / f64::from(scale)).powi(2);
@@ -853,13 +873,13 @@ impl FastSimulation {
     ) {
         let active = self.settings.active;
         for family in active.families() {
-            if family.projected_by_partner(&active) {
+            if self.families.projected_by_partner(family, &active) {
                 continue;
             }
             let rule = Rule::for_settings(&self.settings, family, h);
             let started = Instant::now();
             let sums = self.jacobi.as_mut().map(|j| &mut j.sums[..]);
-            if let Some(partner) = family.partner_in(&active) {
+            if let Some(partner) = self.families.partner_in(family, &active) {
                 struct ProjectPair<'a> {
                     layout: &'a Layout,
                     order: &'a [u32],

@@ -114,11 +114,11 @@ impl Lesson {
         let mut file_families = Vec::new();
         for file in &raw.constraint_files {
             let resolved = resolve_path(path, file.get_ref());
-            let family = ConstraintFile::load(Path::new(&resolved))
+            let defined = ConstraintFile::load_all(Path::new(&resolved))
                 .map_err(|e| e.to_string())
-                .and_then(|file| families.define(file))
+                .and_then(|files| families.define_all(files))
                 .map_err(|e| error(Some(file.span()), format!("constraint file: {e}")))?;
-            file_families.push(family);
+            file_families.extend(defined);
         }
         let mut settings = Settings::default();
         let s = &raw.settings;

@@ -108,12 +108,22 @@ fn disagreeing_arrows(
     });
     let other = match projection.len {
         2 => {
-            let e = file.evaluate_by(&[points[0], points[1]], projection.rest, !file.use_gradient);
+            let e = file.evaluate_by(
+                &[points[0], points[1]],
+                projection.rest,
+                projection.stored(),
+                !file.use_gradient,
+            );
             [e.gradients[0], e.gradients[1], DVec3::ZERO, DVec3::ZERO]
         }
         _ => {
-            file.evaluate_by(&points, projection.rest, !file.use_gradient)
-                .gradients
+            file.evaluate_by(
+                &points,
+                projection.rest,
+                projection.stored(),
+                !file.use_gradient,
+            )
+            .gradients
         }
     };
     let used = &projection.gradients[..projection.len];

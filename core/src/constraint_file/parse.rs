@@ -1,0 +1,495 @@
+//! Reading a constraint file: the TOML ([`Raw`]), then each of its constraints compiled
+//! ([`parse_all`]), every mistake placed at file:line:column of the file as written (offsets in a
+//! TOML string's content mapped back through its escapes, [`file_offset`]).
+//!
+//! One constraint is written at the top level (`value = "…"`); several as `[[constraint]]`
+//! tables, which share the top level's `define`, and may ask for two of them to be projected as
+//! a pair (`pair = ["a", "b"]`). Each family is then named `FILE-CONSTRAINT`, and the file's name
+//! names the group of them (`--constraints my-neohookean`).
+
+use super::expression;
+use super::program::{CompileError, Program, Type};
+use super::{ConstraintFile, ConstraintFileError, GradeOnce, Stiffness};
+use crate::constraints::Binding;
+use crate::input::text_file;
+use std::collections::BTreeMap;
+use std::path::Path;
+use toml::Spanned;
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Raw {
+    name: Spanned<String>,
+    applies_to: Spanned<String>,
+    #[serde(default)]
+    define: Option<Spanned<String>>,
+    // A file of one constraint says it here; see RawConstraint.
+    #[serde(default)]
+    value: Option<Spanned<String>>,
+    #[serde(default)]
+    rest: Option<Spanned<String>>,
+    #[serde(default)]
+    gradient: BTreeMap<Spanned<String>, Spanned<String>>,
+    #[serde(default)]
+    use_gradient: bool,
+    #[serde(default)]
+    stiffness: Option<Spanned<String>>,
+    #[serde(default)]
+    constraint: Vec<RawNamed>,
+    #[serde(default)]
+    pair: Option<Spanned<Vec<Spanned<String>>>>,
+}
+
+/// What one constraint says: at the top level of a file of one, or in a `[[constraint]]`
+/// ([`RawNamed`]; serde's `flatten` would lose `deny_unknown_fields`, so the fields are written
+/// out in each).
+#[derive(Default)]
+struct RawConstraint {
+    value: Option<Spanned<String>>,
+    rest: Option<Spanned<String>>,
+    gradient: BTreeMap<Spanned<String>, Spanned<String>>,
+    use_gradient: bool,
+    stiffness: Option<Spanned<String>>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawNamed {
+    name: Spanned<String>,
+    #[serde(default)]
+    value: Option<Spanned<String>>,
+    #[serde(default)]
+    rest: Option<Spanned<String>>,
+    #[serde(default)]
+    gradient: BTreeMap<Spanned<String>, Spanned<String>>,
+    #[serde(default)]
+    use_gradient: bool,
+    #[serde(default)]
+    stiffness: Option<Spanned<String>>,
+}
+
+impl RawNamed {
+    fn constraint(&self) -> RawConstraint {
+        RawConstraint {
+            value: self.value.clone(),
+            rest: self.rest.clone(),
+            gradient: self.gradient.clone(),
+            use_gradient: self.use_gradient,
+            stiffness: self.stiffness.clone(),
+        }
+    }
+}
+
+/// Every constraint of the file `text` (`path` names it in errors), in the order written.
+pub(super) fn parse_all(
+    path: &Path,
+    text: &str,
+) -> Result<Vec<ConstraintFile>, ConstraintFileError> {
+    let text = text_file::without_byte_order_mark(text);
+    let error = |offset: Option<usize>, message: String| ConstraintFileError {
+        path: path.to_owned(),
+        at: offset.map(|o| position(text, o)),
+        message,
+    };
+    let raw: Raw = toml::from_str(text).map_err(|e| {
+        let message = e.message().trim().replace('\n', " ");
+        error(e.span().map(|s| s.start), message)
+    })?;
+    let binding = match raw.applies_to.get_ref().as_str() {
+        "edges" => Binding::Edges,
+        "tets" => Binding::Tets,
+        "tet-vertices" => Binding::TetVertices,
+        other => {
+            return Err(error(
+                Some(raw.applies_to.span().start),
+                format!(
+                    "applies_to is \"{other}\": expected \"edges\" (p0 p1), \"tets\" \
+                     (p0..p3) or \"tet-vertices\" (p0..p3, four per tet)"
+                ),
+            ));
+        }
+    };
+    let checked_name = |name: &Spanned<String>| {
+        let trimmed = name.get_ref().trim().to_owned();
+        if trimmed.is_empty()
+            || !trimmed
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        {
+            return Err(error(
+                Some(name.span().start),
+                format!(
+                    "name \"{trimmed}\": use letters, digits, - and _ (it names the family on the command line)"
+                ),
+            ));
+        }
+        Ok(trimmed)
+    };
+    let file_name = checked_name(&raw.name)?;
+    let shared = Shared {
+        path,
+        text,
+        binding,
+        define: raw.define.as_ref(),
+    };
+    let single = RawConstraint {
+        value: raw.value.clone(),
+        rest: raw.rest.clone(),
+        gradient: raw.gradient.clone(),
+        use_gradient: raw.use_gradient,
+        stiffness: raw.stiffness.clone(),
+    };
+    if raw.constraint.is_empty() {
+        if let Some(pair) = &raw.pair {
+            return Err(error(
+                Some(pair.span().start),
+                "`pair` names two [[constraint]] tables, and this file has none".to_owned(),
+            ));
+        }
+        let Some(value) = &single.value else {
+            // Where it would go: after the last key before the first table (`[gradient]`).
+            let keys_end = text
+                .match_indices('\n')
+                .map(|(i, _)| i + 1)
+                .find(|&i| text[i..].trim_start_matches([' ', '\t']).starts_with('['))
+                .unwrap_or(text.len());
+            return Err(error(
+                Some(keys_end),
+                "no `value`: give C as `value = \"…\"` (before any [table]), or several as \
+                 [[constraint]] tables"
+                    .to_owned(),
+            ));
+        };
+        let file = shared.compile(file_name, None, value, &single)?;
+        return Ok(vec![file]);
+    }
+    let stray = [&raw.value, &raw.rest, &raw.stiffness]
+        .into_iter()
+        .flatten()
+        .chain(raw.gradient.values())
+        .next();
+    if let Some(value) = stray {
+        return Err(error(
+            Some(value.span().start),
+            "this file has [[constraint]] tables: give each its own `value`, `rest`, `stiffness` and \
+             [gradient] there, not at the top"
+                .to_owned(),
+        ));
+    }
+    let mut files = Vec::new();
+    for named in &raw.constraint {
+        let own = checked_name(&named.name)?;
+        let constraint = named.constraint();
+        if raw
+            .constraint
+            .iter()
+            .filter(|n| n.name.get_ref().trim() == own)
+            .count()
+            > 1
+        {
+            return Err(error(
+                Some(named.name.span().start),
+                format!("two [[constraint]] tables are named \"{own}\""),
+            ));
+        }
+        let Some(value) = &constraint.value else {
+            return Err(error(
+                Some(named.name.span().start),
+                format!("[[constraint]] \"{own}\" has no `value`: give its C as `value = \"…\"`"),
+            ));
+        };
+        let mut file = shared.compile(
+            format!("{file_name}-{own}"),
+            Some(file_name.clone()),
+            value,
+            &constraint,
+        )?;
+        file.formula.insert(0, format!("[{own}]"));
+        files.push(file);
+    }
+    if let Some(pair) = &raw.pair {
+        let names = pair.get_ref();
+        if names.len() != 2 || names[0].get_ref() == names[1].get_ref() {
+            return Err(error(
+                Some(pair.span().start),
+                "`pair` names two different constraints of the file: pair = [\"a\", \"b\"]"
+                    .to_owned(),
+            ));
+        }
+        let mut places = [0; 2];
+        for (k, name) in names.iter().enumerate() {
+            let wanted = format!("{file_name}-{}", name.get_ref().trim());
+            places[k] = files.iter().position(|f| f.name == wanted).ok_or_else(|| {
+                error(
+                    Some(name.span().start),
+                    format!(
+                        "`pair` names \"{}\", and the file's constraints are {}",
+                        name.get_ref(),
+                        raw.constraint
+                            .iter()
+                            .map(|c| format!("\"{}\"", c.name.get_ref().trim()))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                )
+            })?;
+        }
+        let [a, b] = places;
+        let (name_a, name_b) = (files[a].name.clone(), files[b].name.clone());
+        files[a].pair = Some(name_b);
+        files[b].pair = Some(name_a);
+    }
+    Ok(files)
+}
+
+/// What the constraints of a file share: where it is, its text, its binding and `define`.
+struct Shared<'a> {
+    path: &'a Path,
+    text: &'a str,
+    binding: Binding,
+    define: Option<&'a Spanned<String>>,
+}
+
+impl Shared<'_> {
+    fn error(&self, offset: Option<usize>, message: String) -> ConstraintFileError {
+        ConstraintFileError {
+            path: self.path.to_owned(),
+            at: offset.map(|o| position(self.text, o)),
+            message,
+        }
+    }
+
+    /// A program with the file's definitions (and `rest` when `with_rest`).
+    fn program(&self, with_rest: bool) -> Result<Program, ConstraintFileError> {
+        let mut program = Program::new(self.binding.arity(), with_rest);
+        if let Some(define) = self.define {
+            // An expression's errors are placed by where its TOML string starts (`at`).
+            let at = define.span().start;
+            let parsed = expression::parse_definitions(define.get_ref()).map_err(|e| {
+                self.error(
+                    Some(file_offset(self.text, at, e.offset)),
+                    format!("in define: {}", e.message),
+                )
+            })?;
+            program.at(at);
+            for (name, span, expr) in &parsed {
+                program
+                    .define(name, *span, expr)
+                    .map_err(|e| self.compile_error(at, e, define.get_ref(), "define"))?;
+            }
+        }
+        Ok(program)
+    }
+
+    fn compile_error(
+        &self,
+        at: usize,
+        e: CompileError,
+        source: &str,
+        what: &str,
+    ) -> ConstraintFileError {
+        let snippet = source.get(e.span.start..e.span.end).unwrap_or("").trim();
+        self.error(
+            Some(file_offset(self.text, at, e.span.start)),
+            format!("in {what}: {} (`{snippet}`)", e.message),
+        )
+    }
+
+    /// Compiles `spanned` into `program` as an output of type `ty`.
+    fn output(
+        &self,
+        program: &mut Program,
+        spanned: &Spanned<String>,
+        ty: Type,
+        what: &str,
+    ) -> Result<usize, ConstraintFileError> {
+        let at = spanned.span().start;
+        let expr = expression::parse_expression(spanned.get_ref()).map_err(|e| {
+            self.error(
+                Some(file_offset(self.text, at, e.offset)),
+                format!("in {what}: {}", e.message),
+            )
+        })?;
+        program.at(at);
+        program
+            .output(&expr, ty, what)
+            .map_err(|e| self.compile_error(at, e, spanned.get_ref(), what))
+    }
+
+    /// One constraint, named `name`, of the group `group` (a file of several).
+    fn compile(
+        &self,
+        name: String,
+        group: Option<String>,
+        value: &Spanned<String>,
+        raw: &RawConstraint,
+    ) -> Result<ConstraintFile, ConstraintFileError> {
+        let arity = self.binding.arity();
+        let mut program = self.program(true)?;
+        let c = self.output(&mut program, value, Type::Scalar, "value")?;
+        let mut outputs = vec![c];
+        let mut gradient_outputs = [None; 4];
+        for (key, entry) in &raw.gradient {
+            let particle = key
+                .get_ref()
+                .strip_prefix('p')
+                .and_then(|k| k.parse::<usize>().ok())
+                .filter(|&k| k < arity && key.get_ref().len() == 2);
+            let Some(k) = particle else {
+                return Err(self.error(
+                    Some(key.span().start),
+                    format!(
+                        "gradient entry `{}`: this binding has particles p0…p{} only",
+                        key.get_ref(),
+                        arity - 1
+                    ),
+                ));
+            };
+            let what = format!("gradient.{}", key.get_ref());
+            outputs.push(self.output(&mut program, entry, Type::Vector, &what)?);
+            gradient_outputs[k] = Some(outputs.len() - 1);
+        }
+        let compiled = program
+            .compiled(&[&[c], &outputs])
+            .map_err(|message| self.error(Some(value.span().start), message))?;
+        let [value_tape, yours] = <[_; 2]>::try_from(compiled.tapes).expect("two groups");
+        let rest = match &raw.rest {
+            Some(rest) => {
+                let mut program = self.program(false)?;
+                let r = self.output(&mut program, rest, Type::Scalar, "rest")?;
+                Some(program.tape(&[r]))
+            }
+            None => None,
+        };
+        let stiffness = match &raw.stiffness {
+            None => None,
+            Some(s) => Some(match s.get_ref().trim() {
+                "mu" => Stiffness::Mu,
+                "lambda" => Stiffness::Lambda,
+                other => {
+                    return Err(self.error(
+                        Some(s.span().start),
+                        format!(
+                            "stiffness is \"{other}\": expected \"mu\" (compliance 1/μ) or \
+                             \"lambda\" (compliance 1/λ), both from --material"
+                        ),
+                    ));
+                }
+            }),
+        };
+        let mut formula: Vec<String> = self
+            .define
+            .map(|d| {
+                d.get_ref()
+                    .lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .map(str::to_owned)
+                    .collect()
+            })
+            .unwrap_or_default();
+        formula.push(format!(
+            "C = {}",
+            value
+                .get_ref()
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ")
+        ));
+        Ok(ConstraintFile {
+            path: self.path.to_owned(),
+            name,
+            group,
+            binding: self.binding,
+            use_gradient: raw.use_gradient,
+            stiffness,
+            pair: None,
+            source: self.text.to_owned(),
+            formula,
+            prelude: compiled.prelude,
+            stored: compiled.stored,
+            value: value_tape,
+            yours,
+            gradient_outputs,
+            rest,
+            grade: GradeOnce::default(),
+        })
+    }
+}
+
+/// Line and column (from 1, in characters) of byte `offset` of `text`.
+pub(super) fn position(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text[..text.floor_char_boundary(offset)];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+/// The byte of `text` that byte `offset` of a TOML string's content comes from, the string's
+/// value starting at byte `value_start` (its opening quote). The content starts after `"`, `'`,
+/// or `"""` / `'''` and the newline that may follow them; in a basic (double-quoted) string an
+/// escape such as `\t` is two bytes of the file for one of the content, `\uXXXX` six, and a
+/// backslash at the end of a line of a `"""` string stands for the white space after it.
+pub(super) fn file_offset(text: &str, value_start: usize, offset: usize) -> usize {
+    let rest = &text[value_start.min(text.len())..];
+    let (quote, escapes) = if rest.starts_with("\"\"\"") {
+        (3, true)
+    } else if rest.starts_with("'''") {
+        (3, false)
+    } else if rest.starts_with('"') {
+        (1, true)
+    } else if rest.starts_with('\'') {
+        (1, false)
+    } else {
+        (0, false)
+    };
+    let mut at = value_start + quote;
+    if quote == 3 {
+        let tail = &text[at.min(text.len())..];
+        if tail.starts_with("\r\n") {
+            at += 2;
+        } else if tail.starts_with('\n') {
+            at += 1;
+        }
+    }
+    let bytes = text.as_bytes();
+    let mut content = 0;
+    while content < offset && at < bytes.len() {
+        if escapes && bytes[at] == b'\\' {
+            match bytes.get(at + 1) {
+                Some(b'u') => {
+                    content += decoded_len(text.get(at + 2..).unwrap_or(""), 4);
+                    at += 6;
+                }
+                Some(b'U') => {
+                    content += decoded_len(text.get(at + 2..).unwrap_or(""), 8);
+                    at += 10;
+                }
+                Some(b' ' | b'\t' | b'\r' | b'\n') => {
+                    at += 1;
+                    while at < bytes.len() && matches!(bytes[at], b' ' | b'\t' | b'\r' | b'\n') {
+                        at += 1;
+                    }
+                }
+                _ => {
+                    content += 1;
+                    at += 2;
+                }
+            }
+        } else {
+            let width = text[at..].chars().next().map_or(1, char::len_utf8);
+            content += width;
+            at += width;
+        }
+    }
+    at.min(text.len())
+}
+
+/// The UTF-8 length of the character whose `digits` hex digits start `hex` (1 if they are not).
+fn decoded_len(hex: &str, digits: usize) -> usize {
+    hex.get(..digits)
+        .and_then(|h| u32::from_str_radix(h, 16).ok())
+        .and_then(char::from_u32)
+        .map_or(1, char::len_utf8)
+}

@@ -1,0 +1,294 @@
+//! The instructions of a tape ([`Op`]): what each computes from the registers it reads
+//! ([`Op::apply`], generic over [`Real`]), the registers it reads, and why its value is not
+//! finite when it is not. The derivative rules are the backward pass's ([`super::tape`]).
+
+use super::tape::Inputs;
+use crate::constraint_file::expression::CompareOp;
+use crate::numbers::vector::Real;
+use arrayvec::ArrayVec;
+
+/// A register: the index of the instruction that defines it.
+pub(super) type Reg = u16;
+
+/// The most registers (instructions) a program may have: tapes keep their registers on the stack,
+/// so that an evaluation allocates nothing.
+pub const MAX_REGISTERS: usize = 160;
+
+/// The most numbers a constraint may store ([`Op::Stored`]): what depends only on the rest shape
+/// and the material, worked out once per element.
+pub const MAX_STORED: usize = 48;
+
+/// One instruction; it defines the register of its own index from the registers it names.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Op {
+    /// A number or (from folding) a constant vector; a scalar is `[x, 0, 0]`.
+    Const([f64; 3]),
+    Particle(u8),
+    /// A particle's rest position.
+    RestParticle(u8),
+    /// μ, λ or γ = 1 + μ/λ of the material.
+    Material(u8),
+    /// A number (`false`) or vector (`true`) stored per element, from this offset.
+    Stored(u8, bool),
+    Rest,
+    NegS(Reg),
+    NegV(Reg),
+    AddS(Reg, Reg),
+    SubS(Reg, Reg),
+    MulS(Reg, Reg),
+    DivS(Reg, Reg),
+    AddV(Reg, Reg),
+    SubV(Reg, Reg),
+    /// vector × scalar.
+    Scale(Reg, Reg),
+    /// vector ÷ scalar.
+    Shrink(Reg, Reg),
+    Dot(Reg, Reg),
+    Cross(Reg, Reg),
+    Length(Reg),
+    Normalize(Reg),
+    Sqrt(Reg),
+    Abs(Reg),
+    Min(Reg, Reg),
+    Max(Reg, Reg),
+    Det(Reg, Reg, Reg),
+    Sin(Reg),
+    Cos(Reg),
+    Exp(Reg),
+    Ln(Reg),
+    /// atan2(y, x).
+    Atan2(Reg, Reg),
+    Asin(Reg),
+    Acos(Reg),
+    Cbrt(Reg),
+    Sign(Reg),
+    /// A vector's component 0, 1 or 2.
+    Component(Reg, u8),
+    Vec3(Reg, Reg, Reg),
+    /// `if(a cmp b, then, otherwise)`, scalars or vectors.
+    If(CompareOp, Reg, Reg, Reg, Reg),
+}
+
+impl Op {
+    /// The same instruction with each register r it reads replaced by `f(r)`, in order.
+    pub(super) fn map_inputs(self, mut f: impl FnMut(Reg) -> Reg) -> Op {
+        use Op::*;
+        match self {
+            Const(_) | Particle(_) | RestParticle(_) | Material(_) | Stored(..) | Rest => self,
+            NegS(a) => NegS(f(a)),
+            NegV(a) => NegV(f(a)),
+            Length(a) => Length(f(a)),
+            Normalize(a) => Normalize(f(a)),
+            Sqrt(a) => Sqrt(f(a)),
+            Abs(a) => Abs(f(a)),
+            Sin(a) => Sin(f(a)),
+            Cos(a) => Cos(f(a)),
+            Exp(a) => Exp(f(a)),
+            Ln(a) => Ln(f(a)),
+            Asin(a) => Asin(f(a)),
+            Acos(a) => Acos(f(a)),
+            Cbrt(a) => Cbrt(f(a)),
+            Sign(a) => Sign(f(a)),
+            Component(a, i) => Component(f(a), i),
+            AddS(a, b) => AddS(f(a), f(b)),
+            SubS(a, b) => SubS(f(a), f(b)),
+            MulS(a, b) => MulS(f(a), f(b)),
+            DivS(a, b) => DivS(f(a), f(b)),
+            AddV(a, b) => AddV(f(a), f(b)),
+            SubV(a, b) => SubV(f(a), f(b)),
+            Scale(a, b) => Scale(f(a), f(b)),
+            Shrink(a, b) => Shrink(f(a), f(b)),
+            Dot(a, b) => Dot(f(a), f(b)),
+            Cross(a, b) => Cross(f(a), f(b)),
+            Min(a, b) => Min(f(a), f(b)),
+            Max(a, b) => Max(f(a), f(b)),
+            Atan2(a, b) => Atan2(f(a), f(b)),
+            Det(a, b, c) => Det(f(a), f(b), f(c)),
+            Vec3(a, b, c) => Vec3(f(a), f(b), f(c)),
+            If(cmp, a, b, t, e) => {
+                let (a, b) = (f(a), f(b));
+                let (t, e) = (f(t), f(e));
+                If(cmp, a, b, t, e)
+            }
+        }
+    }
+
+    /// The registers it reads.
+    pub(super) fn inputs(self) -> ArrayVec<Reg, 4> {
+        let mut out = ArrayVec::new();
+        self.map_inputs(|r| {
+            out.push(r);
+            r
+        });
+        out
+    }
+
+    /// The same instruction reading `map[r]` for each register r it reads.
+    pub(super) fn renumbered(self, map: &[Reg]) -> Op {
+        self.map_inputs(|r| map[r as usize])
+    }
+
+    /// Whether its value is a vector (`input_is_vector` says for the registers it reads; a
+    /// constant is taken for a scalar unless it has a y or z).
+    pub(super) fn is_vector(self, input_is_vector: impl Fn(Reg) -> bool) -> bool {
+        match self {
+            Op::Particle(_)
+            | Op::RestParticle(_)
+            | Op::NegV(_)
+            | Op::AddV(..)
+            | Op::SubV(..)
+            | Op::Scale(..)
+            | Op::Shrink(..)
+            | Op::Cross(..)
+            | Op::Normalize(_)
+            | Op::Vec3(..) => true,
+            Op::Stored(_, vector) => vector,
+            Op::If(_, _, _, then, _) => input_is_vector(then),
+            Op::Const(x) => x[1] != 0.0 || x[2] != 0.0,
+            _ => false,
+        }
+    }
+
+    /// Whether C has a kink (or a jump) where this instruction switches: the zeros of `abs`'s
+    /// and `sign`'s argument, where `min`'s or `max`'s two agree, an `if`'s boundary.
+    pub(super) fn switches(self) -> bool {
+        matches!(
+            self,
+            Op::Abs(_) | Op::Min(..) | Op::Max(..) | Op::Sign(_) | Op::If(..)
+        )
+    }
+
+    /// Its value from the values `v` of the registers it reads, and the inputs.
+    #[inline(always)]
+    pub(super) fn apply<T: Real>(
+        self,
+        v: impl Fn(Reg) -> [T; 3],
+        inputs: &Inputs<'_, T>,
+    ) -> [T; 3] {
+        let s = |i: Reg| v(i)[0];
+        let scalar = |x: T| [x, T::ZERO, T::ZERO];
+        match self {
+            Op::Const(x) => x.map(T::from_f64),
+            Op::Particle(k) => inputs.points[k as usize],
+            Op::RestParticle(k) => inputs.shape[k as usize],
+            Op::Material(k) => scalar(inputs.material[k as usize]),
+            Op::Stored(at, vector) => {
+                let at = at as usize;
+                let s = inputs.stored;
+                if vector {
+                    [s[at], s[at + 1], s[at + 2]]
+                } else {
+                    scalar(s[at])
+                }
+            }
+            Op::Rest => scalar(inputs.rest),
+            Op::NegS(a) => scalar(-s(a)),
+            Op::NegV(a) => scale(v(a), -T::ONE),
+            Op::AddS(a, b) => scalar(s(a) + s(b)),
+            Op::SubS(a, b) => scalar(s(a) - s(b)),
+            Op::MulS(a, b) => scalar(s(a) * s(b)),
+            Op::DivS(a, b) => scalar(s(a) / s(b)),
+            Op::AddV(a, b) => add3(v(a), v(b)),
+            Op::SubV(a, b) => sub3(v(a), v(b)),
+            Op::Scale(a, b) => scale(v(a), s(b)),
+            Op::Shrink(a, b) => shrink(v(a), s(b)),
+            Op::Dot(a, b) => scalar(dot(v(a), v(b))),
+            Op::Cross(a, b) => cross(v(a), v(b)),
+            Op::Length(a) => scalar(dot(v(a), v(a)).sqrt()),
+            Op::Normalize(a) => shrink(v(a), dot(v(a), v(a)).sqrt()),
+            Op::Sqrt(a) => scalar(s(a).sqrt()),
+            Op::Abs(a) => {
+                let x = s(a);
+                scalar(T::select(x.le(T::ZERO), -x, x))
+            }
+            Op::Min(a, b) => {
+                let (x, y) = (s(a), s(b));
+                scalar(T::select(x.le(y), x, y))
+            }
+            Op::Max(a, b) => {
+                let (x, y) = (s(a), s(b));
+                scalar(T::select(x.gt(y), x, y))
+            }
+            Op::Det(a, b, c) => scalar(dot(v(a), cross(v(b), v(c)))),
+            Op::Sin(a) => scalar(s(a).sin()),
+            Op::Cos(a) => scalar(s(a).cos()),
+            Op::Exp(a) => scalar(s(a).exp()),
+            Op::Ln(a) => scalar(s(a).ln()),
+            Op::Atan2(y, x) => scalar(s(y).atan2(s(x))),
+            Op::Asin(a) => scalar(s(a).asin()),
+            Op::Acos(a) => scalar(s(a).acos()),
+            Op::Cbrt(a) => scalar(s(a).cbrt()),
+            Op::Sign(a) => {
+                let x = s(a);
+                let negative = T::select(T::ZERO.gt(x), -T::ONE, T::ZERO);
+                scalar(T::select(x.gt(T::ZERO), T::ONE, negative))
+            }
+            Op::Component(a, i) => scalar(v(a)[i as usize]),
+            Op::Vec3(a, b, c) => [s(a), s(b), s(c)],
+            Op::If(cmp, a, b, t, e) => {
+                let mask = holds(cmp, s(a), s(b));
+                let (t, e) = (v(t), v(e));
+                [0, 1, 2].map(|k| T::select(mask, t[k], e[k]))
+            }
+        }
+    }
+
+    /// Why its value is not finite, given the finite values `v` of what it reads.
+    pub(super) fn undefined(self, v: impl Fn(Reg) -> [f64; 3]) -> String {
+        let s = |i: Reg| v(i)[0];
+        match self {
+            Op::DivS(_, b) | Op::Shrink(_, b) if s(b) == 0.0 => "division by zero".to_owned(),
+            Op::Ln(a) => format!("log of {}: log is defined above 0", s(a)),
+            Op::Sqrt(a) => format!("sqrt of {}: sqrt is defined from 0 up", s(a)),
+            Op::Asin(a) => format!("asin of {}: asin is defined on -1..1", s(a)),
+            Op::Acos(a) => format!("acos of {}: acos is defined on -1..1", s(a)),
+            Op::Normalize(_) => "normalize of a zero vector: it has no direction".to_owned(),
+            _ => "the result is too large for f64".to_owned(),
+        }
+    }
+}
+
+/// Whether `a cmp b` (false with a NaN).
+#[inline(always)]
+pub(super) fn holds<T: Real>(cmp: CompareOp, a: T, b: T) -> T::Mask {
+    match cmp {
+        CompareOp::Less => b.gt(a),
+        CompareOp::LessOrEqual => a.le(b),
+        CompareOp::Greater => a.gt(b),
+        CompareOp::GreaterOrEqual => b.le(a),
+    }
+}
+
+#[inline(always)]
+pub(super) fn add3<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+#[inline(always)]
+pub(super) fn sub3<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+pub(super) fn scale<T: Real>(a: [T; 3], k: T) -> [T; 3] {
+    [a[0] * k, a[1] * k, a[2] * k]
+}
+
+#[inline(always)]
+pub(super) fn shrink<T: Real>(a: [T; 3], k: T) -> [T; 3] {
+    [a[0] / k, a[1] / k, a[2] / k]
+}
+
+#[inline(always)]
+pub(super) fn dot<T: Real>(a: [T; 3], b: [T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+pub(super) fn cross<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}

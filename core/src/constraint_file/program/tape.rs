@@ -1,0 +1,380 @@
+//! A tape ([`Tape`]): what some outputs of a [`super::Program`] need, as flat single-assignment
+//! instructions, run front to back for values ([`Tape::run`]) and back to front for gradients
+//! ([`Tape::gradient`], reverse mode), on the stack, in any [`Real`].
+
+use super::Origin;
+use super::op::{MAX_REGISTERS, Op, Reg, add3, cross, dot, holds, scale, shrink, sub3};
+use crate::numbers::vector::Real;
+use arrayvec::ArrayVec;
+
+/// What some outputs of a [`Program`] need, as flat single-assignment instructions: instruction k
+/// defines register k from earlier registers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tape {
+    pub(super) ops: Vec<Op>,
+    pub(super) origins: Vec<Origin>,
+    pub(super) outputs: Vec<Reg>,
+    /// For a prelude, whether each output is a vector (three stored numbers) or a scalar.
+    pub(super) widths: Vec<bool>,
+    /// Whether each register depends on a particle: the backward pass skips the others, and
+    /// carries no adjoint into them (a stored number, a constant, `rest`).
+    pub(super) varying: Vec<bool>,
+}
+
+/// What a tape reads besides its instructions: the particles, their rest positions, the rest
+/// value, the material (μ, λ, γ) and the numbers stored for the element ([`Op::Stored`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Inputs<'a, T> {
+    /// p0, p1, …
+    pub points: &'a [[T; 3]],
+    /// q0, q1, …: the rest positions (the points again, for a tape that reads none).
+    pub shape: &'a [[T; 3]],
+    /// `rest`.
+    pub rest: T,
+    /// μ, λ and γ = 1 + μ/λ.
+    pub material: [T; 3],
+    /// What the element stores ([`super::Compiled::prelude`] worked it out).
+    pub stored: &'a [T],
+}
+
+impl<'a, T: Real> Inputs<'a, T> {
+    /// The inputs of a tape that reads only the particles and `rest`.
+    pub fn of(points: &'a [[T; 3]], rest: T) -> Self {
+        Inputs {
+            points,
+            shape: points,
+            rest,
+            material: [T::ZERO; 3],
+            stored: &[],
+        }
+    }
+}
+
+/// The registers of a tape after [`Tape::run`]: read its outputs.
+pub struct Registers<'a, T> {
+    registers: &'a [[T; 3]],
+    outputs: &'a [Reg],
+    widths: &'a [bool],
+}
+
+impl<T: Copy> Registers<'_, T> {
+    /// Output `i` of the tape as a scalar.
+    pub fn scalar(&self, i: usize) -> T {
+        self.registers[self.outputs[i] as usize][0]
+    }
+
+    /// Output `i` of the tape as a vector.
+    pub fn vector(&self, i: usize) -> [T; 3] {
+        self.registers[self.outputs[i] as usize]
+    }
+
+    /// A prelude's outputs, in order, into `out`: a scalar's one number, a vector's three
+    /// ([`super::Compiled::stored`] of them in all).
+    pub fn write_all(&self, out: &mut [T]) {
+        let mut at = 0;
+        for (i, &vector) in self.widths.iter().enumerate() {
+            let v = self.vector(i);
+            let width = if vector { 3 } else { 1 };
+            out[at..at + width].copy_from_slice(&v[..width]);
+            at += width;
+        }
+    }
+}
+
+/// What the backward pass adds into a register.
+#[derive(Clone, Copy)]
+enum Adjoint<T> {
+    Scalar(T),
+    Vector([T; 3]),
+}
+
+/// Where a tape's value stops being finite ([`Tape::undefined_at`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Undefined {
+    /// Where the text of the expression that gives the first non-finite value starts
+    /// ([`Program::at`]).
+    pub base: usize,
+    /// The byte of that text where it is.
+    pub offset: usize,
+    /// What it is (`/`, `acos`) and why (`acos of 1.0000001: acos is defined on -1..1`).
+    pub message: String,
+}
+
+/// A place where C may have a kink or a jump ([`Tape::switches_at`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Switch {
+    /// Where the expression's text starts ([`Program::at`]).
+    pub base: usize,
+    /// The byte of that text.
+    pub offset: usize,
+    /// What it is: `abs`, `min`, `if`…
+    pub what: &'static str,
+    /// The value whose zero is the kink, at the configuration asked about.
+    pub decides: f64,
+}
+
+impl Tape {
+    /// Whether it reads the rest shape (q0…).
+    pub fn reads_rest_shape(&self) -> bool {
+        self.ops.iter().any(|op| matches!(op, Op::RestParticle(_)))
+    }
+
+    /// How many instructions (and registers) it has.
+    pub fn len(&self) -> usize {
+        self.ops.len()
+    }
+
+    /// Whether it has none.
+    pub fn is_empty(&self) -> bool {
+        self.ops.is_empty()
+    }
+
+    /// Runs the tape on `inputs` and reads its outputs with `read`.
+    #[inline]
+    pub fn run<T: Real, R>(
+        &self,
+        inputs: &Inputs<'_, T>,
+        read: impl FnOnce(&Registers<'_, T>) -> R,
+    ) -> R {
+        let mut registers = ArrayVec::new();
+        self.forward(inputs, &mut registers);
+        read(&Registers {
+            registers: &registers,
+            outputs: &self.outputs,
+            widths: &self.widths,
+        })
+    }
+
+    /// The first instruction, in evaluation order, whose value is not finite while what it reads
+    /// is, at `points` with `rest`: where and why C is undefined there. `None` where every value
+    /// is finite.
+    pub fn undefined_at(&self, inputs: &Inputs<'_, f64>) -> Option<Undefined> {
+        let mut r: ArrayVec<[f64; 3], MAX_REGISTERS> = ArrayVec::new();
+        for (op, origin) in self.ops.iter().zip(&self.origins) {
+            let value = op.apply(|i| r[i as usize], inputs);
+            let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+            if !finite(&value) && op.inputs().iter().all(|&i| finite(&r[i as usize])) {
+                return Some(Undefined {
+                    base: origin.base,
+                    offset: origin.offset,
+                    message: format!(
+                        "`{}` is undefined: {}",
+                        origin.what,
+                        op.undefined(|i| r[i as usize])
+                    ),
+                });
+            }
+            r.push(value);
+        }
+        None
+    }
+
+    /// Where C may have a kink or a jump: for each `abs`, `sign`, `min`, `max`, `clamp` and
+    /// `if` on C's path, where it is (as [`Undefined`] says) and what it is, with the value at
+    /// `points` of what decides it (the argument of `abs`, the difference of `min`'s two, the
+    /// two sides of a condition): the kink is where that value is 0.
+    pub fn switches_at(&self, inputs: &Inputs<'_, f64>) -> Vec<Switch> {
+        let mut r: ArrayVec<[f64; 3], MAX_REGISTERS> = ArrayVec::new();
+        let mut out = Vec::new();
+        for (op, origin) in self.ops.iter().zip(&self.origins) {
+            if op.switches() {
+                let s = |i: Reg| r[i as usize][0];
+                let decides = match *op {
+                    Op::Abs(a) | Op::Sign(a) => s(a),
+                    Op::Min(a, b) | Op::Max(a, b) => s(a) - s(b),
+                    Op::If(_, a, b, ..) => s(a) - s(b),
+                    _ => f64::NAN,
+                };
+                out.push(Switch {
+                    base: origin.base,
+                    offset: origin.offset,
+                    what: origin.what,
+                    decides,
+                });
+            }
+            r.push(op.apply(|i| r[i as usize], inputs));
+        }
+        out
+    }
+
+    /// Output 0, C, and its gradient with respect to every particle, by reverse mode: the values
+    /// forward, then r̄ = ∂C/∂r from C back to the particles, each instruction by the derivative
+    /// rule of what it computes. Non-finite where the gradient is undefined (a zero vector's
+    /// length or direction, a division by zero, `acos` at ±1).
+    ///
+    /// Generic over [`Real`]: run on [`crate::numbers::dual::Tangent`] numbers it gives the
+    /// derivative of the gradient along the tangents, a column of the Hessian.
+    #[inline]
+    pub fn gradient<T: Real, const N: usize>(&self, inputs: &Inputs<'_, T>) -> (T, [[T; 3]; N]) {
+        let mut r = ArrayVec::new();
+        self.forward(inputs, &mut r);
+        let r = &r;
+        let out = self.outputs[0] as usize;
+        let mut adjoint: ArrayVec<[T; 3], MAX_REGISTERS> = ArrayVec::new();
+        for _ in 0..=out {
+            adjoint.push([T::ZERO; 3]);
+        }
+        adjoint[out][0] = T::ONE;
+        let mut gradient = [[T::ZERO; 3]; N];
+        let varying = &self.varying;
+        for k in (0..=out).rev() {
+            if !varying[k] {
+                continue;
+            }
+            let bar = adjoint[k];
+            let s = bar[0];
+            let value = |i: Reg| r[i as usize];
+            let x = |i: Reg| r[i as usize][0];
+            // r̄ into register i: all three components for a vector, the first for a scalar;
+            // nothing into (and no work for) a register that does not depend on a particle.
+            macro_rules! add {
+                ($i:expr, $v:expr) => {
+                    if varying[$i as usize] {
+                        let into = &mut adjoint[$i as usize];
+                        match $v {
+                            Adjoint::Vector(v) => {
+                                into[0] += v[0];
+                                into[1] += v[1];
+                                into[2] += v[2];
+                            }
+                            Adjoint::Scalar(x) => into[0] += x,
+                        }
+                    }
+                };
+            }
+            let scalar = |x: T| Adjoint::Scalar(x);
+            let vector = |v: [T; 3]| Adjoint::Vector(v);
+            match self.ops[k] {
+                Op::Const(_)
+                | Op::Rest
+                | Op::Sign(_)
+                | Op::RestParticle(_)
+                | Op::Material(_)
+                | Op::Stored(..) => {}
+                Op::Particle(p) if (p as usize) < N => {
+                    gradient[p as usize] = add3(gradient[p as usize], bar)
+                }
+                Op::Particle(_) => {}
+                Op::NegS(a) => add!(a, scalar(-s)),
+                Op::NegV(a) => add!(a, vector(scale(bar, -T::ONE))),
+                Op::AddS(a, b) => {
+                    add!(a, scalar(s));
+                    add!(b, scalar(s));
+                }
+                Op::SubS(a, b) => {
+                    add!(a, scalar(s));
+                    add!(b, scalar(-s));
+                }
+                Op::MulS(a, b) => {
+                    add!(a, scalar(s * x(b)));
+                    add!(b, scalar(s * x(a)));
+                }
+                Op::DivS(a, b) => {
+                    // r = a / b: ā += r̄ / b, b̄ −= r̄ r / b.
+                    let d = x(b);
+                    add!(a, scalar(s / d));
+                    add!(b, scalar(-(s * r[k][0]) / d));
+                }
+                Op::AddV(a, b) => {
+                    add!(a, vector(bar));
+                    add!(b, vector(bar));
+                }
+                Op::SubV(a, b) => {
+                    add!(a, vector(bar));
+                    add!(b, vector(scale(bar, -T::ONE)));
+                }
+                Op::Scale(v, f) => {
+                    // r = v f: v̄ += r̄ f, f̄ += r̄·v.
+                    add!(v, vector(scale(bar, x(f))));
+                    add!(f, scalar(dot(bar, value(v))));
+                }
+                Op::Shrink(v, f) => {
+                    // r = v / f: v̄ += r̄ / f, f̄ −= r̄·r / f.
+                    let d = x(f);
+                    add!(v, vector(shrink(bar, d)));
+                    add!(f, scalar(-dot(bar, r[k]) / d));
+                }
+                Op::Dot(a, b) => {
+                    add!(a, vector(scale(value(b), s)));
+                    add!(b, vector(scale(value(a), s)));
+                }
+                Op::Cross(a, b) => {
+                    // r = a × b: ā += b × r̄, b̄ += r̄ × a.
+                    add!(a, vector(cross(value(b), bar)));
+                    add!(b, vector(cross(bar, value(a))));
+                }
+                Op::Length(a) => add!(a, vector(scale(value(a), s / r[k][0]))),
+                Op::Normalize(a) => {
+                    // r = a / |a|: ā += (r̄ − r (r·r̄)) / |a|.
+                    let n = r[k];
+                    let length = dot(value(a), value(a)).sqrt();
+                    let along = dot(n, bar);
+                    add!(a, vector(shrink(sub3(bar, scale(n, along)), length)));
+                }
+                Op::Sqrt(a) => add!(a, scalar(s / (r[k][0] + r[k][0]))),
+                Op::Abs(a) => add!(a, scalar(T::select(x(a).le(T::ZERO), -s, s))),
+                Op::Min(a, b) => {
+                    let first = x(a).le(x(b));
+                    add!(a, scalar(T::select(first, s, T::ZERO)));
+                    add!(b, scalar(T::select(first, T::ZERO, s)));
+                }
+                Op::Max(a, b) => {
+                    let first = x(a).gt(x(b));
+                    add!(a, scalar(T::select(first, s, T::ZERO)));
+                    add!(b, scalar(T::select(first, T::ZERO, s)));
+                }
+                Op::Det(a, b, c) => {
+                    // r = a·(b × c): ā += r̄ b×c, b̄ += r̄ c×a, c̄ += r̄ a×b.
+                    let (a_, b_, c_) = (value(a), value(b), value(c));
+                    add!(a, vector(scale(cross(b_, c_), s)));
+                    add!(b, vector(scale(cross(c_, a_), s)));
+                    add!(c, vector(scale(cross(a_, b_), s)));
+                }
+                // r = sin a: ā += r̄ cos a; r = cos a: ā −= r̄ sin a.
+                Op::Sin(a) => add!(a, scalar(s * x(a).cos())),
+                Op::Cos(a) => add!(a, scalar(-(s * x(a).sin()))),
+                // r = eᵃ: ā += r̄ r; r = log a: ā += r̄ / a.
+                Op::Exp(a) => add!(a, scalar(s * r[k][0])),
+                Op::Ln(a) => add!(a, scalar(s / x(a))),
+                Op::Atan2(y, x_) => {
+                    // r = atan2(y, x): ȳ += r̄ x / (x² + y²), x̄ −= r̄ y / (x² + y²).
+                    let (yv, xv) = (x(y), x(x_));
+                    let d = xv * xv + yv * yv;
+                    add!(y, scalar(s * xv / d));
+                    add!(x_, scalar(-(s * yv) / d));
+                }
+                // r = asin a: ā += r̄ / √(1 − a²); r = acos a: ā −= r̄ / √(1 − a²).
+                Op::Asin(a) => add!(a, scalar(s / (T::ONE - x(a) * x(a)).sqrt())),
+                Op::Acos(a) => add!(a, scalar(-(s / (T::ONE - x(a) * x(a)).sqrt()))),
+                // r = ∛a: ā += r̄ / (3 r²).
+                Op::Cbrt(a) => add!(a, scalar(s / (T::from_f64(3.0) * r[k][0] * r[k][0]))),
+                Op::Component(a, i) => {
+                    let mut v = [T::ZERO; 3];
+                    v[i as usize] = s;
+                    add!(a, vector(v));
+                }
+                Op::Vec3(a, b, c) => {
+                    add!(a, scalar(bar[0]));
+                    add!(b, scalar(bar[1]));
+                    add!(c, scalar(bar[2]));
+                }
+                Op::If(cmp, a, b, t, e) => {
+                    let mask = holds(cmp, x(a), x(b));
+                    add!(t, vector(bar.map(|v| T::select(mask, v, T::ZERO))));
+                    add!(e, vector(bar.map(|v| T::select(mask, T::ZERO, v))));
+                }
+            }
+        }
+        (r[out][0], gradient)
+    }
+
+    /// Every register's value, instruction by instruction, into `r` (empty; the caller's, so
+    /// that it is never moved).
+    #[inline]
+    fn forward<T: Real>(&self, inputs: &Inputs<'_, T>, r: &mut ArrayVec<[T; 3], MAX_REGISTERS>) {
+        for op in &self.ops {
+            let value = op.apply(|i| r[i as usize], inputs);
+            r.push(value);
+        }
+    }
+}
