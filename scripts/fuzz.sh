@@ -68,7 +68,15 @@ seed() {
     lesson)
       cp assets/lessons/*.toml "$dir/" ;;
     constraint_file)
-      cp assets/constraints/*.toml "$dir/" ;;
+      cp assets/constraints/*.toml "$dir/"
+      # The generator's inputs (fuzz/fuzz_targets/constraint_file.rs): NUL-separated segments,
+      # N*TEXT repeating TEXT, for the deep and long files that once crashed the parser.
+      local head='name = "g"\napplies_to = "edges"\n'
+      printf "${head}"'value = "\00010000*(\0001\00010000*)\000"\n' >"$dir/gen-parentheses"
+      printf "${head}"'value = "\00010000*abs(\0001\00010000*)\000"\n' >"$dir/gen-abs"
+      printf "${head}"'value = "\00020000*-\0001\000"\n' >"$dir/gen-minus"
+      printf "${head}"'value = "\00055000*p0.x + \0001\000"\n' >"$dir/gen-sum"
+      printf "${head}"'define = "k = \00010000*(\0001\00010000*)\000"\nvalue = "k"\n' >"$dir/gen-define" ;;
     rrd)
       cargo run --quiet --locked -- record --scene tet --frames 2 --arrows none --quiet --out "$dir/tet.rrd" >/dev/null
       cargo run --quiet --locked -- record --scene cube --resolution 1 --frames 1 --quiet --out "$dir/cube.rrd" >/dev/null ;;
@@ -93,6 +101,9 @@ for target in "${targets[@]}"; do
   # A recording's first 16 KB hold its header and a dozen messages (each decoded as arrow): the
   # whole files, ten times as long, would make each run ten times as slow.
   [ "$target" = rrd ] && extra=(-max_len=16384)
+  # Long enough for the generator's inputs to grow past libFuzzer's default of 4,096 bytes;
+  # they stand for texts of up to 2 MB (see the target).
+  [ "$target" = constraint_file ] && extra=(-max_len=65536)
   "${fuzz_env[@]}" cargo fuzz run "${build[@]}" "$target" "$corpus" "$seeded" -- \
     "${limit[@]}" "${extra[@]}" -malloc_limit_mb=1024 -rss_limit_mb=3072 -timeout=10 \
     -artifact_prefix="fuzz/artifacts/$target/" -print_final_stats=1 >"$log" 2>&1 || status=$?

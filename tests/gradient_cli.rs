@@ -481,3 +481,268 @@ fn gradient_of_a_constraint_file_shows_automatic_yours_and_finite_differences() 
     }
     assert_eq!(v["degenerate"], false);
 }
+
+/// A file `name` with `text` in a fresh folder (whose name has a space, as paths do), and the
+/// folder to remove.
+fn written(name: &str, text: &str) -> (std::path::PathBuf, String) {
+    let dir = std::env::temp_dir().join(format!("tetlab constraint {} {name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    let shown = path.to_str().unwrap().to_owned();
+    (dir, shown)
+}
+
+/// Each of `check-gradients`, `run` and `gradient` on the edge file `path`, as a user runs them.
+fn every_command(path: &str) -> Vec<std::process::Output> {
+    vec![
+        tetlab(&[
+            "check-gradients",
+            "--constraint-file",
+            path,
+            "--configs",
+            "50",
+        ]),
+        tetlab(&[
+            "run",
+            "--scene",
+            "tet",
+            "--frames",
+            "1",
+            "--constraint-file",
+            path,
+        ]),
+        tetlab(&[
+            "gradient",
+            "--constraint-file",
+            path,
+            "--points",
+            "0,0,0",
+            "1,0,0",
+        ]),
+    ]
+}
+
+#[test]
+fn inputs_that_crashed_the_parser_exit_two_at_their_place_in_every_command() {
+    let header = "name = \"c\"\napplies_to = \"edges\"\n";
+    let deep =
+        |n: usize, open: &str, inner: &str| format!("{}{inner}{}", open.repeat(n), ")".repeat(n));
+    let sum = vec!["length(p0 - p1)"; 70_000].join(" + ");
+    let cases = [
+        (
+            "parentheses",
+            format!("{header}value = \"{}\"\n", deep(10_000, "(", "1")),
+        ),
+        (
+            "define",
+            format!(
+                "{header}define = \"k = {}\"\nvalue = \"k\"\n",
+                deep(10_000, "(", "1")
+            ),
+        ),
+        (
+            "gradient",
+            format!(
+                "{header}value = \"length(p0 - p1)\"\n[gradient]\np0 = \"{}\"\n",
+                deep(10_000, "(", "p0")
+            ),
+        ),
+        (
+            "abs",
+            format!("{header}value = \"{}\"\n", deep(10_000, "abs(", "1")),
+        ),
+        (
+            "minus",
+            format!("{header}value = \"{}1\"\n", "-".repeat(20_000)),
+        ),
+        ("megabyte", format!("{header}value = \"{sum}\"\n")),
+    ];
+    for (what, text) in cases {
+        assert!(what != "megabyte" || text.len() > 1_000_000);
+        let (dir, path) = written(&format!("{what}.toml"), &text);
+        for output in every_command(&path) {
+            let err = assert_usage_error(&output, "nests too deeply");
+            // `run` says which option it was: "--constraint-file PATH:LINE:COLUMN: …".
+            let at = err
+                .find(&format!("{path}:"))
+                .unwrap_or_else(|| panic!("{what}: {err}"));
+            let place: Vec<&str> = err[at + path.len() + 1..].splitn(3, ':').collect();
+            assert!(
+                place[0].parse::<usize>().is_ok() && place[1].parse::<usize>().is_ok(),
+                "{what}: no line and column in {err}"
+            );
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn an_undefined_constant_exits_two_at_its_place_in_every_command() {
+    for (value, what) in [
+        ("length(p0 - p1) / (1 - 1)", "division by zero"),
+        ("length(p0 - p1) + 1e308 * 10", "too large"),
+        ("length(p0 - p1) + log(0)", "log of 0"),
+    ] {
+        let text = format!("name = \"c\"\napplies_to = \"edges\"\nvalue = \"{value}\"\n");
+        let (dir, path) = written("undefined.toml", &text);
+        for output in every_command(&path) {
+            let err = assert_usage_error(&output, what);
+            assert!(err.contains(&format!("{path}:3:")), "{err}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+/// `check-gradients` on an edge file whose value is `value` and gradient `gradient`.
+fn checked(value: &str, gradient: &str, json: bool) -> (std::process::Output, String) {
+    let text = format!(
+        "name = \"c\"\napplies_to = \"edges\"\nvalue = \"{value}\"\n[gradient]\n{gradient}\n"
+    );
+    let (dir, path) = written("check.toml", &text);
+    let mut args = vec![
+        "check-gradients",
+        "--constraint-file",
+        &path,
+        "--configs",
+        "200",
+    ];
+    if json {
+        args.push("--json");
+    }
+    let output = tetlab(&args);
+    std::fs::remove_dir_all(&dir).unwrap();
+    (output, path)
+}
+
+#[test]
+fn the_checks_messages_say_what_is_true() {
+    // An error of 10⁻⁴ at one particle, in two significant digits.
+    let (output, _) = checked(
+        "length(p0 - p1)",
+        "p0 = \"normalize(p0 - p1) * 1.0001\"\np1 = \"normalize(p1 - p0)\"",
+        false,
+    );
+    assert_eq!(output.status.code(), Some(1));
+    let text = stdout(&output);
+    assert!(
+        text.contains("p0 is off by 1.0e-4 of the gradient's size"),
+        "{text}"
+    );
+    // Translation invariance is reported for your gradient too.
+    assert!(
+        text.contains("AD's yes") && text.contains("and yours no"),
+        "{text}"
+    );
+    // A gradient that is never finite is "non_finite" in JSON, not null ("not given").
+    let (output, _) = checked(
+        "length(p0 - p1)",
+        "p0 = \"normalize(p0 - p1) * log(length(p0 - p1) - length(p0 - p1))\"",
+        true,
+    );
+    let v: Value = serde_json::from_str(&stdout(&output)).unwrap();
+    assert_eq!(v["max_relative_error"]["p0"], "non_finite", "{v}");
+    assert!(v["max_relative_error"]["p1"].is_null(), "{v}");
+    // Where AD's gradient is zero the error is absolute, and said to be.
+    let (output, _) = checked("0 * length(p0 - p1)", "p0 = \"vec3(0.5, 0, 0)\"", false);
+    let text = stdout(&output);
+    assert!(
+        text.contains("off by 0.50 (absolute: AD's gradient is zero there)"),
+        "{text}"
+    );
+}
+
+#[test]
+fn the_suggested_command_runs_from_a_path_with_a_space() {
+    let text = "name = \"c\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p1)\"\n[gradient]\np0 = \"normalize(p1 - p0)\"\n";
+    let (dir, path) = written("wrong.toml", text);
+    let output = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &path,
+        "--configs",
+        "50",
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(&stdout(&output)).unwrap();
+    let command = v["worst"]["command"].as_str().unwrap();
+    let mut words = shlex::split(command).expect("a command a shell reads");
+    assert_eq!(words.remove(0), "tetlab");
+    assert!(words.contains(&path), "{command}");
+    words.push("--json".into());
+    let args: Vec<&str> = words.iter().map(String::as_str).collect();
+    let shown = json(&args);
+    assert_eq!(shown["name"], "c");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn kinks_are_reported_where_they_are() {
+    let text =
+        "name = \"k\"\napplies_to = \"edges\"\nvalue = \"abs(p0.x - p1.x) + max(p0.y, 0)\"\n";
+    let (dir, path) = written("kinks.toml", text);
+    let output = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &path,
+        "--configs",
+        "100",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let out = stdout(&output);
+    assert!(out.contains("C has kinks"), "{out}");
+    assert!(out.contains(&format!("abs at {path}:3:10")), "{out}");
+    assert!(out.contains(&format!("max at {path}:3:29")), "{out}");
+    // On the kink of abs, `gradient` says so.
+    let output = tetlab(&[
+        "gradient",
+        "--constraint-file",
+        &path,
+        "--points",
+        "0.5,-1,0",
+        "0.5,0,0",
+    ]);
+    let out = stdout(&output);
+    assert!(
+        out.contains("kink        yes") && out.contains("abs at"),
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_file_of_several_constraints_is_checked_constraint_by_constraint() {
+    let output = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &asset("neohookean.toml"),
+        "--configs",
+        "300",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stdout(&output);
+    let rows: Vec<Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["name"], "my-neohookean-deviatoric");
+    assert_eq!(rows[1]["name"], "my-neohookean-hydrostatic");
+    for row in &rows {
+        assert!(
+            row["automatic_vs_finite_difference"].as_f64().unwrap() < 1e-6,
+            "{row}"
+        );
+        assert_eq!(row["translation_invariant"], true);
+    }
+    // The bending example's hand gradient agrees with AD.
+    let output = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &asset("bending.toml"),
+        "--configs",
+        "300",
+    ]);
+    assert_eq!(output.status.code(), Some(0), "{}", stdout(&output));
+}

@@ -294,18 +294,7 @@ fn reverse_and_forward_mode_agree_on_every_example() {
                     .evaluate(points, rest, &stored)
                     .automatic
                     .expect("well conditioned");
-                let reverse: Vec<DVec3> = match file.arity() {
-                    2 => file
-                        .evaluate_by(&[points[0], points[1]], rest, &stored, false)
-                        .gradients
-                        .to_vec(),
-                    _ => {
-                        let p: [DVec3; 4] = std::array::from_fn(|i| points[i]);
-                        file.evaluate_by(&p, rest, &stored, false)
-                            .gradients
-                            .to_vec()
-                    }
-                };
+                let reverse = file.gradients_of(points, rest, &stored, false);
                 let scale = forward.iter().map(|g| g.length()).fold(0.0, f64::max);
                 for (f, r) in forward.iter().zip(&reverse) {
                     worst = worst.max((*f - *r).length() / scale);

@@ -220,12 +220,12 @@ fn the_reverse_tape_on_tangents_gives_second_derivatives() {
         plus[0][axis] += h;
         minus[0][axis] -= h;
         let g = |q: &[DVec3; 2]| file.evaluate_vectors(q, 0.0, &[]).gradients;
-        for k in 0..2 {
-            let numeric = (g(&plus)[k] - g(&minus)[k]) / (2.0 * h);
+        let (above, below) = (g(&plus), g(&minus));
+        for (k, exact) in column.iter().enumerate() {
+            let numeric = (above[k] - below[k]) / (2.0 * h);
             assert!(
-                (column[k] - numeric).length() < 1e-6,
-                "axis {axis}, p{k}: {} against {numeric}",
-                column[k]
+                (*exact - numeric).length() < 1e-6,
+                "axis {axis}, p{k}: {exact} against {numeric}"
             );
         }
     }
@@ -318,4 +318,29 @@ fn inputs_that_crashed_the_parser_are_errors_at_their_place_on_a_1_mb_stack() {
         ConstraintFile::parse(Path::new("deep.toml"), &file_with("value", &negations))
             .unwrap_or_else(|e| panic!("{e}"));
     });
+}
+
+#[test]
+fn the_material_and_the_rest_shape_are_read_once_per_element_and_follow_a_new_material() {
+    use tetlab_core::constraints::material::Material;
+    // C = μ (|p0 − p1| − |q0 − q1|) / λ: μ / λ and the rest length are stored, not recomputed.
+    let file = edge_file("", "mu / lambda * (length(p0 - p1) - length(q0 - q1))").unwrap();
+    assert_eq!(file.stored_len(), 2);
+    let rest_shape = [DVec3::ZERO, DVec3::X];
+    let stretched = [DVec3::ZERO, 3.0 * DVec3::X];
+    for (young, poisson) in [(1e6, 0.3), (5e4, 0.45)] {
+        let material = Material { young, poisson };
+        let stored = file.store(&rest_shape, &material);
+        let expected = material.mu() / material.lambda() * 2.0;
+        let value = file.value(&stretched, 0.0, &stored);
+        assert!(
+            (value - expected).abs() < 1e-15 * expected,
+            "{value} against {expected}"
+        );
+        // The same in the lanes, from the stored numbers in f32.
+        let lanes = stretched.map(|p| Vec3x8::gather([p.as_vec3a(); 8]));
+        let stored32: Vec<F32x8> = stored.iter().map(|&x| F32x8::from_f64(x)).collect();
+        let e = file.evaluate_vectors(&lanes, F32x8::ZERO, &stored32);
+        assert!((f64::from(e.value.to_array()[0]) - expected).abs() < 1e-6 * expected);
+    }
 }

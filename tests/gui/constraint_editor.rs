@@ -195,3 +195,33 @@ fn a_dropped_constraint_file_opens_in_the_editor() {
     let table = families(&harness);
     assert!(visual::family_colour(&table, family) != visual::family_colour(&table, Family::VOLUME));
 }
+
+/// The neo-Hookean example holds two constraints: pressed in the editor, both are defined and
+/// switched on, projected as a pair, and the editor's previous family is switched off.
+#[test]
+fn a_file_of_two_constraints_defines_both_from_the_editor() {
+    let mut harness = workbench("cube", 2);
+    with_examples(&mut harness);
+    harness.key_press(egui::Key::G);
+    harness.run_steps(2);
+    harness
+        .get_by_role_and_label(egui::accesskit::Role::Button, "neohookean")
+        .click();
+    harness.run_steps(2);
+    let table = families(&harness);
+    let deviatoric = table.parse("my-neohookean-deviatoric").unwrap();
+    let hydrostatic = table.parse("my-neohookean-hydrostatic").unwrap();
+    let active = harness.state().bench.simulation.settings().active;
+    assert!(active[deviatoric] && active[hydrostatic]);
+    assert!(!active[table.parse("my-height").unwrap()]);
+    assert_eq!(table.partner_in(deviatoric, &active), Some(hydrostatic));
+    assert_eq!(harness.state().editor.family, Some(deviatoric));
+    // Played from a mirror, the pair brings the cube back, as the built-in does.
+    harness.key_press(egui::Key::M);
+    harness.run_steps(2);
+    assert!(harness.state().bench.metrics.inverted_tets > 0, "mirrored");
+    for _ in 0..90 {
+        harness.state_mut().bench.step_frame();
+    }
+    assert_eq!(harness.state().bench.metrics.inverted_tets, 0);
+}

@@ -239,9 +239,11 @@ impl TetlabApp {
         {
             self.editor.set_text(&file.path, &file.source);
             self.editor.family = Some(family);
+            self.editor.families = vec![family];
         } else {
             // The lesson's table replaces the workbench's: what the editor defined is not in it.
             self.editor.family = None;
+            self.editor.families.clear();
             self.editor.report = None;
         }
         self.load(lesson.scene());
@@ -430,7 +432,7 @@ impl TetlabApp {
                 self.editor.open = true;
                 self.error = None;
                 match self.editor.set_text(&path, &text) {
-                    Some(file) => self.define_constraint(file),
+                    Some(files) => self.define_constraints(files),
                     None => self.error = self.editor.error.clone(),
                 }
             }
@@ -442,21 +444,33 @@ impl TetlabApp {
     /// same name), switches it on (and the editor's previous family off, when the name
     /// changed), and rebuilds its constraints in every simulation shown.
     pub fn define_constraint(&mut self, file: tetlab_core::constraint_file::ConstraintFile) {
+        self.define_constraints(vec![file]);
+    }
+
+    /// [`TetlabApp::define_constraint`] for every constraint of a file (one per
+    /// `[[constraint]]`): each is defined and switched on, and those of the editor's previous
+    /// text that this one does not define are switched off.
+    pub fn define_constraints(&mut self, files: Vec<tetlab_core::constraint_file::ConstraintFile>) {
         let mut families = self.bench.simulation.families().clone();
-        let family = match families.define(file) {
-            Ok(family) => family,
+        let defined = match families.define_all(files) {
+            Ok(defined) => defined,
             Err(message) => {
                 self.editor.error = Some(format!("{}: {message}", self.editor.path.display()));
                 return;
             }
         };
-        let previous = self.editor.family.replace(family);
+        let previous = std::mem::replace(&mut self.editor.families, defined.clone());
+        self.editor.family = defined.first().copied();
         let mut settings = *self.bench.simulation.settings();
-        if previous != Some(family) {
-            if let Some(previous) = previous {
-                settings.active[previous] = false;
+        for &family in &defined {
+            if !previous.contains(&family) {
+                settings.active[family] = true;
             }
-            settings.active[family] = true;
+        }
+        for family in previous {
+            if !defined.contains(&family) {
+                settings.active[family] = false;
+            }
         }
         if let Some(comparison) = &mut self.comparison {
             comparison.bench.set_families(families.clone());
@@ -489,7 +503,7 @@ impl TetlabApp {
             Request::Lesson(request) => self.lesson_request(request),
             Request::Compare(families) => self.compare(families),
             Request::Settings(settings) => self.set_settings(*settings),
-            Request::Constraint(file) => self.define_constraint(*file),
+            Request::Constraint(files) => self.define_constraints(files),
         }
     }
 
@@ -517,8 +531,8 @@ impl TetlabApp {
                         .iter()
                         .find(|e| e.file == "height.toml")
                         .unwrap_or(&tetlab_core::constraint_file::EXAMPLES[0]);
-                    if let Some(file) = self.editor.set_text(&example.shown(), example.text) {
-                        self.define_constraint(file);
+                    if let Some(files) = self.editor.set_text(&example.shown(), example.text) {
+                        self.define_constraints(files);
                     }
                 }
             }

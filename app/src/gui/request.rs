@@ -22,7 +22,7 @@ pub enum Request {
     /// New solver settings, for every simulation shown.
     Settings(Box<Settings>),
     /// A constraint file the editor compiled: its family is (re)defined and switched on.
-    Constraint(Box<ConstraintFile>),
+    Constraint(Vec<ConstraintFile>),
 }
 
 /// A scene the user asked for.

@@ -1,5 +1,5 @@
 //! A constraint written by a user in a file: C as an expression of the particles p0…p3, bound to a
-//! mesh like a built-in family (per edge, per tet, per tet vertex), its gradient by automatic
+//! mesh like a built-in family (per edge, per tet, per tet vertex, per surface triangle or hinge), its gradient by automatic
 //! differentiation ([`crate::numbers::dual`]) and, optionally, the user's own derivation of it, checked
 //! against that ([`check`]).
 //!
@@ -7,7 +7,7 @@
 //! TOML, e.g. `assets/constraints/height.toml`:
 //! ```toml
 //! name = "my-height"
-//! applies_to = "tet-vertices"   # "edges": p0 p1; "tets": p0..p3; "tet-vertices": four per tet
+//! applies_to = "tet-vertices"   # or edges, tets, triangles, hinges
 //! define = """
 //! e1 = p1 - p0
 //! c = cross(p2 - p0, p3 - p0)
@@ -18,8 +18,16 @@
 //! p1 = "n"
 //! ```
 //! `rest` is `value` with rest = 0 on the rest configuration, unless `rest = "…"` gives it.
-//! Expressions: numbers, names, `+ − * /`, unary −, parentheses, and `dot cross length normalize
-//! sqrt abs min max det` ([`program`]). Every mistake is reported at file:line:column.
+//! Expressions ([`expression`], [`program`]) over scalars, 3-vectors and 3×3 matrices, over several
+//! lines if need be: `+ − * /`, components (`v.x`, `M.xy`), the functions `dot cross length
+//! normalize det vec3 mat3 outer transpose inverse trace norm sqrt cbrt pow exp log sin cos tan
+//! asin acos atan2 abs sign min max clamp if`, the rest shape (`q0`…, `Dm`, `Ds`, `F`, `V0`) and
+//! the material (`mu`, `lambda`, `gamma`). The bindings are `edges`, `tets`, `tet-vertices`,
+//! `triangles` and `hinges` ([`Binding`]). Several constraints go in `[[constraint]]` tables,
+//! each with its `stiffness`, two of them projected together as a `pair`
+//! ([`ConstraintFile::parse_all`];
+//! `assets/constraints/neohookean.toml`). Every mistake is reported at file:line:column; the
+//! whole language is in docs/gradients.md, "The constraint language".
 
 pub mod check;
 pub mod expression;
@@ -483,6 +491,33 @@ impl ConstraintFile {
             self.value.gradient(&inputs)
         };
         sound(value, gradients)
+    }
+
+    /// ∇C in f64 as [`ConstraintFile::evaluate_by`] gives it (the file's own with `own`, else
+    /// AD's), for `points` given as a slice of the file's arity, padded to four.
+    pub fn gradients_of(
+        &self,
+        points: &[DVec3],
+        rest: f64,
+        stored: &[f64],
+        own: bool,
+    ) -> [DVec3; 4] {
+        fn padded<const N: usize>(
+            file: &ConstraintFile,
+            points: &[DVec3],
+            rest: f64,
+            stored: &[f64],
+            own: bool,
+        ) -> [DVec3; 4] {
+            let p: [DVec3; N] = std::array::from_fn(|k| points[k]);
+            let e = file.evaluate_by(&p, rest, stored, own);
+            std::array::from_fn(|k| e.gradients.get(k).copied().unwrap_or(DVec3::ZERO))
+        }
+        match self.arity() {
+            2 => padded::<2>(self, points, rest, stored, own),
+            3 => padded::<3>(self, points, rest, stored, own),
+            _ => padded::<4>(self, points, rest, stored, own),
+        }
     }
 
     /// ∇C by forward-mode AD in f64 over [`Tangent`] numbers, one pass per coordinate; `None`

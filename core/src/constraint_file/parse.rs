@@ -99,12 +99,16 @@ pub(super) fn parse_all(
         "edges" => Binding::Edges,
         "tets" => Binding::Tets,
         "tet-vertices" => Binding::TetVertices,
+        "triangles" => Binding::Triangles,
+        "hinges" => Binding::Hinges,
         other => {
             return Err(error(
                 Some(raw.applies_to.span().start),
                 format!(
                     "applies_to is \"{other}\": expected \"edges\" (p0 p1), \"tets\" \
-                     (p0..p3) or \"tet-vertices\" (p0..p3, four per tet)"
+                     (p0..p3), \"tet-vertices\" (p0..p3, four per tet), \"triangles\" (p0 p1 \
+                     p2, the surface's, wound outwards) or \"hinges\" (p0 p1 an edge of the \
+                     surface, p2 p3 the wings)"
                 ),
             ));
         }

@@ -470,6 +470,8 @@ impl Families {
                 match (file.arity(), file.reads_rest_shape()) {
                     (2, false) => visitor.visit(family, &FileConstraint::<2, false>(file)),
                     (2, true) => visitor.visit(family, &FileConstraint::<2, true>(file)),
+                    (3, false) => visitor.visit(family, &FileConstraint::<3, false>(file)),
+                    (3, true) => visitor.visit(family, &FileConstraint::<3, true>(file)),
                     (_, false) => visitor.visit(family, &FileConstraint::<4, false>(file)),
                     (_, true) => visitor.visit(family, &FileConstraint::<4, true>(file)),
                 }

@@ -86,7 +86,8 @@ impl Binding {
     pub fn arity(self) -> usize {
         match self {
             Binding::Edges => 2,
-            Binding::Tets | Binding::TetVertices => 4,
+            Binding::Triangles => 3,
+            Binding::Tets | Binding::TetVertices | Binding::Hinges => 4,
         }
     }
 
@@ -96,6 +97,8 @@ impl Binding {
         match self {
             Binding::Edges => mesh.edges().into_iter().flatten().collect(),
             Binding::Tets => mesh.tets.iter().flatten().copied().collect(),
+            Binding::Triangles => mesh.surface_faces().into_iter().flatten().collect(),
+            Binding::Hinges => mesh.surface_hinges().into_iter().flatten().collect(),
             Binding::TetVertices => mesh
                 .tets
                 .iter()
@@ -121,6 +124,8 @@ impl Binding {
             Binding::Edges => (0..0, true),
             Binding::Tets => (tet..tet + 1, false),
             Binding::TetVertices => (4 * tet..4 * tet + 4, false),
+            // Of the surface, not of a tet.
+            Binding::Triangles | Binding::Hinges => (0..0, false),
         };
         let pairs = pairs(edges);
         let looked_up = TET_EDGES

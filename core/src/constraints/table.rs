@@ -24,6 +24,14 @@ pub enum Binding {
     /// Four per tet, one per corner k: (p0, p1, p2, p3) with p1 = corner k, in the orders of
     /// [`super::height::tet_vertex_order`]; tet t's are constraints 4t..4t+4.
     TetVertices,
+    /// One per triangle of the surface: (p0, p1, p2) wound so that (p1 − p0) × (p2 − p0) points
+    /// out of the body ([`crate::scene::mesh::TetMesh::surface_faces`]).
+    Triangles,
+    /// One per edge of the surface that two surface triangles share: (p0, p1) the edge, as the
+    /// first triangle (p0, p1, p2) winds it, p2 and p3 the wings, so that the second triangle
+    /// is (p1, p0, p3), both wound outwards ([`crate::scene::mesh::TetMesh::surface_hinges`]).
+    /// An edge of one surface triangle or of three or more (non-manifold) makes no hinge.
+    Hinges,
 }
 
 /// A family as people see it, and as the code reaches it.

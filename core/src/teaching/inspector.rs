@@ -65,21 +65,7 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
     let mut numeric_gradients = [DVec3::ZERO; 4];
     numeric_gradients[..numeric.len()].copy_from_slice(&numeric);
     let file_gradients = families.file(family).map(|file| {
-        let mut automatic = [DVec3::ZERO; 4];
-        let mut at = [DVec3::ZERO; 4];
-        at[..points.len()].copy_from_slice(&points);
-        match points.len() {
-            2 => {
-                let e =
-                    file.evaluate_by(&[at[0], at[1]], projection.rest, projection.stored(), false);
-                automatic[..2].copy_from_slice(&e.gradients);
-            }
-            _ => {
-                automatic = file
-                    .evaluate_by(&at, projection.rest, projection.stored(), false)
-                    .gradients
-            }
-        }
+        let automatic = file.gradients_of(&points, projection.rest, projection.stored(), false);
         FileGradients {
             automatic,
             yours: file.yours(&points, projection.rest, projection.stored()),

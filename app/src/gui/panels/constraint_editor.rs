@@ -27,8 +27,11 @@ pub struct ConstraintEditor {
     pub text: String,
     /// What errors call the text: the file it came from, or [`UNSAVED`].
     pub path: PathBuf,
-    /// The family the text defines now (the last text that compiled).
+    /// The family the text defines now (the last text that compiled; of a file of several
+    /// constraints, the first, which the check and the grade are of).
     pub family: Option<Family>,
+    /// Every family the text defines now (one, or one per `[[constraint]]`).
+    pub families: Vec<Family>,
     /// Why the text does not define a family now (`FILE:LINE:COLUMN: …`), if it does not.
     pub error: Option<String>,
     /// Where that mistake is, line and column from 1, to mark it.
@@ -44,6 +47,7 @@ impl Default for ConstraintEditor {
             text: String::new(),
             path: PathBuf::from(UNSAVED),
             family: None,
+            families: Vec::new(),
             error: None,
             error_at: None,
             report: None,
@@ -52,20 +56,21 @@ impl Default for ConstraintEditor {
 }
 
 impl ConstraintEditor {
-    /// Puts `text`, from `path`, in the editor and compiles it.
-    pub fn set_text(&mut self, path: &Path, text: &str) -> Option<ConstraintFile> {
+    /// Puts `text`, from `path`, in the editor and compiles it: its constraints (one, or one
+    /// per `[[constraint]]`), or `None` and the mistake.
+    pub fn set_text(&mut self, path: &Path, text: &str) -> Option<Vec<ConstraintFile>> {
         self.text = text.to_owned();
         self.path = path.to_owned();
         self.compile()
     }
 
     /// Compiles the text: the file, or the mistake (kept in [`ConstraintEditor::error`]).
-    pub fn compile(&mut self) -> Option<ConstraintFile> {
-        match ConstraintFile::parse(&self.path, &self.text) {
-            Ok(file) => {
+    pub fn compile(&mut self) -> Option<Vec<ConstraintFile>> {
+        match ConstraintFile::parse_all(&self.path, &self.text) {
+            Ok(files) => {
                 self.error = None;
                 self.error_at = None;
-                Some(file)
+                Some(files)
             }
             Err(e) => {
                 self.error_at = e.at;
@@ -84,7 +89,7 @@ impl ConstraintEditor {
         ui: &mut egui::Ui,
         families: &Families,
         exercise: bool,
-    ) -> Option<ConstraintFile> {
+    ) -> Option<Vec<ConstraintFile>> {
         if !self.open {
             return None;
         }
@@ -114,7 +119,7 @@ impl ConstraintEditor {
         ui: &mut egui::Ui,
         families: &Families,
         exercise: bool,
-    ) -> Option<ConstraintFile> {
+    ) -> Option<Vec<ConstraintFile>> {
         let mut compiled = None;
         let width = ui.available_width();
         let height = ui.available_height();
@@ -147,7 +152,7 @@ impl ConstraintEditor {
     }
 
     /// The examples of `assets/constraints` as buttons; the one pressed replaces the text.
-    fn examples(&mut self, ui: &mut egui::Ui) -> Option<ConstraintFile> {
+    fn examples(&mut self, ui: &mut egui::Ui) -> Option<Vec<ConstraintFile>> {
         let mut compiled = None;
         ui.horizontal_wrapped(|ui| {
             ui.label("Start from:");
@@ -166,7 +171,7 @@ impl ConstraintEditor {
     }
 
     /// The text, its mistake's line marked; the file when an edit made it compile.
-    fn text(&mut self, ui: &mut egui::Ui) -> Option<ConstraintFile> {
+    fn text(&mut self, ui: &mut egui::Ui) -> Option<Vec<ConstraintFile>> {
         let label = ui
             .horizontal(|ui| {
                 let label = ui.label("Constraint file");
@@ -211,6 +216,7 @@ impl ConstraintEditor {
     /// What the text defines now, or its mistake; then the gradient check.
     fn status(&mut self, ui: &mut egui::Ui, families: &Families) {
         // A family of another table (a lesson opened since) is not this text's any more.
+        self.families.retain(|&f| families.has(f));
         if self.family.is_some_and(|f| !families.has(f)) {
             self.family = None;
         }
@@ -290,8 +296,8 @@ impl Panel for ConstraintEditor {
                 .exercises()
                 .any(|family| Some(family) == self.family)
         });
-        if let Some(file) = self.show(ui, context.bench.simulation.families(), exercise) {
-            requests.push(Request::Constraint(Box::new(file)));
+        if let Some(files) = self.show(ui, context.bench.simulation.families(), exercise) {
+            requests.push(Request::Constraint(files));
         }
     }
 }

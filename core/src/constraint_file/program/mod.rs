@@ -664,13 +664,13 @@ impl Program {
                     (BinaryOp::Div, Vc, Sc) => single(self, Op::Shrink(x, y), Vc),
                     (BinaryOp::Add, Mx, Mx) | (BinaryOp::Sub, Mx, Mx) => {
                         let mut out = [0; 3];
-                        for j in 0..3 {
+                        for (slot, (&x, &y)) in out.iter_mut().zip(a.r.iter().zip(&b.r)) {
                             let instruction = if *op == BinaryOp::Add {
-                                Op::AddV(a.r[j], b.r[j])
+                                Op::AddV(x, y)
                             } else {
-                                Op::SubV(a.r[j], b.r[j])
+                                Op::SubV(x, y)
                             };
-                            out[j] = self.emit(instruction, *span, what)?;
+                            *slot = self.emit(instruction, *span, what)?;
                         }
                         Ok(Value::matrix(out))
                     }
@@ -1036,7 +1036,7 @@ impl Program {
                     Ok(positive)
                 }
             }
-            Some(half) if half == 0.5 => self.emit(Op::Sqrt(a), span, "pow"),
+            Some(0.5) => self.emit(Op::Sqrt(a), span, "pow"),
             _ => {
                 let log = self.emit(Op::Ln(a), span, "pow")?;
                 let product = self.emit(Op::MulS(b, log), span, "pow")?;

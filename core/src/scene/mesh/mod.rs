@@ -161,6 +161,49 @@ impl TetMesh {
             .collect()
     }
 
+    /// The hinges of the surface: for each edge that exactly two surface triangles share,
+    /// `[a, b, c, d]`, with a → b the edge as the first of them (a, b, c) winds it (faces in
+    /// [`TetMesh::surface_faces`]'s order), c its third corner and d the other's, which winds the
+    /// edge b → a: (b, a, d). Sorted, so the result is deterministic. A surface edge of one
+    /// triangle (an open surface, which a tet mesh's is not) or of three or more (a non-manifold
+    /// edge, where two bodies touch along it) makes no hinge.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use tetlab_core::scene::mesh::TetMesh;
+    /// // One tet: four faces, six edges, each shared by two faces.
+    /// let tet = TetMesh { positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z], tets: vec![[0, 1, 2, 3]] };
+    /// let hinges = tet.surface_hinges();
+    /// assert_eq!(hinges.len(), 6);
+    /// // Each wing is the corner off its edge, and the two wings differ.
+    /// assert!(hinges.iter().all(|h| h[2] != h[3] && !h[..2].contains(&h[2]) && !h[..2].contains(&h[3])));
+    /// ```
+    pub fn surface_hinges(&self) -> Vec<[u32; 4]> {
+        let faces = self.surface_faces();
+        let mut by_edge: std::collections::HashMap<[u32; 2], Vec<(usize, [u32; 3])>> =
+            std::collections::HashMap::new();
+        for (f, face) in faces.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b, c) = (face[k], face[(k + 1) % 3], face[(k + 2) % 3]);
+                by_edge
+                    .entry([a.min(b), a.max(b)])
+                    .or_default()
+                    .push((f, [a, b, c]));
+            }
+        }
+        let mut hinges: Vec<[u32; 4]> = by_edge
+            .into_values()
+            .filter(|sides| sides.len() == 2)
+            .map(|mut sides| {
+                sides.sort_unstable();
+                let ([a, b, c], [_, _, d]) = (sides[0].1, sides[1].1);
+                [a, b, c, d]
+            })
+            .collect();
+        hinges.sort_unstable();
+        hinges
+    }
+
     /// The positions of tet `t`'s four corners.
     #[inline]
     pub fn corners(&self, t: usize) -> [DVec3; 4] {

@@ -299,9 +299,10 @@ impl Batches {
         if stored_len > 0 {
             for lanes in &layout.elements {
                 let values = lanes.map(&stored);
-                for k in 0..stored_len {
-                    rows.push(F32x8::new(std::array::from_fn(|lane| values[lane][k])));
-                }
+                rows.extend(
+                    (0..stored_len)
+                        .map(|k| F32x8::new(std::array::from_fn(|lane| values[lane][k]))),
+                );
             }
         }
         Batches {

@@ -146,6 +146,8 @@ struct Layouts {
     edges: Layout,
     tets: Layout,
     tet_vertices: Layout,
+    triangles: Layout,
+    hinges: Layout,
 }
 
 impl Layouts {
@@ -155,12 +157,20 @@ impl Layouts {
             Binding::Edges => &self.edges,
             Binding::Tets => &self.tets,
             Binding::TetVertices => &self.tet_vertices,
+            Binding::Triangles => &self.triangles,
+            Binding::Hinges => &self.hinges,
         }
     }
 
     /// Every one, for the families' weights and the memory.
-    fn all_mut(&mut self) -> [&mut Layout; 3] {
-        [&mut self.edges, &mut self.tets, &mut self.tet_vertices]
+    fn all_mut(&mut self) -> [&mut Layout; 5] {
+        [
+            &mut self.edges,
+            &mut self.tets,
+            &mut self.tet_vertices,
+            &mut self.triangles,
+            &mut self.hinges,
+        ]
     }
 }
 
@@ -349,6 +359,26 @@ impl FastSimulation {
             let visit: Vec<usize> = (0..4).flat_map(|k| (k..n).step_by(4)).collect();
             layouts.tet_vertices =
                 Layout::new_visiting(&constraints, visit, &inverse_masses, &rest_positions);
+        }
+        // The surface's triangles and hinges, in the order of their binding, as the sets of the
+        // active families that bind to them hold them (whose rest values they are).
+        let of_binding = |binding: Binding| {
+            active
+                .families()
+                .find(|&f| simulation.families.binding(f) == binding)
+                .map(|f| simulation.constraints[f].all_particles())
+        };
+        if let Some(flat) = of_binding(Binding::Triangles) {
+            let (triangles, _) = flat.as_chunks::<3>();
+            let triangles: Vec<[u32; 3]> = triangles
+                .iter()
+                .map(|t| t.map(|i| renumber[i as usize]))
+                .collect();
+            layouts.triangles = Layout::new(&triangles, &inverse_masses, &rest_positions);
+        }
+        if let Some(flat) = of_binding(Binding::Hinges) {
+            let (hinges, _) = flat.as_chunks::<4>();
+            layouts.hinges = Layout::new(&renumbered(hinges), &inverse_masses, &rest_positions);
         }
         let sets = simulation.families.per_family(|family| {
             if !active[family] {

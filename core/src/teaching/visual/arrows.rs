@@ -103,29 +103,16 @@ fn disagreeing_arrows(
     if projection.degenerate || !(0..projection.len).any(|k| file.gives_gradient(k)) {
         return;
     }
-    let points: [DVec3; 4] = std::array::from_fn(|k| {
-        positions[projection.particles[k.min(projection.len - 1)] as usize]
-    });
-    let other = match projection.len {
-        2 => {
-            let e = file.evaluate_by(
-                &[points[0], points[1]],
-                projection.rest,
-                projection.stored(),
-                !file.use_gradient,
-            );
-            [e.gradients[0], e.gradients[1], DVec3::ZERO, DVec3::ZERO]
-        }
-        _ => {
-            file.evaluate_by(
-                &points,
-                projection.rest,
-                projection.stored(),
-                !file.use_gradient,
-            )
-            .gradients
-        }
-    };
+    let points: Vec<DVec3> = projection.particles[..projection.len]
+        .iter()
+        .map(|&i| positions[i as usize])
+        .collect();
+    let other = file.gradients_of(
+        &points,
+        projection.rest,
+        projection.stored(),
+        !file.use_gradient,
+    );
     let used = &projection.gradients[..projection.len];
     let scale = used.iter().map(|g| g.length()).fold(0.0, f64::max);
     for (k, (&particle, &gradient)) in projection.particles().iter().zip(&other).enumerate() {
