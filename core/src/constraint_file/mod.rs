@@ -445,7 +445,7 @@ impl ConstraintFile {
     /// let e = file.evaluate_vectors(&[glam::Vec3::new(3.0, 0.0, 4.0), glam::Vec3::ZERO], 1.0, &[]);
     /// assert!((e.gradients[1] + glam::Vec3::new(0.6, 0.0, 0.8)).length() < 1e-6);
     /// ```
-    #[inline]
+    #[inline(always)]
     pub fn evaluate_vectors<V: Vector3, const N: usize>(
         &self,
         p: &[V; N],
@@ -458,7 +458,7 @@ impl ConstraintFile {
     /// [`ConstraintFile::evaluate_vectors`] with the file's own gradient (`own`) or AD's,
     /// whichever the file asks the simulation to use: what the workbench shows beside the one in
     /// use.
-    #[inline]
+    #[inline(always)]
     pub fn evaluate_by<V: Vector3, const N: usize>(
         &self,
         p: &[V; N],
@@ -625,7 +625,7 @@ impl ConstraintFile {
 
 /// C and ∇C as a simulation takes them: where either is not finite, degenerate, with C = 0 and
 /// ∇C = 0.
-#[inline]
+#[inline(always)]
 fn sound<V: Vector3, const N: usize>(
     value: V::Real,
     gradients: [[V::Real; 3]; N],

@@ -36,7 +36,7 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
         self.0.evaluate_vectors(p, rest, &stored)
     }
 
-    #[inline]
+    #[inline(always)]
     fn evaluate_stored<V: Vector3>(
         &self,
         p: &[V; N],

@@ -130,7 +130,7 @@ impl Tape {
     }
 
     /// Runs the tape on `inputs` and reads its outputs with `read`.
-    #[inline]
+    #[inline(always)]
     pub fn run<T: Real, R>(
         &self,
         inputs: &Inputs<'_, T>,
@@ -204,7 +204,7 @@ impl Tape {
     ///
     /// Generic over [`Real`]: run on [`crate::numbers::dual::Tangent`] numbers it gives the
     /// derivative of the gradient along the tangents, a column of the Hessian.
-    #[inline]
+    #[inline(always)]
     pub fn gradient<T: Real, const N: usize>(&self, inputs: &Inputs<'_, T>) -> (T, [[T; 3]; N]) {
         let mut r = ArrayVec::new();
         self.forward(inputs, &mut r);
@@ -370,7 +370,7 @@ impl Tape {
 
     /// Every register's value, instruction by instruction, into `r` (empty; the caller's, so
     /// that it is never moved).
-    #[inline]
+    #[inline(always)]
     fn forward<T: Real>(&self, inputs: &Inputs<'_, T>, r: &mut ArrayVec<[T; 3], MAX_REGISTERS>) {
         for op in &self.ops {
             let value = op.apply(|i| r[i as usize], inputs);
