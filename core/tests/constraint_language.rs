@@ -344,3 +344,92 @@ fn the_material_and_the_rest_shape_are_read_once_per_element_and_follow_a_new_ma
         assert!((f64::from(e.value.to_array()[0]) - expected).abs() < 1e-6 * expected);
     }
 }
+
+#[test]
+fn every_mistake_in_a_file_of_several_constraints_is_named_at_its_place() {
+    let header = "name = \"two\"\napplies_to = \"edges\"\n";
+    let table = |name: &str, body: &str| format!("[[constraint]]\nname = \"{name}\"\n{body}\n");
+    let cases = [
+        (
+            format!(
+                "{header}pair = [\"a\", \"c\"]\n{}{}",
+                table("a", "value = \"1 * length(p0 - p1)\""),
+                table("b", "value = \"length(p0 - p1)\"")
+            ),
+            "two.toml:3:14: ",
+            "`pair` names \"c\"",
+        ),
+        (
+            format!(
+                "{header}pair = [\"a\"]\n{}",
+                table("a", "value = \"length(p0 - p1)\"")
+            ),
+            "two.toml:3:8: ",
+            "names two different constraints",
+        ),
+        (
+            format!("{header}pair = [\"a\", \"b\"]\nvalue = \"length(p0 - p1)\"\n"),
+            "two.toml:3:8: ",
+            "has none",
+        ),
+        (
+            format!(
+                "{header}{}{}",
+                table("a", "value = \"length(p0 - p1)\""),
+                table("a", "value = \"length(p0 - p1)\"")
+            ),
+            "two.toml:7:8: ",
+            "two [[constraint]] tables are named \"a\"",
+        ),
+        (
+            format!("{header}{}", table("a", "rest = \"0\"")),
+            "two.toml:4:8: ",
+            "has no `value`",
+        ),
+        (
+            format!(
+                "{header}value = \"length(p0 - p1)\"\n{}",
+                table("a", "value = \"length(p0 - p1)\"")
+            ),
+            "two.toml:3:9: ",
+            "give each its own `value`",
+        ),
+        (
+            format!(
+                "{header}{}",
+                table("a", "value = \"length(p0 - p1)\"\nstiffness = \"young\"")
+            ),
+            "two.toml:6:13: ",
+            "stiffness is \"young\"",
+        ),
+        (
+            format!(
+                "{header}{}",
+                table("a", "value = \"length(p0 - p1)\"\nvalu = \"1\"")
+            ),
+            "two.toml:6:1: ",
+            "unknown field `valu`",
+        ),
+        (
+            "name = \"two\"\napplies_to = \"faces\"\nvalue = \"1\"\n".to_owned(),
+            "two.toml:2:14: ",
+            "\"triangles\"",
+        ),
+    ];
+    for (text, at, what) in cases {
+        let e = ConstraintFile::parse_all(Path::new("two.toml"), &text)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(at) && e.contains(what), "{text}\n{e}");
+    }
+    // A file of two where one is asked for says so.
+    let two = format!(
+        "{header}{}{}",
+        table("a", "value = \"length(p0 - p1)\""),
+        table("b", "value = \"length(p0 - p1)\"")
+    );
+    let e = ConstraintFile::parse(Path::new("two.toml"), &two)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("holds 2 constraints (two-a, two-b)"), "{e}");
+}

@@ -9,12 +9,15 @@
 //! - **The same outcome.** Simulated, the files recover a mirrored cube and a flattened bunny
 //!   where the built-ins do, on both engines.
 
-use glam::{DVec3, Vec3};
+#[path = "support/both_precisions.rs"]
+mod both_precisions;
+use both_precisions::Both;
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::material::Material;
-use tetlab_core::constraints::{Constraint, Families, Family, PerFamily, Visit};
+use tetlab_core::constraints::{Families, Family, PerFamily};
 use tetlab_core::input::shared_meshes;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
@@ -77,39 +80,6 @@ fn table() -> &'static Families {
     &ROUTES.0
 }
 
-/// C and ∇C of constraint `points` of `family` in f64 and in f32 (as f64).
-struct Both<'a> {
-    points: &'a [DVec3],
-    rest: f64,
-    shape: &'a [DVec3],
-}
-
-type Values = (f64, [DVec3; 4], bool);
-
-impl Visit for Both<'_> {
-    type Output = [Values; 2];
-    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
-        let p: [DVec3; N] = std::array::from_fn(|k| self.points[k]);
-        let q: [DVec3; N] = std::array::from_fn(|k| self.shape[k]);
-        let e = c.evaluate(&p, self.rest, &q);
-        let mut g64 = [DVec3::ZERO; 4];
-        g64[..N].copy_from_slice(&e.gradients);
-        let e32 = c.evaluate(
-            &p.map(|v| v.as_vec3()),
-            self.rest as f32,
-            &q.map(|v| v.as_vec3()),
-        );
-        let mut g32 = [DVec3::ZERO; 4];
-        for (g, v) in g32.iter_mut().zip(e32.gradients.iter()) {
-            *g = Vec3::as_dvec3(v);
-        }
-        [
-            (e.value, g64, e.degenerate),
-            (e32.value as f64, g32, e32.degenerate),
-        ]
-    }
-}
-
 /// The largest relative differences, f64 and f32, over every constraint of `route` at
 /// `positions`, and the constraints compared.
 fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2], [f64; 2], usize) {
@@ -134,6 +104,7 @@ fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2],
                     points: &points,
                     rest,
                     shape: &shape,
+                    stored: &[],
                 },
             )
         };

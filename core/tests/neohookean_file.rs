@@ -11,11 +11,14 @@
 //!   mirrored cube on the reference engine, every position agrees to 10⁻⁸ of the cube's size, and
 //!   both recover (or neither) on each engine and under each of four order seeds.
 
-use glam::{DVec3, Vec3};
+#[path = "support/both_precisions.rs"]
+mod both_precisions;
+use both_precisions::Both;
+use glam::DVec3;
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::material::Material;
-use tetlab_core::constraints::{Constraint, Families, Family, PerFamily, Visit};
+use tetlab_core::constraints::{Families, Family, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
@@ -35,42 +38,6 @@ fn table() -> (Families, [Family; 2]) {
     );
     let added = families.register_all(files).unwrap();
     (families, [added[0], added[1]])
-}
-
-/// C and ∇C in f64 and f32 of one constraint, with what its element stores.
-struct Both<'a> {
-    points: &'a [DVec3],
-    rest: f64,
-    shape: &'a [DVec3],
-    stored: &'a [f64],
-}
-
-type Values = (f64, [DVec3; 4], bool);
-
-impl Visit for Both<'_> {
-    type Output = [Values; 2];
-    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
-        let p: [DVec3; N] = std::array::from_fn(|k| self.points[k]);
-        let q: [DVec3; N] = std::array::from_fn(|k| self.shape[k]);
-        let e = c.evaluate_stored(&p, self.rest, &q, self.stored);
-        let mut g64 = [DVec3::ZERO; 4];
-        g64[..N].copy_from_slice(&e.gradients);
-        let stored32: Vec<f32> = self.stored.iter().map(|&x| x as f32).collect();
-        let e32 = c.evaluate_stored(
-            &p.map(|v| v.as_vec3()),
-            self.rest as f32,
-            &q.map(|v| v.as_vec3()),
-            &stored32,
-        );
-        let mut g32 = [DVec3::ZERO; 4];
-        for (g, v) in g32.iter_mut().zip(e32.gradients.iter()) {
-            *g = Vec3::as_dvec3(v);
-        }
-        [
-            (e.value, g64, e.degenerate),
-            (f64::from(e32.value), g32, e32.degenerate),
-        ]
-    }
 }
 
 fn settings(active: PerFamily<bool>, engine: Engine, order_seed: Option<u64>) -> Settings {

@@ -68,22 +68,14 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             args.points.len()
         )));
     }
-    let rest_shape = if args.rest_shape.is_empty() {
-        &args.points
-    } else if !families.uses_rest_shape(family) {
-        return Err(UsageError(format!(
-            "--rest-shape: the {} constraint does not read a rest shape",
+    let rest_shape = rest_shape(
+        args,
+        families.uses_rest_shape(family),
+        &format!(
+            "the {} constraint does not read a rest shape",
             families.name(family)
-        )));
-    } else if args.rest_shape.len() != args.points.len() {
-        return Err(UsageError(format!(
-            "--rest-shape: {} points, as many as --points ({})",
-            args.rest_shape.len(),
-            args.points.len()
-        )));
-    } else {
-        &args.rest_shape
-    };
+        ),
+    )?;
     let evaluation = families.evaluate(family, &args.points, args.rest, rest_shape);
     let (analytic, numeric) =
         analytic_and_numeric(&families, family, &args.points, args.rest, rest_shape);
@@ -187,6 +179,24 @@ struct FileOutput {
     kinks: Vec<String>,
 }
 
+/// `--rest-shape`, or `--points` when it is not given: refused (`why`) for a constraint that
+/// reads no rest shape, and unless it has as many points as `--points`.
+fn rest_shape<'a>(args: &'a Args, reads: bool, why: &str) -> Result<&'a [DVec3], UsageError> {
+    if args.rest_shape.is_empty() {
+        Ok(&args.points)
+    } else if !reads {
+        Err(UsageError(format!("--rest-shape: {why}")))
+    } else if args.rest_shape.len() != args.points.len() {
+        Err(UsageError(format!(
+            "--rest-shape: {} points, as many as --points ({})",
+            args.rest_shape.len(),
+            args.points.len()
+        )))
+    } else {
+        Ok(&args.rest_shape)
+    }
+}
+
 /// Every constraint of the file (one, or each of its `[[constraint]]` tables in turn).
 fn run_file(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let path = args
@@ -217,22 +227,14 @@ fn run_one_file(
             args.points.len()
         )));
     }
-    let rest_shape = if args.rest_shape.is_empty() {
-        &args.points
-    } else if !file.reads_rest_shape() {
-        return Err(UsageError(format!(
-            "--rest-shape: {} reads no rest shape (q0…, Dm, F, V0); its rest value is --rest",
+    let rest_shape = rest_shape(
+        args,
+        file.reads_rest_shape(),
+        &format!(
+            "{} reads no rest shape (q0…, Dm, F, V0); its rest value is --rest",
             file.name
-        )));
-    } else if args.rest_shape.len() != args.points.len() {
-        return Err(UsageError(format!(
-            "--rest-shape: {} points, as many as --points ({})",
-            args.rest_shape.len(),
-            args.points.len()
-        )));
-    } else {
-        &args.rest_shape
-    };
+        ),
+    )?;
     // What the element stores, from the rest shape and the default material.
     let stored = file.store(
         rest_shape,

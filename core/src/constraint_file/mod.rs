@@ -131,9 +131,7 @@ impl Stiffness {
     }
 }
 
-/// What an element stores ([`ConstraintFile::store`]): numbers worked out once from its rest
-/// shape and the material.
-pub type Stored = ArrayVec<f64, MAX_STORED>;
+pub use crate::constraints::Stored;
 
 /// A grade worked out once per compiled file: a cache that belongs to the file, so that a file
 /// redefined (the editor, as a student types) starts with none and the old one goes with the old

@@ -181,15 +181,13 @@ pub(super) fn parse_all(
         ));
     }
     let mut files = Vec::new();
-    for named in &raw.constraint {
+    for (k, named) in raw.constraint.iter().enumerate() {
         let own = checked_name(&named.name)?;
         let constraint = named.constraint();
-        if raw
-            .constraint
+        // Named at the second of the two.
+        if raw.constraint[..k]
             .iter()
-            .filter(|n| n.name.get_ref().trim() == own)
-            .count()
-            > 1
+            .any(|n| n.name.get_ref().trim() == own)
         {
             return Err(error(
                 Some(named.name.span().start),

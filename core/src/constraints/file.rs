@@ -2,8 +2,8 @@
 //! joins the table of families in [`super::Families`].
 
 use super::{Constraint, Evaluation};
-use crate::constraint_file::program::MAX_STORED;
-use crate::constraint_file::{ConstraintFile, Stored};
+use super::{MAX_STORED, Stored};
+use crate::constraint_file::ConstraintFile;
 use crate::constraints::material::Material;
 use crate::numbers::vector::Vector3;
 use arrayvec::ArrayVec;

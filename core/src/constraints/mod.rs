@@ -35,10 +35,16 @@ pub use families::{Families, Named};
 pub use family::{Binding, Family, MAX_FAMILIES, PerFamily, Row, TABLE, Visit, VisitPair};
 pub use table::Formula;
 
-use crate::constraint_file::Stored;
 use crate::constraints::material::Material;
 use crate::numbers::vector::{Real, Vector3};
 use glam::DVec3;
+
+/// The most numbers a constraint may store beyond its rest value ([`Constraint::store`]): what
+/// depends only on its rest shape and the material, worked out once per element.
+pub const MAX_STORED: usize = 48;
+
+/// What an element stores ([`Constraint::store`]).
+pub type Stored = arrayvec::ArrayVec<f64, MAX_STORED>;
 
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or
 /// eight constraints at once in SIMD lanes).

@@ -151,7 +151,7 @@ pub struct Projection {
     pub rest: f64,
     /// What the element stores ([`crate::constraints::Constraint::store`]), the first
     /// `stored_len`: read them with [`Projection::stored`].
-    pub stored: [f64; crate::constraint_file::program::MAX_STORED],
+    pub stored: [f64; crate::constraints::MAX_STORED],
     /// How many numbers it stores.
     pub stored_len: usize,
     /// ∇ₚC for each particle.

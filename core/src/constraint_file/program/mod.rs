@@ -31,8 +31,8 @@
 mod op;
 mod tape;
 
-pub use op::{MAX_REGISTERS, MAX_STORED};
-pub use tape::{Inputs, Registers, Switch, Tape, Undefined};
+pub use op::{Inputs, MAX_REGISTERS, MAX_STORED};
+pub use tape::{Registers, Switch, Tape, Undefined};
 
 use super::expression::{BinaryOp, Expr, Span};
 use op::{Op, Reg};

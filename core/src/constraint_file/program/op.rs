@@ -2,7 +2,6 @@
 //! ([`Op::apply`], generic over [`Real`]), the registers it reads, and why its value is not
 //! finite when it is not. The derivative rules are the backward pass's ([`super::tape`]).
 
-use super::tape::Inputs;
 use crate::constraint_file::expression::CompareOp;
 use crate::numbers::vector::Real;
 use arrayvec::ArrayVec;
@@ -14,9 +13,7 @@ pub(super) type Reg = u16;
 /// so that an evaluation allocates nothing.
 pub const MAX_REGISTERS: usize = 160;
 
-/// The most numbers a constraint may store ([`Op::Stored`]): what depends only on the rest shape
-/// and the material, worked out once per element.
-pub const MAX_STORED: usize = 48;
+pub use crate::constraints::MAX_STORED;
 
 /// One instruction; it defines the register of its own index from the registers it names.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -244,6 +241,35 @@ impl Op {
             Op::Acos(a) => format!("acos of {}: acos is defined on -1..1", s(a)),
             Op::Normalize(_) => "normalize of a zero vector: it has no direction".to_owned(),
             _ => "the result is too large for f64".to_owned(),
+        }
+    }
+}
+
+/// What a tape reads besides its instructions: the particles, their rest positions, the rest
+/// value, the material (μ, λ, γ) and the numbers stored for the element ([`Op::Stored`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Inputs<'a, T> {
+    /// p0, p1, …
+    pub points: &'a [[T; 3]],
+    /// q0, q1, …: the rest positions (the points again, for a tape that reads none).
+    pub shape: &'a [[T; 3]],
+    /// `rest`.
+    pub rest: T,
+    /// μ, λ and γ = 1 + μ/λ.
+    pub material: [T; 3],
+    /// What the element stores ([`super::Compiled::prelude`] worked it out).
+    pub stored: &'a [T],
+}
+
+impl<'a, T: Real> Inputs<'a, T> {
+    /// The inputs of a tape that reads only the particles and `rest`.
+    pub fn of(points: &'a [[T; 3]], rest: T) -> Self {
+        Inputs {
+            points,
+            shape: points,
+            rest,
+            material: [T::ZERO; 3],
+            stored: &[],
         }
     }
 }

@@ -3,7 +3,7 @@
 //! ([`Tape::gradient`], reverse mode), on the stack, in any [`Real`].
 
 use super::Origin;
-use super::op::{MAX_REGISTERS, Op, Reg, add3, cross, dot, holds, scale, shrink, sub3};
+use super::op::{Inputs, MAX_REGISTERS, Op, Reg, add3, cross, dot, holds, scale, shrink, sub3};
 use crate::numbers::vector::Real;
 use arrayvec::ArrayVec;
 
@@ -19,35 +19,6 @@ pub struct Tape {
     /// Whether each register depends on a particle: the backward pass skips the others, and
     /// carries no adjoint into them (a stored number, a constant, `rest`).
     pub(super) varying: Vec<bool>,
-}
-
-/// What a tape reads besides its instructions: the particles, their rest positions, the rest
-/// value, the material (μ, λ, γ) and the numbers stored for the element ([`Op::Stored`]).
-#[derive(Clone, Copy, Debug)]
-pub struct Inputs<'a, T> {
-    /// p0, p1, …
-    pub points: &'a [[T; 3]],
-    /// q0, q1, …: the rest positions (the points again, for a tape that reads none).
-    pub shape: &'a [[T; 3]],
-    /// `rest`.
-    pub rest: T,
-    /// μ, λ and γ = 1 + μ/λ.
-    pub material: [T; 3],
-    /// What the element stores ([`super::Compiled::prelude`] worked it out).
-    pub stored: &'a [T],
-}
-
-impl<'a, T: Real> Inputs<'a, T> {
-    /// The inputs of a tape that reads only the particles and `rest`.
-    pub fn of(points: &'a [[T; 3]], rest: T) -> Self {
-        Inputs {
-            points,
-            shape: points,
-            rest,
-            material: [T::ZERO; 3],
-            stored: &[],
-        }
-    }
 }
 
 /// The registers of a tape after [`Tape::run`]: read its outputs.
