@@ -216,6 +216,26 @@ fn a_file_of_two_constraints_defines_both_from_the_editor() {
     assert!(!active[table.parse("my-height").unwrap()]);
     assert_eq!(table.partner_in(deviatoric, &active), Some(hydrostatic));
     assert_eq!(harness.state().editor.family, Some(deviatoric));
+    // The solver panel shows the pair as one group, with the material's E and ν (its stiffness
+    // is μ and λ): switched off and on together.
+    // The solver panel's (the compare panel below has one of the same name).
+    harness
+        .get_all_by_role_and_label(egui::accesskit::Role::CheckBox, "my-neohookean")
+        .next()
+        .expect("the solver panel's checkbox")
+        .click();
+    harness.run_steps(2);
+    let active = harness.state().bench.simulation.settings().active;
+    assert!(!active[deviatoric] && !active[hydrostatic]);
+    // The solver panel's (the compare panel below has one of the same name).
+    harness
+        .get_all_by_role_and_label(egui::accesskit::Role::CheckBox, "my-neohookean")
+        .next()
+        .expect("the solver panel's checkbox")
+        .click();
+    harness.run_steps(2);
+    let active = harness.state().bench.simulation.settings().active;
+    assert!(active[deviatoric] && active[hydrostatic]);
     // Played from a mirror, the pair brings the cube back, as the built-in does.
     harness.key_press(egui::Key::M);
     harness.run_steps(2);

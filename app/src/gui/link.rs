@@ -149,7 +149,7 @@ impl Link {
         }
         for family in families.all() {
             // The material gives these; `material` carries them.
-            if family.compliance_from_material().is_some() {
+            if families.compliance_from_material(family).is_some() {
                 continue;
             }
             if s.compliance[family] != defaults.compliance[family] {

@@ -68,16 +68,31 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
     });
     for (group, members) in families.groups() {
         let family = members.families().next().expect("a group has a family");
-        if family.compliance_from_material().is_some() {
+        // The material gives the compliance of the neo-Hookean pair and of a file's constraints
+        // with a `stiffness`.
+        if families.compliance_from_material(family).is_some() {
             material_group(ui, families, &mut settings, group, members);
             continue;
         }
+        // A file of several constraints is one group: switched and set together.
+        let label = if members.families().count() > 1 {
+            group
+        } else {
+            &*families.row(family).label
+        };
         ui.horizontal(|ui| {
-            ui.checkbox(&mut settings.active[family], &*families.row(family).label);
+            let mut on = members.families().all(|f| settings.active[f]);
+            if ui.checkbox(&mut on, label).changed() {
+                for f in members.families() {
+                    settings.active[f] = on;
+                }
+            }
+            let (mut compliance, mut stiffness) =
+                (settings.compliance[family], settings.stiffness[family]);
             match settings.method {
                 Method::Xpbd => {
                     ui.add(
-                        egui::DragValue::new(&mut settings.compliance[family])
+                        egui::DragValue::new(&mut compliance)
                             .range(0.0..=10.0)
                             .speed(1e-4)
                             .prefix("alpha "),
@@ -85,7 +100,19 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
                     .on_hover_text("XPBD compliance: 0 is rigid, larger is softer");
                 }
                 Method::Pbd => {
-                    ui.add(egui::Slider::new(&mut settings.stiffness[family], 0.0..=1.0).text("k"));
+                    ui.add(egui::Slider::new(&mut stiffness, 0.0..=1.0).text("k"));
+                }
+            }
+            let changed = (
+                compliance != settings.compliance[family],
+                stiffness != settings.stiffness[family],
+            );
+            for f in members.families() {
+                if changed.0 {
+                    settings.compliance[f] = compliance;
+                }
+                if changed.1 {
+                    settings.stiffness[f] = stiffness;
                 }
             }
         });
@@ -156,6 +183,11 @@ pub fn group_label<'a>(families: &'a Families, group: &str) -> &'a str {
         .all()
         .find(|&f| families.row(f).group == group)
         .expect("a group of the table");
-    let label: &str = &families.row(family).label;
+    let row = families.row(family);
+    if families.file(family).is_some() {
+        // A file's group is named by the file's `name`.
+        return &row.group;
+    }
+    let label: &str = &row.label;
     label.split(' ').next().unwrap_or(label)
 }
