@@ -464,6 +464,25 @@ impl ConstraintFile {
         stored: &[V::Real],
         own: bool,
     ) -> crate::constraints::Evaluation<V, N> {
+        let coordinates: [[V::Real; 3]; N] = std::array::from_fn(|i| p[i].to_array());
+        let (value, gradients) = self.value_and_gradient(&coordinates, rest, stored, own);
+        sound(value, gradients)
+    }
+
+    /// C and ∇C at the particles `points` (coordinates in any [`Real`]: a number, lanes, a
+    /// [`crate::numbers::block::Block`] of lanes), as they come, not finite where they are
+    /// undefined: what [`ConstraintFile::evaluate_by`] makes an evaluation of.
+    ///
+    /// # Panics
+    /// When `N` is not the file's arity.
+    #[inline(always)]
+    pub fn value_and_gradient<T: Real, const N: usize>(
+        &self,
+        points: &[[T; 3]; N],
+        rest: T,
+        stored: &[T],
+        own: bool,
+    ) -> (T, [[T; 3]; N]) {
         assert_eq!(
             N,
             self.arity(),
@@ -471,9 +490,8 @@ impl ConstraintFile {
             self.name,
             self.arity()
         );
-        let coordinates: [[V::Real; 3]; N] = std::array::from_fn(|i| p[i].to_array());
-        let inputs = self.inputs(&coordinates, rest, stored);
-        let (value, gradients) = if own {
+        let inputs = self.inputs(points, rest, stored);
+        if own {
             // Where the file gives no gradient, AD's: a student may write one particle's at a
             // time (the exercise of lesson 9 starts with none).
             let missing = self.gradient_outputs[..N].iter().any(Option::is_none);
@@ -481,14 +499,13 @@ impl ConstraintFile {
             self.yours.run(&inputs, |r| {
                 let gradients = std::array::from_fn(|k| match self.gradient_outputs[k] {
                     Some(o) => r.vector(o),
-                    None => automatic.map_or([V::Real::ZERO; 3], |g: [[V::Real; 3]; N]| g[k]),
+                    None => automatic.map_or([T::ZERO; 3], |g: [[T; 3]; N]| g[k]),
                 });
                 (r.scalar(0), gradients)
             })
         } else {
             self.value.gradient(&inputs)
-        };
-        sound(value, gradients)
+        }
     }
 
     /// ∇C in f64 as [`ConstraintFile::evaluate_by`] gives it (the file's own with `own`, else
@@ -624,7 +641,7 @@ impl ConstraintFile {
 /// C and ∇C as a simulation takes them: where either is not finite, degenerate, with C = 0 and
 /// ∇C = 0.
 #[inline(always)]
-fn sound<V: Vector3, const N: usize>(
+pub(crate) fn sound<V: Vector3, const N: usize>(
     value: V::Real,
     gradients: [[V::Real; 3]; N],
 ) -> crate::constraints::Evaluation<V, N> {

@@ -2,10 +2,12 @@
 //! joins the table of families in [`super::Families`].
 
 use super::{Constraint, Evaluation};
-use super::{MAX_STORED, Stored};
-use crate::constraint_file::ConstraintFile;
+use super::{GROUP, MAX_STORED, Stored};
+use crate::constraint_file::{ConstraintFile, sound};
 use crate::constraints::material::Material;
-use crate::numbers::vector::Vector3;
+use crate::numbers::block::Block;
+use crate::numbers::lanes::{F32x8, Vec3x8};
+use crate::numbers::vector::{Real, Vector3};
 use arrayvec::ArrayVec;
 use glam::DVec3;
 
@@ -19,6 +21,8 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
     const USES_REST_SHAPE: bool = SHAPE;
     // μ and λ may appear in what an element stores and in its rest value.
     const REST_USES_MATERIAL: bool = true;
+    // The tape's dispatch on each instruction, paid once for GROUP batches.
+    const GROUPED: bool = true;
 
     /// C and ∇C with what the element stores worked out here from `rest_shape` and the default
     /// material: for the checkers and readers that hold no stored values (the solvers call
@@ -47,6 +51,54 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
         self.0.evaluate_vectors(p, rest, stored)
     }
 
+    /// The GROUP batches as one [`Block`] of lanes through the tape, then each batch's lanes
+    /// taken out: each lane computes what it computes in [`Constraint::evaluate_stored`].
+    #[inline(always)]
+    // Indexed loops: the iterator forms compiled to copies of these wide arrays.
+    #[allow(clippy::needless_range_loop)]
+    fn evaluate_batches(
+        &self,
+        p: &[[Vec3x8; N]; GROUP],
+        rest: [F32x8; GROUP],
+        _: &[[Vec3x8; N]; GROUP],
+        stored: [&[F32x8]; GROUP],
+    ) -> [Evaluation<Vec3x8, N>; GROUP] {
+        // Plain indexed loops, not `array::map`, `from_fn` or iterators over arrays: those
+        // compiled to copies of these wide arrays (memcpy), which cost more than the tape.
+        let file = self.0;
+        let mut points = [[Block::<F32x8, GROUP>::ZERO; 3]; N];
+        for j in 0..GROUP {
+            for k in 0..N {
+                let v = p[j][k];
+                (points[k][0].0[j], points[k][1].0[j], points[k][2].0[j]) = (v.x, v.y, v.z);
+            }
+        }
+        let mut blocks: ArrayVec<Block<F32x8, GROUP>, MAX_STORED> = ArrayVec::new();
+        for i in 0..file.stored_len() {
+            let mut block = Block::<F32x8, GROUP>::ZERO;
+            for j in 0..GROUP {
+                block.0[j] = stored[j][i];
+            }
+            blocks.push(block);
+        }
+        let (value, gradients) = through_tape(file, &points, Block(rest), &blocks);
+        let mut out = [Evaluation {
+            value: F32x8::ZERO,
+            gradients: [Vec3x8::ZERO; N],
+            degenerate: F32x8::ZERO.finite(),
+        }; GROUP];
+        for j in 0..GROUP {
+            let mut g = [[F32x8::ZERO; 3]; N];
+            for k in 0..N {
+                for c in 0..3 {
+                    g[k][c] = gradients[k][c].0[j];
+                }
+            }
+            out[j] = sound::<Vec3x8, N>(value.0[j], g);
+        }
+        out
+    }
+
     fn stored_len(&self) -> usize {
         self.0.stored_len()
     }
@@ -58,4 +110,17 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
     fn rest_value(&self, rest_shape: &[DVec3; N], material: &Material) -> f64 {
         self.0.rest_value(rest_shape, material)
     }
+}
+
+/// The file's C and ∇C on a block of batches, as a call of its own: one copy of the interpreter
+/// for every family and pair of this arity, which the instruction cache holds, rather than one
+/// inlined into each kernel.
+#[inline(never)]
+fn through_tape<const N: usize>(
+    file: &ConstraintFile,
+    points: &[[Block<F32x8, GROUP>; 3]; N],
+    rest: Block<F32x8, GROUP>,
+    stored: &[Block<F32x8, GROUP>],
+) -> (Block<F32x8, GROUP>, [[Block<F32x8, GROUP>; 3]; N]) {
+    file.value_and_gradient(points, rest, stored, file.use_gradient)
 }

@@ -36,8 +36,13 @@ pub use family::{Binding, Family, MAX_FAMILIES, PerFamily, Row, TABLE, Visit, Vi
 pub use table::Formula;
 
 use crate::constraints::material::Material;
+use crate::numbers::lanes::{F32x8, Vec3x8};
 use crate::numbers::vector::{Real, Vector3};
 use glam::DVec3;
+
+/// How many batches of lanes the fast engine hands at once to a family that asks for it
+/// ([`Constraint::GROUPED`], [`Constraint::evaluate_batches`]).
+pub const GROUP: usize = 2;
 
 /// The most numbers a constraint may store beyond its rest value ([`Constraint::store`]): what
 /// depends only on its rest shape and the material, worked out once per element.
@@ -102,6 +107,27 @@ pub trait Constraint<const N: usize>: Sync {
     ) -> Evaluation<V, N> {
         let _ = stored;
         self.evaluate(p, rest, rest_shape)
+    }
+
+    /// Whether the fast engine should evaluate this family [`GROUP`] batches at a time
+    /// ([`Constraint::evaluate_batches`]) rather than one: for a family whose evaluation costs
+    /// something per call whatever the lanes (a constraint file's tape pays its dispatch on each
+    /// instruction once per call).
+    const GROUPED: bool = false;
+
+    /// C and ∇C of [`GROUP`] batches of lanes of one colour at once, batch j at `p[j]` with
+    /// `rest[j]`, `rest_shape[j]` and `stored[j]`. Each batch's evaluation is, to the bit, what
+    /// [`Constraint::evaluate_stored`] gives it alone, which is what this does unless the family
+    /// has a faster way.
+    #[inline(always)]
+    fn evaluate_batches(
+        &self,
+        p: &[[Vec3x8; N]; GROUP],
+        rest: [F32x8; GROUP],
+        rest_shape: &[[Vec3x8; N]; GROUP],
+        stored: [&[F32x8]; GROUP],
+    ) -> [Evaluation<Vec3x8, N>; GROUP] {
+        std::array::from_fn(|j| self.evaluate_stored(&p[j], rest[j], &rest_shape[j], stored[j]))
     }
 
     /// What else a reader should see of the constraint's particles at `p` (rest shape

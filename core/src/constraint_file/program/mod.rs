@@ -35,7 +35,8 @@ pub use op::{Inputs, MAX_REGISTERS, MAX_STORED};
 pub use tape::{Registers, Switch, Tape, Undefined};
 
 use super::expression::{BinaryOp, Expr, Span};
-use op::{Op, Reg};
+use arrayvec::ArrayVec;
+use op::{MAX_SLOTS, Op, Reg};
 use std::collections::HashMap;
 
 #[cfg(doc)]
@@ -436,44 +437,36 @@ impl Program {
                 }
             }
         }
+        // Each register renumbered to where its value starts among the tape's numbers.
         let mut map = vec![0 as Reg; self.ops.len()];
         let mut ops = Vec::new();
         let mut origins = Vec::new();
+        let mut vector = Vec::new();
+        let mut slots = 0usize;
         for (r, op) in self.ops.iter().enumerate() {
             if needed[r] {
-                map[r] = ops.len() as Reg;
+                map[r] = slots as Reg;
                 ops.push(match stored.get(&(r as Reg)) {
                     Some(&(at, vector)) => Op::Stored(at, vector),
                     None => op.renumbered(&map),
                 });
                 origins.push(self.origins[r]);
+                let wide = self.is_vector(r as Reg);
+                vector.push(wide);
+                slots += if wide { 3 } else { 1 };
             }
         }
-        let mut varying: Vec<bool> = Vec::with_capacity(ops.len());
-        for op in &ops {
-            let v = match op {
-                Op::Particle(_) => true,
-                Op::Const(_)
-                | Op::Rest
-                | Op::RestParticle(_)
-                | Op::Material(_)
-                | Op::Stored(..) => false,
-                _ => op.inputs().iter().any(|&i| varying[i as usize]),
-            };
-            varying.push(v);
-        }
-        Tape {
+        Tape::new(
             ops,
             origins,
-            outputs: outputs.iter().map(|&o| map[o as usize]).collect(),
-            widths: Vec::new(),
-            varying,
-        }
+            vector,
+            outputs.iter().map(|&o| map[o as usize]).collect(),
+        )
     }
 
     /// Whether register `r` holds a vector (its instruction's result type).
     fn is_vector(&self, r: Reg) -> bool {
-        self.ops[r as usize].is_vector(|i| self.is_vector(i))
+        self.ops[r as usize].is_vector()
     }
 
     fn push(&mut self, op: Op, what: &'static str) -> Reg {
@@ -482,7 +475,7 @@ impl Program {
 
     fn record(&mut self, op: Op, span: Span, what: &'static str) -> Reg {
         let depends = match op {
-            Op::Const(_) => Depends::Nothing,
+            Op::Const(_) | Op::ConstVector(_) => Depends::Nothing,
             Op::RestParticle(_) | Op::Material(_) => Depends::Element,
             Op::Particle(_) | Op::Rest | Op::Stored(..) => Depends::Projection,
             _ => op
@@ -514,20 +507,38 @@ impl Program {
             });
         }
         let constant = |r: Reg| match self.ops[r as usize] {
-            Op::Const(x) => Some(x),
+            Op::Const(x) => Some([x, 0.0, 0.0]),
+            Op::ConstVector(x) => Some(x),
             _ => None,
         };
         let inputs = op.inputs();
         if !inputs.is_empty() && inputs.iter().all(|&r| constant(r).is_some()) {
             let value = |r: Reg| constant(r).unwrap_or_default();
-            let folded = op.apply::<f64>(value, &Inputs::of(&[], 0.0));
+            let scalar = |r: Reg| value(r)[0];
+            // The inputs laid out as a tape's registers, then the instruction run on them.
+            let mut registers: ArrayVec<f64, MAX_SLOTS> = ArrayVec::new();
+            let laid_out = op.map_inputs(|r| {
+                let at = registers.len() as Reg;
+                let width = if self.is_vector(r) { 3 } else { 1 };
+                registers.extend(value(r)[..width].iter().copied());
+                at
+            });
+            let start = registers.len();
+            laid_out.apply(&mut registers, &Inputs::of(&[], 0.0));
+            let mut folded = [0.0; 3];
+            folded[..registers.len() - start].copy_from_slice(&registers[start..]);
             if !folded.iter().all(|x| x.is_finite()) {
                 return Err(CompileError {
                     span,
-                    message: format!("`{what}` is undefined here: {}", op.undefined(value)),
+                    message: format!("`{what}` is undefined here: {}", op.undefined(scalar)),
                 });
             }
-            return Ok(self.record(Op::Const(folded), span, what));
+            let constant = if op.is_vector() {
+                Op::ConstVector(folded)
+            } else {
+                Op::Const(folded[0])
+            };
+            return Ok(self.record(constant, span, what));
         }
         Ok(self.record(op, span, what))
     }
@@ -601,7 +612,7 @@ impl Program {
                     });
                 }
                 Ok(Value::scalar(self.emit(
-                    Op::Const([*x, 0.0, 0.0]),
+                    Op::Const(*x),
                     *span,
                     "a number",
                 )?))
@@ -640,7 +651,7 @@ impl Program {
                 let a = self.compile(left)?;
                 let b = self.compile(right)?;
                 let (x, y) = (a.r[0], b.r[0]);
-                if *op == BinaryOp::Div && self.ops[y as usize] == Op::Const([0.0; 3]) {
+                if *op == BinaryOp::Div && self.ops[y as usize] == Op::Const(0.0) {
                     return Err(CompileError {
                         span: right.span(),
                         message: "division by zero: the divisor is 0 whatever the particles"
@@ -797,7 +808,7 @@ impl Program {
             for (j, column) in columns.iter_mut().enumerate() {
                 let mut e = [0.0; 3];
                 e[j] = 1.0;
-                *column = self.emit(Op::Const(e), span, "I")?;
+                *column = self.emit(Op::ConstVector(e), span, "I")?;
             }
             return Ok(Some(Value::matrix(columns)));
         }
@@ -825,7 +836,7 @@ impl Program {
             "V0" => {
                 let dm = edges(self, Op::RestParticle, "V0")?;
                 let det = self.emit(Op::Det(dm.r[0], dm.r[1], dm.r[2]), span, "V0")?;
-                let six = self.emit(Op::Const([6.0, 0.0, 0.0]), span, "V0")?;
+                let six = self.emit(Op::Const(6.0), span, "V0")?;
                 Value::scalar(self.emit(Op::DivS(det, six), span, "V0")?)
             }
             _ => {
@@ -995,7 +1006,12 @@ impl Program {
             "pow" => Ok(Value::scalar(self.pow(a, b, span)?)),
             _ => {
                 let (cmp, x, y) = condition.expect("if has a condition");
-                let r = self.emit(Op::If(cmp, x, y, b, c), span, "if")?;
+                let op = if same == Some(Type::Vector) {
+                    Op::IfVector(cmp, x, y, b, c)
+                } else {
+                    Op::If(cmp, x, y, b, c)
+                };
+                let r = self.emit(op, span, "if")?;
                 Ok(Value {
                     r: [r; 3],
                     ty: same.unwrap_or(Type::Scalar),
@@ -1008,7 +1024,7 @@ impl Program {
     /// derivatives); for b = ½, √a; otherwise exp(b log a), for a > 0.
     fn pow(&mut self, a: Reg, b: Reg, span: Span) -> Result<Reg, CompileError> {
         let exponent = match self.ops[b as usize] {
-            Op::Const([x, ..]) => Some(x),
+            Op::Const(x) => Some(x),
             _ => None,
         };
         match exponent {
@@ -1028,7 +1044,7 @@ impl Program {
                         square = self.emit(Op::MulS(square, square), span, "pow")?;
                     }
                 }
-                let one = self.emit(Op::Const([1.0, 0.0, 0.0]), span, "pow")?;
+                let one = self.emit(Op::Const(1.0), span, "pow")?;
                 let positive = result.unwrap_or(one);
                 if n < 0.0 {
                     self.emit(Op::DivS(one, positive), span, "pow")

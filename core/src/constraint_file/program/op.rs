@@ -6,7 +6,9 @@ use crate::constraint_file::expression::CompareOp;
 use crate::numbers::vector::Real;
 use arrayvec::ArrayVec;
 
-/// A register: the index of the instruction that defines it.
+/// A register. In a [`super::Program`], the index of the instruction that defines it; in a
+/// [`super::Tape`], where its value starts among the tape's numbers ([`super::tape::MAX_SLOTS`]): a
+/// scalar is one number there, a vector three.
 pub(super) type Reg = u16;
 
 /// The most registers (instructions) a program may have: tapes keep their registers on the stack,
@@ -15,11 +17,16 @@ pub const MAX_REGISTERS: usize = 160;
 
 pub use crate::constraints::MAX_STORED;
 
+/// The most numbers a tape's registers hold: three for each vector.
+pub const MAX_SLOTS: usize = 3 * MAX_REGISTERS;
+
 /// One instruction; it defines the register of its own index from the registers it names.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Op {
-    /// A number or (from folding) a constant vector; a scalar is `[x, 0, 0]`.
-    Const([f64; 3]),
+    /// A number.
+    Const(f64),
+    /// A constant vector (from folding, or the columns of `I`).
+    ConstVector([f64; 3]),
     Particle(u8),
     /// A particle's rest position.
     RestParticle(u8),
@@ -62,8 +69,10 @@ pub(super) enum Op {
     /// A vector's component 0, 1 or 2.
     Component(Reg, u8),
     Vec3(Reg, Reg, Reg),
-    /// `if(a cmp b, then, otherwise)`, scalars or vectors.
+    /// `if(a cmp b, then, otherwise)` of scalars.
     If(CompareOp, Reg, Reg, Reg, Reg),
+    /// `if(a cmp b, then, otherwise)` of vectors.
+    IfVector(CompareOp, Reg, Reg, Reg, Reg),
 }
 
 impl Op {
@@ -71,7 +80,8 @@ impl Op {
     pub(super) fn map_inputs(self, mut f: impl FnMut(Reg) -> Reg) -> Op {
         use Op::*;
         match self {
-            Const(_) | Particle(_) | RestParticle(_) | Material(_) | Stored(..) | Rest => self,
+            Const(_) | ConstVector(_) | Particle(_) | RestParticle(_) | Material(_)
+            | Stored(..) | Rest => self,
             NegS(a) => NegS(f(a)),
             NegV(a) => NegV(f(a)),
             Length(a) => Length(f(a)),
@@ -107,6 +117,11 @@ impl Op {
                 let (t, e) = (f(t), f(e));
                 If(cmp, a, b, t, e)
             }
+            IfVector(cmp, a, b, t, e) => {
+                let (a, b) = (f(a), f(b));
+                let (t, e) = (f(t), f(e));
+                IfVector(cmp, a, b, t, e)
+            }
         }
     }
 
@@ -125,9 +140,8 @@ impl Op {
         self.map_inputs(|r| map[r as usize])
     }
 
-    /// Whether its value is a vector (`input_is_vector` says for the registers it reads; a
-    /// constant is taken for a scalar unless it has a y or z).
-    pub(super) fn is_vector(self, input_is_vector: impl Fn(Reg) -> bool) -> bool {
+    /// Whether its value is a vector.
+    pub(super) fn is_vector(self) -> bool {
         match self {
             Op::Particle(_)
             | Op::RestParticle(_)
@@ -139,9 +153,9 @@ impl Op {
             | Op::Cross(..)
             | Op::Normalize(_)
             | Op::Vec3(..) => true,
+            Op::ConstVector(_) => true,
             Op::Stored(_, vector) => vector,
-            Op::If(_, _, _, then, _) => input_is_vector(then),
-            Op::Const(x) => x[1] != 0.0 || x[2] != 0.0,
+            Op::IfVector(..) => true,
             _ => false,
         }
     }
@@ -151,88 +165,114 @@ impl Op {
     pub(super) fn switches(self) -> bool {
         matches!(
             self,
-            Op::Abs(_) | Op::Min(..) | Op::Max(..) | Op::Sign(_) | Op::If(..)
+            Op::Abs(_) | Op::Min(..) | Op::Max(..) | Op::Sign(_) | Op::If(..) | Op::IfVector(..)
         )
     }
 
-    /// Its value from the values `v` of the registers it reads, and the inputs.
+    /// Its value, from the registers `r` it reads (earlier ones) and the inputs, pushed onto `r`:
+    /// one number for a scalar, three for a vector.
     #[inline(always)]
-    pub(super) fn apply<T: Real>(
-        self,
-        v: impl Fn(Reg) -> [T; 3],
-        inputs: &Inputs<'_, T>,
-    ) -> [T; 3] {
-        let s = |i: Reg| v(i)[0];
-        let scalar = |x: T| [x, T::ZERO, T::ZERO];
+    pub(super) fn apply<T: Real>(self, r: &mut ArrayVec<T, MAX_SLOTS>, inputs: &Inputs<'_, T>) {
+        // Each arm pushes its own value, so that nothing wider than it is moved.
+        macro_rules! s {
+            ($i:expr) => {
+                r[$i as usize]
+            };
+        }
+        macro_rules! v {
+            ($i:expr) => {{
+                let at = $i as usize;
+                [r[at], r[at + 1], r[at + 2]]
+            }};
+        }
+        macro_rules! scalar {
+            ($x:expr) => {{
+                let x = $x;
+                r.push(x)
+            }};
+        }
+        macro_rules! vector {
+            ($v:expr) => {{
+                let [x, y, z] = $v;
+                r.push(x);
+                r.push(y);
+                r.push(z);
+            }};
+        }
         match self {
-            Op::Const(x) => x.map(T::from_f64),
-            Op::Particle(k) => inputs.points[k as usize],
-            Op::RestParticle(k) => inputs.shape[k as usize],
-            Op::Material(k) => scalar(inputs.material[k as usize]),
+            Op::Const(x) => scalar!(T::from_f64(x)),
+            Op::ConstVector(x) => vector!(x.map(T::from_f64)),
+            Op::Particle(k) => vector!(inputs.points[k as usize]),
+            Op::RestParticle(k) => vector!(inputs.shape[k as usize]),
+            Op::Material(k) => scalar!(inputs.material[k as usize]),
             Op::Stored(at, vector) => {
                 let at = at as usize;
                 let s = inputs.stored;
                 if vector {
-                    [s[at], s[at + 1], s[at + 2]]
+                    vector!([s[at], s[at + 1], s[at + 2]])
                 } else {
-                    scalar(s[at])
+                    scalar!(s[at])
                 }
             }
-            Op::Rest => scalar(inputs.rest),
-            Op::NegS(a) => scalar(-s(a)),
-            Op::NegV(a) => scale(v(a), -T::ONE),
-            Op::AddS(a, b) => scalar(s(a) + s(b)),
-            Op::SubS(a, b) => scalar(s(a) - s(b)),
-            Op::MulS(a, b) => scalar(s(a) * s(b)),
-            Op::DivS(a, b) => scalar(s(a) / s(b)),
-            Op::AddV(a, b) => add3(v(a), v(b)),
-            Op::SubV(a, b) => sub3(v(a), v(b)),
-            Op::Scale(a, b) => scale(v(a), s(b)),
-            Op::Shrink(a, b) => shrink(v(a), s(b)),
-            Op::Dot(a, b) => scalar(dot(v(a), v(b))),
-            Op::Cross(a, b) => cross(v(a), v(b)),
-            Op::Length(a) => scalar(dot(v(a), v(a)).sqrt()),
-            Op::Normalize(a) => shrink(v(a), dot(v(a), v(a)).sqrt()),
-            Op::Sqrt(a) => scalar(s(a).sqrt()),
+            Op::Rest => scalar!(inputs.rest),
+            Op::NegS(a) => scalar!(-s!(a)),
+            Op::NegV(a) => vector!(scale(v!(a), -T::ONE)),
+            Op::AddS(a, b) => scalar!(s!(a) + s!(b)),
+            Op::SubS(a, b) => scalar!(s!(a) - s!(b)),
+            Op::MulS(a, b) => scalar!(s!(a) * s!(b)),
+            Op::DivS(a, b) => scalar!(s!(a) / s!(b)),
+            Op::AddV(a, b) => vector!(add3(v!(a), v!(b))),
+            Op::SubV(a, b) => vector!(sub3(v!(a), v!(b))),
+            Op::Scale(a, b) => vector!(scale(v!(a), s!(b))),
+            Op::Shrink(a, b) => vector!(shrink(v!(a), s!(b))),
+            Op::Dot(a, b) => scalar!(dot(v!(a), v!(b))),
+            Op::Cross(a, b) => vector!(cross(v!(a), v!(b))),
+            Op::Length(a) => scalar!(dot(v!(a), v!(a)).sqrt()),
+            Op::Normalize(a) => vector!(shrink(v!(a), dot(v!(a), v!(a)).sqrt())),
+            Op::Sqrt(a) => scalar!(s!(a).sqrt()),
             Op::Abs(a) => {
-                let x = s(a);
-                scalar(T::select(x.le(T::ZERO), -x, x))
+                let x = s!(a);
+                scalar!(T::select(x.le(T::ZERO), -x, x))
             }
             Op::Min(a, b) => {
-                let (x, y) = (s(a), s(b));
-                scalar(T::select(x.le(y), x, y))
+                let (x, y) = (s!(a), s!(b));
+                scalar!(T::select(x.le(y), x, y))
             }
             Op::Max(a, b) => {
-                let (x, y) = (s(a), s(b));
-                scalar(T::select(x.gt(y), x, y))
+                let (x, y) = (s!(a), s!(b));
+                scalar!(T::select(x.gt(y), x, y))
             }
-            Op::Det(a, b, c) => scalar(dot(v(a), cross(v(b), v(c)))),
-            Op::Sin(a) => scalar(s(a).sin()),
-            Op::Cos(a) => scalar(s(a).cos()),
-            Op::Exp(a) => scalar(s(a).exp()),
-            Op::Ln(a) => scalar(s(a).ln()),
-            Op::Atan2(y, x) => scalar(s(y).atan2(s(x))),
-            Op::Asin(a) => scalar(s(a).asin()),
-            Op::Acos(a) => scalar(s(a).acos()),
-            Op::Cbrt(a) => scalar(s(a).cbrt()),
+            Op::Det(a, b, c) => scalar!(dot(v!(a), cross(v!(b), v!(c)))),
+            Op::Sin(a) => scalar!(s!(a).sin()),
+            Op::Cos(a) => scalar!(s!(a).cos()),
+            Op::Exp(a) => scalar!(s!(a).exp()),
+            Op::Ln(a) => scalar!(s!(a).ln()),
+            Op::Atan2(y, x) => scalar!(s!(y).atan2(s!(x))),
+            Op::Asin(a) => scalar!(s!(a).asin()),
+            Op::Acos(a) => scalar!(s!(a).acos()),
+            Op::Cbrt(a) => scalar!(s!(a).cbrt()),
             Op::Sign(a) => {
-                let x = s(a);
+                let x = s!(a);
                 let negative = T::select(T::ZERO.gt(x), -T::ONE, T::ZERO);
-                scalar(T::select(x.gt(T::ZERO), T::ONE, negative))
+                scalar!(T::select(x.gt(T::ZERO), T::ONE, negative))
             }
-            Op::Component(a, i) => scalar(v(a)[i as usize]),
-            Op::Vec3(a, b, c) => [s(a), s(b), s(c)],
+            Op::Component(a, i) => scalar!(r[a as usize + i as usize]),
+            Op::Vec3(a, b, c) => vector!([s!(a), s!(b), s!(c)]),
             Op::If(cmp, a, b, t, e) => {
-                let mask = holds(cmp, s(a), s(b));
-                let (t, e) = (v(t), v(e));
-                [0, 1, 2].map(|k| T::select(mask, t[k], e[k]))
+                let mask = holds(cmp, s!(a), s!(b));
+                scalar!(T::select(mask, s!(t), s!(e)))
+            }
+            Op::IfVector(cmp, a, b, t, e) => {
+                let mask = holds(cmp, s!(a), s!(b));
+                let (t, e) = (v!(t), v!(e));
+                vector!([0, 1, 2].map(|k| T::select(mask, t[k], e[k])))
             }
         }
     }
 
-    /// Why its value is not finite, given the finite values `v` of what it reads.
-    pub(super) fn undefined(self, v: impl Fn(Reg) -> [f64; 3]) -> String {
-        let s = |i: Reg| v(i)[0];
+    /// Why its value is not finite, given the finite values of what it reads (`s` reads a
+    /// scalar).
+    pub(super) fn undefined(self, s: impl Fn(Reg) -> f64) -> String {
         match self {
             Op::DivS(_, b) | Op::Shrink(_, b) if s(b) == 0.0 => "division by zero".to_owned(),
             Op::Ln(a) => format!("log of {}: log is defined above 0", s(a)),

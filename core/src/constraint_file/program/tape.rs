@@ -3,27 +3,35 @@
 //! ([`Tape::gradient`], reverse mode), on the stack, in any [`Real`].
 
 use super::Origin;
-use super::op::{Inputs, MAX_REGISTERS, Op, Reg, add3, cross, dot, holds, scale, shrink, sub3};
+use super::op::{Inputs, MAX_SLOTS, Op, Reg, add3, cross, dot, holds, scale, shrink, sub3};
 use crate::numbers::vector::Real;
 use arrayvec::ArrayVec;
 
 /// What some outputs of a [`Program`] need, as flat single-assignment instructions: instruction k
-/// defines register k from earlier registers.
+/// defines the next register from earlier ones. The registers are numbers side by side, one for
+/// a scalar and three for a vector, and an instruction names each register it reads by where
+/// its value starts ([`Reg`]), so that a scalar instruction reads and writes one number.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tape {
     pub(super) ops: Vec<Op>,
     pub(super) origins: Vec<Origin>,
+    /// Whether each instruction's value is a vector.
+    vector: Vec<bool>,
+    /// Where each instruction's value starts.
+    starts: Vec<Reg>,
     pub(super) outputs: Vec<Reg>,
+    /// The instruction that defines output 0 (C): the backward pass starts there.
+    first_output: usize,
     /// For a prelude, whether each output is a vector (three stored numbers) or a scalar.
     pub(super) widths: Vec<bool>,
-    /// Whether each register depends on a particle: the backward pass skips the others, and
+    /// Per number, whether it depends on a particle: the backward pass skips the others, and
     /// carries no adjoint into them (a stored number, a constant, `rest`).
-    pub(super) varying: Vec<bool>,
+    varying: Vec<bool>,
 }
 
 /// The registers of a tape after [`Tape::run`]: read its outputs.
 pub struct Registers<'a, T> {
-    registers: &'a [[T; 3]],
+    registers: &'a [T],
     outputs: &'a [Reg],
     widths: &'a [bool],
 }
@@ -31,12 +39,17 @@ pub struct Registers<'a, T> {
 impl<T: Copy> Registers<'_, T> {
     /// Output `i` of the tape as a scalar.
     pub fn scalar(&self, i: usize) -> T {
-        self.registers[self.outputs[i] as usize][0]
+        self.registers[self.outputs[i] as usize]
     }
 
     /// Output `i` of the tape as a vector.
     pub fn vector(&self, i: usize) -> [T; 3] {
-        self.registers[self.outputs[i] as usize]
+        let at = self.outputs[i] as usize;
+        [
+            self.registers[at],
+            self.registers[at + 1],
+            self.registers[at + 2],
+        ]
     }
 
     /// A prelude's outputs, in order, into `out`: a scalar's one number, a vector's three
@@ -44,9 +57,9 @@ impl<T: Copy> Registers<'_, T> {
     pub fn write_all(&self, out: &mut [T]) {
         let mut at = 0;
         for (i, &vector) in self.widths.iter().enumerate() {
-            let v = self.vector(i);
             let width = if vector { 3 } else { 1 };
-            out[at..at + width].copy_from_slice(&v[..width]);
+            let from = self.outputs[i] as usize;
+            out[at..at + width].copy_from_slice(&self.registers[from..from + width]);
             at += width;
         }
     }
@@ -85,6 +98,45 @@ pub struct Switch {
 }
 
 impl Tape {
+    /// The tape of instructions `ops` (each reading registers by where they start), from the
+    /// text `origins` says, whose values are vectors where `vector` says, with `outputs`.
+    pub(super) fn new(
+        ops: Vec<Op>,
+        origins: Vec<Origin>,
+        vector: Vec<bool>,
+        outputs: Vec<Reg>,
+    ) -> Tape {
+        let mut starts = Vec::with_capacity(ops.len());
+        let mut varying: Vec<bool> = Vec::new();
+        for (op, &wide) in ops.iter().zip(&vector) {
+            starts.push(varying.len() as Reg);
+            let v = match op {
+                Op::Particle(_) => true,
+                Op::Const(_)
+                | Op::ConstVector(_)
+                | Op::Rest
+                | Op::RestParticle(_)
+                | Op::Material(_)
+                | Op::Stored(..) => false,
+                _ => op.inputs().iter().any(|&i| varying[i as usize]),
+            };
+            varying.extend(std::iter::repeat_n(v, if wide { 3 } else { 1 }));
+        }
+        let first_output = outputs
+            .first()
+            .map_or(0, |&o| starts.iter().position(|&s| s == o).unwrap_or(0));
+        Tape {
+            ops,
+            origins,
+            vector,
+            starts,
+            outputs,
+            first_output,
+            widths: Vec::new(),
+            varying,
+        }
+    }
+
     /// Whether it reads the rest shape (q0…).
     pub fn reads_rest_shape(&self) -> bool {
         self.ops.iter().any(|op| matches!(op, Op::RestParticle(_)))
@@ -120,11 +172,17 @@ impl Tape {
     /// is, at `points` with `rest`: where and why C is undefined there. `None` where every value
     /// is finite.
     pub fn undefined_at(&self, inputs: &Inputs<'_, f64>) -> Option<Undefined> {
-        let mut r: ArrayVec<[f64; 3], MAX_REGISTERS> = ArrayVec::new();
+        let mut r: ArrayVec<f64, MAX_SLOTS> = ArrayVec::new();
         for (op, origin) in self.ops.iter().zip(&self.origins) {
-            let value = op.apply(|i| r[i as usize], inputs);
-            let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
-            if !finite(&value) && op.inputs().iter().all(|&i| finite(&r[i as usize])) {
+            let start = r.len();
+            op.apply(&mut r, inputs);
+            let finite = |at: Reg| {
+                let at = at as usize;
+                r[at..at + self.width_at(at as Reg)]
+                    .iter()
+                    .all(|x| x.is_finite())
+            };
+            if !r[start..].iter().all(|x| x.is_finite()) && op.inputs().iter().all(|&i| finite(i)) {
                 return Some(Undefined {
                     base: origin.base,
                     offset: origin.offset,
@@ -135,7 +193,6 @@ impl Tape {
                     ),
                 });
             }
-            r.push(value);
         }
         None
     }
@@ -145,15 +202,15 @@ impl Tape {
     /// `points` of what decides it (the argument of `abs`, the difference of `min`'s two, the
     /// two sides of a condition): the kink is where that value is 0.
     pub fn switches_at(&self, inputs: &Inputs<'_, f64>) -> Vec<Switch> {
-        let mut r: ArrayVec<[f64; 3], MAX_REGISTERS> = ArrayVec::new();
+        let mut r: ArrayVec<f64, MAX_SLOTS> = ArrayVec::new();
         let mut out = Vec::new();
         for (op, origin) in self.ops.iter().zip(&self.origins) {
             if op.switches() {
-                let s = |i: Reg| r[i as usize][0];
+                let s = |i: Reg| r[i as usize];
                 let decides = match *op {
                     Op::Abs(a) | Op::Sign(a) => s(a),
                     Op::Min(a, b) | Op::Max(a, b) => s(a) - s(b),
-                    Op::If(_, a, b, ..) => s(a) - s(b),
+                    Op::If(_, a, b, ..) | Op::IfVector(_, a, b, ..) => s(a) - s(b),
                     _ => f64::NAN,
                 };
                 out.push(Switch {
@@ -163,9 +220,19 @@ impl Tape {
                     decides,
                 });
             }
-            r.push(op.apply(|i| r[i as usize], inputs));
+            op.apply(&mut r, inputs);
         }
         out
+    }
+
+    /// How many numbers instruction `k`'s value is.
+    fn width(&self, k: usize) -> usize {
+        if self.vector[k] { 3 } else { 1 }
+    }
+
+    /// How many numbers the register starting at `at` is.
+    fn width_at(&self, at: Reg) -> usize {
+        self.starts.binary_search(&at).map_or(1, |k| self.width(k))
     }
 
     /// Output 0, C, and its gradient with respect to every particle, by reverse mode: the values
@@ -180,43 +247,53 @@ impl Tape {
         let mut r = ArrayVec::new();
         self.forward(inputs, &mut r);
         let r = &r;
+        let last = self.first_output;
         let out = self.outputs[0] as usize;
-        let mut adjoint: ArrayVec<[T; 3], MAX_REGISTERS> = ArrayVec::new();
-        for _ in 0..=out {
-            adjoint.push([T::ZERO; 3]);
+        let mut adjoint: ArrayVec<T, MAX_SLOTS> = ArrayVec::new();
+        for _ in 0..self.starts[last] as usize + self.width(last) {
+            adjoint.push(T::ZERO);
         }
-        adjoint[out][0] = T::ONE;
+        adjoint[out] = T::ONE;
         let mut gradient = [[T::ZERO; 3]; N];
         let varying = &self.varying;
-        for k in (0..=out).rev() {
-            if !varying[k] {
+        for k in (0..=last).rev() {
+            let at = self.starts[k] as usize;
+            if !varying[at] {
                 continue;
             }
-            let bar = adjoint[k];
+            let bar = if self.vector[k] {
+                read3(&adjoint, at as Reg)
+            } else {
+                [adjoint[at], T::ZERO, T::ZERO]
+            };
             let s = bar[0];
-            let value = |i: Reg| r[i as usize];
-            let x = |i: Reg| r[i as usize][0];
-            // r̄ into register i: all three components for a vector, the first for a scalar;
-            // nothing into (and no work for) a register that does not depend on a particle.
+            let value = |i: Reg| read3(r, i);
+            let x = |i: Reg| r[i as usize];
+            // This instruction's own value.
+            let own = r[at];
+            let own3 = || read3(r, at as Reg);
+            // r̄ into register i: all three numbers for a vector, the one for a scalar; nothing
+            // into (and no work for) a register that does not depend on a particle.
             macro_rules! add {
-                ($i:expr, $v:expr) => {
-                    if varying[$i as usize] {
-                        let into = &mut adjoint[$i as usize];
+                ($i:expr, $v:expr) => {{
+                    let i = $i as usize;
+                    if varying[i] {
                         match $v {
                             Adjoint::Vector(v) => {
-                                into[0] += v[0];
-                                into[1] += v[1];
-                                into[2] += v[2];
+                                adjoint[i] += v[0];
+                                adjoint[i + 1] += v[1];
+                                adjoint[i + 2] += v[2];
                             }
-                            Adjoint::Scalar(x) => into[0] += x,
+                            Adjoint::Scalar(x) => adjoint[i] += x,
                         }
                     }
-                };
+                }};
             }
             let scalar = |x: T| Adjoint::Scalar(x);
             let vector = |v: [T; 3]| Adjoint::Vector(v);
             match self.ops[k] {
                 Op::Const(_)
+                | Op::ConstVector(_)
                 | Op::Rest
                 | Op::Sign(_)
                 | Op::RestParticle(_)
@@ -244,7 +321,7 @@ impl Tape {
                     // r = a / b: ā += r̄ / b, b̄ −= r̄ r / b.
                     let d = x(b);
                     add!(a, scalar(s / d));
-                    add!(b, scalar(-(s * r[k][0]) / d));
+                    add!(b, scalar(-(s * own) / d));
                 }
                 Op::AddV(a, b) => {
                     add!(a, vector(bar));
@@ -263,7 +340,7 @@ impl Tape {
                     // r = v / f: v̄ += r̄ / f, f̄ −= r̄·r / f.
                     let d = x(f);
                     add!(v, vector(shrink(bar, d)));
-                    add!(f, scalar(-dot(bar, r[k]) / d));
+                    add!(f, scalar(-dot(bar, own3()) / d));
                 }
                 Op::Dot(a, b) => {
                     add!(a, vector(scale(value(b), s)));
@@ -274,15 +351,15 @@ impl Tape {
                     add!(a, vector(cross(value(b), bar)));
                     add!(b, vector(cross(bar, value(a))));
                 }
-                Op::Length(a) => add!(a, vector(scale(value(a), s / r[k][0]))),
+                Op::Length(a) => add!(a, vector(scale(value(a), s / own))),
                 Op::Normalize(a) => {
                     // r = a / |a|: ā += (r̄ − r (r·r̄)) / |a|.
-                    let n = r[k];
+                    let n = own3();
                     let length = dot(value(a), value(a)).sqrt();
                     let along = dot(n, bar);
                     add!(a, vector(shrink(sub3(bar, scale(n, along)), length)));
                 }
-                Op::Sqrt(a) => add!(a, scalar(s / (r[k][0] + r[k][0]))),
+                Op::Sqrt(a) => add!(a, scalar(s / (own + own))),
                 Op::Abs(a) => add!(a, scalar(T::select(x(a).le(T::ZERO), -s, s))),
                 Op::Min(a, b) => {
                     let first = x(a).le(x(b));
@@ -305,7 +382,7 @@ impl Tape {
                 Op::Sin(a) => add!(a, scalar(s * x(a).cos())),
                 Op::Cos(a) => add!(a, scalar(-(s * x(a).sin()))),
                 // r = eᵃ: ā += r̄ r; r = log a: ā += r̄ / a.
-                Op::Exp(a) => add!(a, scalar(s * r[k][0])),
+                Op::Exp(a) => add!(a, scalar(s * own)),
                 Op::Ln(a) => add!(a, scalar(s / x(a))),
                 Op::Atan2(y, x_) => {
                     // r = atan2(y, x): ȳ += r̄ x / (x² + y²), x̄ −= r̄ y / (x² + y²).
@@ -318,7 +395,7 @@ impl Tape {
                 Op::Asin(a) => add!(a, scalar(s / (T::ONE - x(a) * x(a)).sqrt())),
                 Op::Acos(a) => add!(a, scalar(-(s / (T::ONE - x(a) * x(a)).sqrt()))),
                 // r = ∛a: ā += r̄ / (3 r²).
-                Op::Cbrt(a) => add!(a, scalar(s / (T::from_f64(3.0) * r[k][0] * r[k][0]))),
+                Op::Cbrt(a) => add!(a, scalar(s / (T::from_f64(3.0) * own * own))),
                 Op::Component(a, i) => {
                     let mut v = [T::ZERO; 3];
                     v[i as usize] = s;
@@ -331,21 +408,32 @@ impl Tape {
                 }
                 Op::If(cmp, a, b, t, e) => {
                     let mask = holds(cmp, x(a), x(b));
+                    add!(t, scalar(T::select(mask, s, T::ZERO)));
+                    add!(e, scalar(T::select(mask, T::ZERO, s)));
+                }
+                Op::IfVector(cmp, a, b, t, e) => {
+                    let mask = holds(cmp, x(a), x(b));
                     add!(t, vector(bar.map(|v| T::select(mask, v, T::ZERO))));
                     add!(e, vector(bar.map(|v| T::select(mask, T::ZERO, v))));
                 }
             }
         }
-        (r[out][0], gradient)
+        (r[out], gradient)
     }
 
     /// Every register's value, instruction by instruction, into `r` (empty; the caller's, so
     /// that it is never moved).
     #[inline(always)]
-    fn forward<T: Real>(&self, inputs: &Inputs<'_, T>, r: &mut ArrayVec<[T; 3], MAX_REGISTERS>) {
+    fn forward<T: Real>(&self, inputs: &Inputs<'_, T>, r: &mut ArrayVec<T, MAX_SLOTS>) {
         for op in &self.ops {
-            let value = op.apply(|i| r[i as usize], inputs);
-            r.push(value);
+            op.apply(r, inputs);
         }
     }
+}
+
+/// The vector whose numbers start at `at`.
+#[inline(always)]
+fn read3<T: Copy>(r: &[T], at: Reg) -> [T; 3] {
+    let at = at as usize;
+    [r[at], r[at + 1], r[at + 2]]
 }

@@ -7,7 +7,7 @@
 
 use super::batches::{Batches, Layout, RestRows, Typed};
 use super::particles::Particles;
-use crate::constraints::Constraint;
+use crate::constraints::{Constraint, Evaluation, GROUP};
 use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
 use crate::numbers::vector::{Real, Vector3};
 use crate::simulation::projection::{Rule, SkipCounts, correction_lanes, pair_correction_lanes};
@@ -84,35 +84,75 @@ fn project_batches<const N: usize, C: Constraint<N>>(
     let mut skips = SkipCounts::default();
     let read = access.read;
     let write = access.sums.unwrap_or(read);
+    let mut project = |b: usize, evaluation: &Evaluation<Vec3x8, N>| {
+        let (skipped, d) =
+            correction_lanes(*evaluation, weights[b], lambda[b], rule, size[b] * reach);
+        skips.add(skipped);
+        lambda[b] += d.delta_lambda;
+        for (&indices, delta) in particles[b].iter().zip(d.delta_x) {
+            scatter_add(write, indices, delta);
+        }
+    };
+    let mut b = 0;
+    if C::GROUPED {
+        // GROUP batches at a time: they share no particle, so that gathering them all before
+        // writing any changes nothing.
+        while b + GROUP <= particles.len() {
+            let (p, shape, rows) = gather_group((access, C::USES_REST_SHAPE), particles, rest, b);
+            let evaluations = constraint.evaluate_batches(&p, rows.0, &shape, rows.1);
+            for (j, evaluation) in evaluations.iter().enumerate() {
+                project(b + j, evaluation);
+            }
+            b += GROUP;
+        }
+    }
     // The next batch is gathered before this one is written (they share no particle), so that
     // its loads overlap this one's arithmetic.
-    let mut next = particles.first().map(|indices| gather_batch(read, indices));
-    for (b, (((indices, weights), size), lambda)) in particles
-        .iter()
-        .zip(weights)
-        .zip(size)
-        .zip(lambda.iter_mut())
-        .enumerate()
-    {
+    let mut next = particles.get(b).map(|indices| gather_batch(read, indices));
+    while let Some(p) = next {
         let (rest, stored) = rest.of(b);
-        let Some(p) = next else { break };
         next = particles
             .get(b + 1)
             .map(|indices| gather_batch(read, indices));
         let shape = if C::USES_REST_SHAPE {
-            gather_batch(access.rest_shape, indices)
+            gather_batch(access.rest_shape, &particles[b])
         } else {
             p
         };
-        let evaluation = constraint.evaluate_stored(&p, rest, &shape, stored);
-        let (skipped, d) = correction_lanes(evaluation, *weights, *lambda, rule, *size * reach);
-        skips.add(skipped);
-        *lambda += d.delta_lambda;
-        for (&indices, delta) in indices.iter().zip(d.delta_x) {
-            scatter_add(write, indices, delta);
-        }
+        project(b, &constraint.evaluate_stored(&p, rest, &shape, stored));
+        b += 1;
     }
     skips
+}
+
+/// Batches `b..b + GROUP`, gathered: their particles, their rest shapes (the particles again
+/// unless `uses_rest_shape`) and their rows of rest values and stored numbers.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn gather_group<'a, const N: usize>(
+    (access, uses_rest_shape): (Access, bool),
+    particles: &[[[u32; LANES]; N]],
+    rest: RestRows<'a>,
+    b: usize,
+) -> (
+    [[Vec3x8; N]; GROUP],
+    [[Vec3x8; N]; GROUP],
+    ([F32x8; GROUP], [&'a [F32x8]; GROUP]),
+) {
+    let mut p = [[Vec3x8::ZERO; N]; GROUP];
+    let mut shape = [[Vec3x8::ZERO; N]; GROUP];
+    let mut rows = [F32x8::ZERO; GROUP];
+    let mut stored: [&[F32x8]; GROUP] = [&[]; GROUP];
+    for j in 0..GROUP {
+        p[j] = gather_batch(access.read, &particles[b + j]);
+        shape[j] = if uses_rest_shape {
+            gather_batch(access.rest_shape, &particles[b + j])
+        } else {
+            p[j]
+        };
+        (rows[j], stored[j]) = rest.of(b + j);
+    }
+    (p, shape, (rows, stored))
 }
 
 /// The colour projected `k`-th: `order[k]`, or `k` when `order` is empty (the layout's order).
@@ -224,9 +264,62 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
 ) -> [SkipCounts; 2] {
     assert_eq!(N, M, "a pair shares its particles");
     let mut skips = [SkipCounts::default(); 2];
-    for (b, (indices, weights)) in particles.iter().zip(weights).enumerate() {
+    let mut project =
+        |b: usize, first_evaluation: &Evaluation<Vec3x8, N>, e: &Evaluation<Vec3x8, M>| {
+            let second_evaluation = Evaluation {
+                value: e.value,
+                gradients: std::array::from_fn(|k| e.gradients[k]),
+                degenerate: e.degenerate,
+            };
+            let d = pair_correction_lanes(
+                *first_evaluation,
+                second_evaluation,
+                weights[b],
+                [lambda_a[b], lambda_b[b]],
+                rules,
+                size[b] * reach,
+            );
+            for (counts, skipped) in skips.iter_mut().zip(d.skipped) {
+                counts.add(skipped);
+            }
+            lambda_a[b] += d.delta_lambda[0];
+            lambda_b[b] += d.delta_lambda[1];
+            for (i, &indices) in particles[b].iter().enumerate() {
+                match access.sums {
+                    Some(sums) => scatter_add(sums, indices, d.delta_x[i]),
+                    None => scatter_add(access.read, indices, d.delta_x[i]),
+                }
+            }
+        };
+    let uses_rest_shape = A::USES_REST_SHAPE || B::USES_REST_SHAPE;
+    let mut b = 0;
+    if A::GROUPED && B::GROUPED {
+        // GROUP batches at a time, as in project_batches.
+        while b + GROUP <= particles.len() {
+            let (p, shape, (rest_a_rows, stored_a)) =
+                gather_group((access, uses_rest_shape), particles, rest_a, b);
+            let first = first.evaluate_batches(&p, rest_a_rows, &shape, stored_a);
+            let mut rest_b_rows = [F32x8::ZERO; GROUP];
+            let mut stored_b: [&[F32x8]; GROUP] = [&[]; GROUP];
+            for j in 0..GROUP {
+                (rest_b_rows[j], stored_b[j]) = rest_b.of(b + j);
+            }
+            let (mut p2, mut shape2) = ([[Vec3x8::ZERO; M]; GROUP], [[Vec3x8::ZERO; M]; GROUP]);
+            for j in 0..GROUP {
+                for k in 0..M {
+                    (p2[j][k], shape2[j][k]) = (p[j][k], shape[j][k]);
+                }
+            }
+            let second = second.evaluate_batches(&p2, rest_b_rows, &shape2, stored_b);
+            for j in 0..GROUP {
+                project(b + j, &first[j], &second[j]);
+            }
+            b += GROUP;
+        }
+    }
+    for (b, indices) in particles.iter().enumerate().skip(b) {
         let p = gather_batch(access.read, indices);
-        let shape = if A::USES_REST_SHAPE || B::USES_REST_SHAPE {
+        let shape = if uses_rest_shape {
             gather_batch(access.rest_shape, indices)
         } else {
             p
@@ -236,30 +329,7 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
         let p2: [Vec3x8; M] = std::array::from_fn(|k| p[k]);
         let shape2: [Vec3x8; M] = std::array::from_fn(|k| shape[k]);
         let e = second.evaluate_stored(&p2, rest_second, &shape2, stored_b);
-        let second_evaluation = crate::constraints::Evaluation {
-            value: e.value,
-            gradients: std::array::from_fn(|k| e.gradients[k]),
-            degenerate: e.degenerate,
-        };
-        let d = pair_correction_lanes(
-            first_evaluation,
-            second_evaluation,
-            *weights,
-            [lambda_a[b], lambda_b[b]],
-            rules,
-            size[b] * reach,
-        );
-        for (counts, skipped) in skips.iter_mut().zip(d.skipped) {
-            counts.add(skipped);
-        }
-        lambda_a[b] += d.delta_lambda[0];
-        lambda_b[b] += d.delta_lambda[1];
-        for (i, &indices) in indices.iter().enumerate() {
-            match access.sums {
-                Some(sums) => scatter_add(sums, indices, d.delta_x[i]),
-                None => scatter_add(access.read, indices, d.delta_x[i]),
-            }
-        }
+        project(b, &first_evaluation, &e);
     }
     skips
 }
