@@ -746,3 +746,156 @@ fn a_file_of_several_constraints_is_checked_constraint_by_constraint() {
     ]);
     assert_eq!(output.status.code(), Some(0), "{}", stdout(&output));
 }
+
+/// check-gradients gives every built-in family a Hessian column: ∇²C by forward mode over the
+/// analytic ∇C, against second-order dual numbers of C (to rounding) and against central
+/// differences of ∇C.
+#[test]
+fn check_gradients_checks_every_familys_hessian() {
+    let output = tetlab(&["check-gradients", "--samples", "300", "--json"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    for line in stdout(&output).lines() {
+        let row: Value = serde_json::from_str(line).unwrap();
+        let hessian = &row["hessian"];
+        assert_eq!(hessian["compared"], 300, "{row}");
+        assert!(
+            hessian["against_second_order"].as_f64().unwrap() < 1e-12,
+            "{row}"
+        );
+        assert!(
+            hessian["against_finite_differences"].as_f64().unwrap() < 1e-5,
+            "{row}"
+        );
+    }
+    let table = stdout(&tetlab(&["check-gradients", "--samples", "300"]));
+    assert!(table.contains("Hessian vs AD²"), "{table}");
+}
+
+/// A file's own Hessian blocks are checked like its gradient: the edge example's agree (exit 0),
+/// a wrong block is named with its error (exit 1), and a block of a particle the constraint does
+/// not have is a mistake at its line and column (exit 2).
+#[test]
+fn a_files_own_hessian_is_checked_block_by_block() {
+    let right = tetlab(&[
+        "check-gradients",
+        "--constraint-file",
+        &asset("edge.toml"),
+        "--json",
+    ]);
+    assert!(right.status.success(), "{}", stderr(&right));
+    let row: Value = serde_json::from_str(stdout(&right).lines().next().unwrap()).unwrap();
+    assert_eq!(row["hessian_agrees"], true, "{row}");
+    for block in ["p0p0", "p0p1", "p1p1"] {
+        assert!(
+            row["hessian"]["yours"][block].as_f64().unwrap() < 1e-12,
+            "{row}"
+        );
+    }
+
+    let (dir, wrong) = written(
+        "wrong-hessian.toml",
+        "name = \"e\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p1) - rest\"\n\
+         [hessian]\np0p0 = \"I / length(p0 - p1)\"\n",
+    );
+    let output = tetlab(&["check-gradients", "--constraint-file", &wrong]);
+    assert_eq!(output.status.code(), Some(1), "{}", stdout(&output));
+    let text = stdout(&output);
+    assert!(text.contains("your p0p0  1.00e0  WRONG"), "{text}");
+    assert!(
+        text.contains("DISAGREES: your Hessian block p0p0"),
+        "{text}"
+    );
+
+    let (_, bad) = written(
+        "bad-hessian.toml",
+        "name = \"e\"\napplies_to = \"edges\"\nvalue = \"length(p0 - p1) - rest\"\n\
+         [hessian]\np0p2 = \"I\"\n",
+    );
+    let output = tetlab(&["check-gradients", "--constraint-file", &bad]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("bad-hessian.toml:5:1: hessian entry `p0p2`"),
+        "{}",
+        stderr(&output)
+    );
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// `tetlab modes` on the unit tet: at rest the volume's energy has 11 zero eigenvalues and one
+/// positive, |∇V|² (with α = 1), flattened it has negative
+/// ones, which the projection clamps; the Hessian passes its checks; the neo-Hookean pair gets
+/// its F-space system; bad points are a usage error.
+#[test]
+fn modes_prints_the_classified_eigenmodes_and_their_checks() {
+    let rest = json(&["modes", "--constraints", "volume", "--json"]);
+    assert_eq!(rest["zero_count"], 11, "{rest}");
+    assert_eq!(rest["negative_count"], 0, "{rest}");
+    let modes = rest["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 12);
+    // |∇V|² at the unit tet: ∇V = (−1,−1,−1)/6, (1,0,0)/6, (0,1,0)/6, (0,0,1)/6, so 6/36.
+    let top = modes[11]["eigenvalue"].as_f64().unwrap();
+    assert!((top - 6.0 / 36.0).abs() < 1e-12, "{top}");
+    assert!(rest["asymmetry"].as_f64().unwrap() <= 1e-12);
+    assert!(rest["against_second_order"].as_f64().unwrap() <= 1e-12);
+
+    let flat = json(&[
+        "modes",
+        "--constraints",
+        "volume",
+        "--points",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0.25,0.25,0",
+        "--json",
+    ]);
+    assert_eq!(flat["negative_count"], 3, "{flat}");
+    for mode in flat["modes"].as_array().unwrap() {
+        let (value, projected) = (
+            mode["eigenvalue"].as_f64().unwrap(),
+            mode["projected"].as_f64().unwrap(),
+        );
+        assert_eq!(projected, value.max(0.0));
+    }
+    let slope = flat["convergence_slope"].as_f64().unwrap();
+    assert!(
+        (slope - 2.0).abs() < 0.1 && flat["convergence_decades"].as_f64().unwrap() >= 3.0,
+        "{flat}"
+    );
+
+    let neo = json(&[
+        "modes",
+        "--constraints",
+        "neohookean",
+        "--points",
+        "0,0,0",
+        "1,0,0",
+        "0,1,0",
+        "0,0,0.5",
+        "--json",
+    ]);
+    assert!(neo["f_space"].is_object(), "{neo}");
+    let table = stdout(&tetlab(&["modes", "--constraints", "neohookean"]));
+    assert!(table.contains("6 zero"), "{table}");
+    assert!(
+        table.contains("translation") && table.contains("rotation"),
+        "{table}"
+    );
+
+    for (args, names) in [
+        (
+            &["modes", "--points", "0,0,0", "1,0,0", "0,1,0"][..],
+            "--points",
+        ),
+        (
+            &["modes", "--rest-shape", "0,0,0", "1,0,0", "2,0,0", "3,0,0"][..],
+            "--rest-shape",
+        ),
+        (
+            &["modes", "--constraints", "none"][..],
+            "no family is active",
+        ),
+    ] {
+        assert_usage_error(&tetlab(args), names);
+    }
+}

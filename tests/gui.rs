@@ -11,6 +11,8 @@ mod gui_support;
 mod constraint_editor;
 #[path = "gui/exercise.rs"]
 mod exercise;
+#[path = "gui/modes.rs"]
+mod modes;
 
 use eframe::egui;
 use egui_kittest::Harness;

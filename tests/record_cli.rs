@@ -253,6 +253,47 @@ fn a_constraint_files_family_is_recorded_with_its_text_and_both_gradients() {
     assert!(stdout(&run).contains("constraints/height-wrong-sign"));
 }
 
+/// `--modes` logs the eigenvalues of the tet's energy Hessian each frame (twelve series in one
+/// entity) and its lowest mode as arrows, beside the rest; without it, neither.
+#[test]
+fn modes_logs_the_tets_eigenvalues_and_lowest_mode_each_frame() {
+    let dir = scratch("modes");
+    for (modes, name) in [(true, "modes.rrd"), (false, "plain.rrd")] {
+        let path = dir.join(name);
+        let mut args = vec![
+            "record",
+            "--scene",
+            "tet",
+            "--perturb",
+            "invert",
+            "--constraints",
+            "volume",
+            "--frames",
+            "5",
+            "--quiet",
+            "--out",
+            path.to_str().unwrap(),
+        ];
+        if modes {
+            args.push("--modes");
+        }
+        let output = tetlab(&args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let summary = inspect(&path);
+        let entities = summary["entities"].as_object().unwrap();
+        for entity in ["modes/eigenvalues", "world/modes/lowest"] {
+            if modes {
+                assert_eq!(
+                    entities[entity]["frame_rows"], 6,
+                    "{entity}: one row a frame"
+                );
+            } else {
+                assert!(!entities.contains_key(entity), "{entity} without --modes");
+            }
+        }
+    }
+}
+
 /// Ctrl-C (SIGINT) and SIGTERM stop after the current frame, within 5 s, with a message, and
 /// leave a complete recording of every finished frame and no partial file.
 #[cfg(unix)]

@@ -132,6 +132,91 @@ fn constraint_file(c: &mut Criterion) {
     group.finish();
 }
 
+/// C and ∇C of sixteen constraints in the fast engine's lanes (two batches of eight, as its kernel
+/// hands them to a file's family): the built-in volume and neo-Hookean pair against the same
+/// constraints from assets/constraints/volume.toml and neohookean.toml. What a file's tape costs
+/// beside the formula it replaces, without the projection around it.
+fn file_in_lanes(c: &mut Criterion) {
+    use tetlab_core::constraints::file::FileConstraint;
+    use tetlab_core::constraints::material::Material;
+    use tetlab_core::constraints::neohookean::{Deviatoric, Hydrostatic};
+    use tetlab_core::constraints::{Constraint, GROUP};
+    let tet = [
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.1, 0.0),
+        DVec3::new(0.2, 1.0, 0.1),
+        DVec3::new(0.1, 0.2, 0.9),
+    ];
+    let rest_shape = tet.map(|p| p * 1.1);
+    // Lane k of batch j a slightly different tet, so that no two lanes are alike.
+    let lanes = |points: &[DVec3; 4], j: usize| {
+        points.map(|p| {
+            Vec3x8::gather(std::array::from_fn(|k| {
+                (p + DVec3::splat(0.01 * (k + 8 * j) as f64)).as_vec3a()
+            }))
+        })
+    };
+    let p: [[Vec3x8; 4]; GROUP] = std::array::from_fn(|j| lanes(&tet, j));
+    let shape: [[Vec3x8; 4]; GROUP] = std::array::from_fn(|j| lanes(&rest_shape, j));
+    let rest = [F32x8::new([0.1; LANES]); GROUP];
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints");
+    let material = Material::default();
+    let mut group = c.benchmark_group("sixteen constraints in lanes");
+    group.bench_function("volume, built-in", |b| {
+        b.iter(|| volume::Volume.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]))
+    });
+    let file = ConstraintFile::load(&folder.join("volume.toml")).expect("the example file");
+    group.bench_function("volume, file", |b| {
+        b.iter(|| {
+            FileConstraint::<4, false>(&file).evaluate_batches(
+                black_box(&p),
+                rest,
+                &shape,
+                [&[]; GROUP],
+            )
+        })
+    });
+    group.bench_function("neo-Hookean pair, built-in", |b| {
+        b.iter(|| {
+            (
+                Deviatoric.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]),
+                Hydrostatic.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]),
+            )
+        })
+    });
+    let files = ConstraintFile::load_all(&folder.join("neohookean.toml")).expect("the example");
+    let stored: Vec<Vec<F32x8>> = files
+        .iter()
+        .map(|file| {
+            let numbers = file.store(&rest_shape, &material);
+            numbers
+                .iter()
+                .map(|&x| F32x8::new([x as f32; LANES]))
+                .collect()
+        })
+        .collect();
+    group.bench_function("neo-Hookean deviatoric alone, file", |b| {
+        b.iter(|| {
+            FileConstraint::<4, true>(&files[0]).evaluate_batches(
+                black_box(&p),
+                rest,
+                &shape,
+                [&stored[0]; GROUP],
+            )
+        })
+    });
+    group.bench_function("neo-Hookean pair, file", |b| {
+        b.iter(|| {
+            let [a, b] = [0, 1].map(|i| FileConstraint::<4, true>(&files[i]));
+            (
+                a.evaluate_batches(black_box(&p), rest, &shape, [&stored[0]; GROUP]),
+                b.evaluate_batches(black_box(&p), rest, &shape, [&stored[1]; GROUP]),
+            )
+        })
+    });
+    group.finish();
+}
+
 /// One frame of the fast solver (edges + volume, 10 substeps) on the bunny of ../shared/meshes, or
 /// on a cube of about the same size when the shared meshes are not there: Gauss–Seidel and
 /// Jacobi. The same work as `tetlab bench`, here so that builds for other CPUs are quick to
@@ -207,5 +292,5 @@ fn frame(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kernels, constraint_file, frame);
+criterion_group!(benches, kernels, constraint_file, file_in_lanes, frame);
 criterion_main!(benches);

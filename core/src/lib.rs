@@ -12,6 +12,8 @@
 //! - [`scene`]: tet meshes and their formats (TetGen, Gmsh), and the scenes built from them;
 //! - [`simulation`]: the XPBD/PBD simulation every front end drives, on its reference (f64) and
 //!   fast (f32, SIMD, threads) solvers, with the projection rule both share;
+//! - [`energy`]: a family's energy on one tet, its Hessian by automatic differentiation, checked,
+//!   and its eigenmodes, with the neo-Hookean energy's analytic eigensystem;
 //! - [`measures`]: what a state is worth, what a run came to, one scene under many orders, and
 //!   the engines against theory;
 //! - [`teaching`]: what front ends draw, step-by-step projection, the live inspector, the
@@ -21,6 +23,7 @@
 
 pub mod constraint_file;
 pub mod constraints;
+pub mod energy;
 pub mod input;
 pub mod measures;
 pub mod numbers;

@@ -200,7 +200,7 @@ fn a_constraint_against_a_fixed_plane_and_point_can_be_written() {
 }
 
 #[test]
-fn the_reverse_tape_on_tangents_gives_second_derivatives() {
+fn the_gradient_tape_on_tangents_gives_second_derivatives() {
     use tetlab_core::numbers::dual::Tangent;
     // C = |p0 − p1|: its Hessian block ∂²C/∂p0² = (I − u uᵀ) / |d|, u = d / |d|.
     let file = edge_file("", "length(p0 - p1) + 0.25 * pow(dot(p0, p0), 2)").unwrap();
@@ -212,7 +212,7 @@ fn the_reverse_tape_on_tangents_gives_second_derivatives() {
                 Tangent::new(p[i][k], if i == 0 && k == axis { 1.0 } else { 0.0 })
             })
         });
-        let (_, gradient) = file.reverse_gradient(&points, Tangent::new(0.0, 0.0), &[]);
+        let (_, gradient) = file.automatic_gradient(&points, Tangent::new(0.0, 0.0), &[]);
         let column = gradient.map(|g| DVec3::new(g[0].slope, g[1].slope, g[2].slope));
         let h = 1e-6;
         let mut plus = p;

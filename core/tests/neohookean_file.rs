@@ -30,11 +30,11 @@ fn table() -> (Families, [Family; 2]) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints/neohookean.toml");
     let files = ConstraintFile::load_all(&path).unwrap_or_else(|e| panic!("{e}"));
     let mut families = Families::builtin();
-    // What a tet stores: inverse(Dm)'s nine entries and s for the deviatoric, s / det(Dm) for
-    // the hydrostatic (docs/gradients.md).
+    // What a tet stores: inverse(Dm)'s nine entries as columns (for F) and as rows (for ∇C) and s
+    // for the deviatoric, s / det(Dm) for the hydrostatic (docs/gradients.md).
     assert_eq!(
         files.iter().map(|f| f.stored_len()).collect::<Vec<_>>(),
-        [10, 1]
+        [19, 1]
     );
     let added = families.register_all(files).unwrap();
     (families, [added[0], added[1]])

@@ -4,9 +4,9 @@
 //
 //   node tests/web/drive.mjs URL SCREENSHOT_FOLDER [REPOSITORY]
 //
-// The steps: drag the selected particle through its opposite face (the tet inverts), Space (it
-// recovers), M (every tet inverted), drop a lesson file and go to its next step (its checks are
-// read), drop a Gmsh mesh (it loads), drop a broken mesh (the page shows the error); each
+// The steps: drag the selected particle through its opposite face (the tet inverts), D (the
+// Modes window of that tet), Space (it recovers), M (every tet inverted), drop a lesson file and
+// go to its next step (its checks are read), drop a Gmsh mesh (it loads), drop a broken mesh (the page shows the error); each
 // exercise graded (a wrong answer dropped, then a right one); lesson 6 on the bunny the page
 // fetched; then every built-in lesson's steps done and their checks read (TETLAB_WEB_LESSONS=0
 // leaves that part out).
@@ -128,6 +128,17 @@ try {
   await page.mouse.move(to[0], to[1], { steps: 25 });
   await page.mouse.up();
   await expect("dragged-through-its-face", (s) => s.inverted_tets >= 1, 10);
+
+  // D opens the Modes window on the selected tet: its energy's twelve eigenvalues, with the
+  // three translations among the zero ones; D again closes it.
+  await page.keyboard.press("KeyD");
+  const modes = await expect("d-shows-the-modes", (s) => s.modes && s.modes.eigenvalues.length === 12 &&
+    s.modes.zero >= 3, 10);
+  if (modes && modes.modes) {
+    console.log(`     modes of tet ${modes.modes.tet}: ${modes.modes.zero} zero, ${modes.modes.negative} negative`);
+  }
+  await page.keyboard.press("KeyD");
+  await expect("d-closes-the-modes", (s) => !s.modes, 10);
 
   // Space plays: it recovers.
   await page.keyboard.press("Space");

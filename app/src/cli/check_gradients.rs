@@ -11,6 +11,7 @@ use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraint_file::check::{AGREEMENT, Reflection, Report, check};
 use tetlab_core::constraints::Families;
 use tetlab_core::constraints::verify::{CONDITIONING, random_check};
+use tetlab_core::energy::check::{HessianReport, MAX_SAMPLES, check as hessian_check};
 
 /// Options of `tetlab check-gradients`.
 #[derive(Debug, clap::Args)]
@@ -39,6 +40,35 @@ struct Row {
     mean_relative_error: f64,
     /// The analytic gradient against automatic differentiation.
     max_error_against_automatic_differentiation: f64,
+    /// ∇²C: forward mode over the analytic ∇C against second-order dual numbers of C, and
+    /// against central differences of AD's ∇C, largest relative errors.
+    hessian: HessianOutput,
+}
+
+/// The check of ∇²C, as `--json` writes it.
+#[derive(Serialize)]
+struct HessianOutput {
+    compared: usize,
+    against_second_order: f64,
+    against_finite_differences: f64,
+    /// The file's own blocks (`[hessian]`), keyed p0p1…: largest relative error against AD.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    yours: BTreeMap<String, Figure>,
+}
+
+impl HessianOutput {
+    fn of(r: &HessianReport) -> HessianOutput {
+        HessianOutput {
+            compared: r.compared,
+            against_second_order: r.against_second_order,
+            against_finite_differences: r.against_finite_differences,
+            yours: r
+                .yours
+                .iter()
+                .map(|&((i, j), e)| (format!("p{i}p{j}"), Figure::of(Some(e))))
+                .collect(),
+        }
+    }
 }
 
 /// Runs the check for every family and writes one row each; or checks the constraint file.
@@ -52,7 +82,9 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<bool, UsageError> {
         .all()
         .map(|family| {
             let r = random_check(&families, family, args.samples as usize, args.seed);
+            let h = hessian_check(&families, family, None, args.samples as usize, args.seed);
             Row {
+                hessian: HessianOutput::of(&h),
                 constraint: families.name(family).to_owned(),
                 compared: r.compared,
                 skipped_near_degenerate: r.skipped,
@@ -89,6 +121,10 @@ struct FileOutput {
     reflection: &'static str,
     near_degenerate: usize,
     undefined_near_degenerate: usize,
+    /// ∇²C by AD, checked; and the file's own blocks, when it gives any.
+    hessian: HessianOutput,
+    /// Whether every Hessian block the file gives agrees with AD (true when it gives none).
+    hessian_agrees: bool,
 }
 
 #[derive(Serialize)]
@@ -159,12 +195,24 @@ fn shell_word(path: &std::path::Path) -> String {
 /// when the gradient of any disagrees.
 fn run_file(args: &Args, path: &std::path::Path, out: &mut impl Write) -> Result<bool, UsageError> {
     let files = ConstraintFile::load_all(path).map_err(|e| UsageError(e.to_string()))?;
+    // The table the Hessian check evaluates the file's families through.
+    let mut families = Families::builtin();
+    let added = families
+        .register_all(files.clone())
+        .map_err(|e| UsageError(format!("{}: {e}", path.display())))?;
     let mut agrees = true;
-    for (k, file) in files.iter().enumerate() {
+    for (k, (file, family)) in files.iter().zip(added).enumerate() {
         if k > 0 && !args.json {
             writeln!(out).map_err(UsageError::stdout)?;
         }
-        agrees &= run_one_file(args, path, file, out)?;
+        let hessian = hessian_check(
+            &families,
+            family,
+            Some(file),
+            args.samples as usize,
+            args.seed,
+        );
+        agrees &= run_one_file(args, path, (file, &hessian), out)?;
     }
     Ok(agrees)
 }
@@ -172,7 +220,7 @@ fn run_file(args: &Args, path: &std::path::Path, out: &mut impl Write) -> Result
 fn run_one_file(
     args: &Args,
     path: &std::path::Path,
-    file: &ConstraintFile,
+    (file, hessian): (&ConstraintFile, &HessianReport),
     out: &mut impl Write,
 ) -> Result<bool, UsageError> {
     let report = check(file, args.samples as usize, args.seed);
@@ -192,7 +240,7 @@ fn run_one_file(
         )));
     }
     let kinks = tetlab_core::constraint_file::check::kinks(file, 200, args.seed);
-    let output = file_output(path, file, &report, &kinks);
+    let output = file_output(path, file, (&report, hessian), &kinks);
     let written = if args.json {
         serde_json::to_writer(&mut *out, &output)
             .map_err(std::io::Error::from)
@@ -201,13 +249,13 @@ fn run_one_file(
         write_file_report(args, &output, &report, out)
     };
     written.map_err(UsageError::stdout)?;
-    Ok(output.agrees)
+    Ok(output.agrees && output.hessian_agrees)
 }
 
 fn file_output(
     path: &std::path::Path,
     file: &ConstraintFile,
-    report: &Report,
+    (report, hessian): (&Report, &HessianReport),
     kinks: &[tetlab_core::constraint_file::check::Kink],
 ) -> FileOutput {
     let worst = report
@@ -265,6 +313,8 @@ fn file_output(
         reflection: report.reflection.describe(),
         near_degenerate: report.near_degenerate,
         undefined_near_degenerate: report.undefined,
+        hessian: HessianOutput::of(hessian),
+        hessian_agrees: hessian.yours_agree(AGREEMENT),
     }
 }
 
@@ -339,6 +389,7 @@ fn write_file_report(
         "near-degenerate configurations: {}; C or its gradient undefined at {} (flagged, never NaN)",
         o.near_degenerate, o.undefined_near_degenerate
     )?;
+    write_file_hessian(&o.hessian, out)?;
     writeln!(out)?;
     match &o.worst {
         None if o
@@ -370,6 +421,19 @@ fn write_file_report(
             )
         }
     }?;
+    let wrong: Vec<(&String, &Figure)> = o
+        .hessian
+        .yours
+        .iter()
+        .filter(|(_, e)| !matches!(e, Figure::Number(x) if *x <= AGREEMENT))
+        .collect();
+    for (block, error) in wrong {
+        let off = match error {
+            Figure::Number(e) => format!("{} of the Hessian's size", two_digits(*e)),
+            _ => "a non-finite amount (NaN or infinite where AD's is finite)".to_owned(),
+        };
+        writeln!(out, "DISAGREES: your Hessian block {block} is off by {off}")?;
+    }
     if !o.kinks.is_empty() {
         writeln!(out)?;
         writeln!(
@@ -400,6 +464,32 @@ fn write_file_report(
     Ok(())
 }
 
+/// The Hessian lines of a file's report.
+fn write_file_hessian(h: &HessianOutput, out: &mut impl Write) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "Hessian (∇²C) on {} configurations: forward mode over AD's ∇C against second-order AD \
+         {:.1e}, against central differences of ∇C {:.1e}",
+        h.compared, h.against_second_order, h.against_finite_differences
+    )?;
+    if h.yours.is_empty() {
+        return writeln!(
+            out,
+            "  the file gives no Hessian: nothing of yours to check (add [hessian] p0p1 = \"...\")"
+        );
+    }
+    for (block, error) in &h.yours {
+        match error {
+            Figure::Number(e) if *e <= AGREEMENT => {
+                writeln!(out, "  your {block}  {e:.2e}  agrees")?
+            }
+            Figure::Number(e) => writeln!(out, "  your {block}  {e:.2e}  WRONG")?,
+            _ => writeln!(out, "  your {block}  non-finite  WRONG")?,
+        }
+    }
+    Ok(())
+}
+
 fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()> {
     if args.json {
         for row in rows {
@@ -417,25 +507,37 @@ fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()>
     let w = rows.iter().map(|r| r.constraint.len()).max().unwrap_or(0) + 2;
     writeln!(
         out,
-        "{:<w$}{:>10}{:>10}{:>22}{:>22}{:>16}",
-        "family", "compared", "skipped", "max relative error", "mean relative error", "against AD"
+        "{:<w$}{:>10}{:>10}{:>22}{:>22}{:>16}{:>18}{:>18}",
+        "family",
+        "compared",
+        "skipped",
+        "max relative error",
+        "mean relative error",
+        "against AD",
+        "Hessian vs AD²",
+        "Hessian vs FD"
     )?;
     for r in rows {
         writeln!(
             out,
-            "{:<w$}{:>10}{:>10}{:>22.3e}{:>22.3e}{:>16.3e}",
+            "{:<w$}{:>10}{:>10}{:>22.3e}{:>22.3e}{:>16.3e}{:>18.3e}{:>18.3e}",
             r.constraint,
             r.compared,
             r.skipped_near_degenerate,
             r.max_relative_error,
             r.mean_relative_error,
-            r.max_error_against_automatic_differentiation
+            r.max_error_against_automatic_differentiation,
+            r.hessian.against_second_order,
+            r.hessian.against_finite_differences
         )?;
     }
     writeln!(
         out,
-        "(relative errors of the analytic gradient against central differences, and in the last \
-         column against automatic differentiation)"
+        "(relative errors of the analytic gradient against central differences, then against \
+         automatic differentiation; then ∇²C, forward mode over the analytic ∇C, against \
+         second-order dual numbers of C (AD²) and against central differences of AD's ∇C, on \
+         the first {} configurations at most)",
+        MAX_SAMPLES
     )?;
     Ok(())
 }

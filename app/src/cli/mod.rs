@@ -11,6 +11,7 @@ mod gradient;
 mod inspect;
 #[cfg(not(target_arch = "wasm32"))]
 mod lesson;
+mod modes;
 #[cfg(not(target_arch = "wasm32"))]
 mod record;
 mod run;
@@ -40,6 +41,9 @@ enum Command {
     /// Compare every analytic gradient with central differences and automatic differentiation
     /// on random configurations, or check your own (--constraint-file).
     CheckGradients(check_gradients::Args),
+    /// The energy of some families on one tet, its Hessian (checked) and its eigenmodes: classes,
+    /// projection, frequencies, eigenvectors.
+    Modes(modes::Args),
     /// Run a scene headless and print its metrics per frame (--json) or a summary.
     Run(run::Args),
     /// Time the solver on a scene: projections, ns per projection, frames per second, memory.
@@ -77,7 +81,10 @@ impl UsageError {
 
 /// Parses the command line, runs the subcommand and turns its outcome into an exit status.
 pub fn main() -> ExitCode {
-    let argv = args::attach_values(std::env::args_os(), "--points");
+    let argv = args::attach_values(
+        args::attach_values(std::env::args_os(), "--points"),
+        "--rest-shape",
+    );
     let cli = match Cli::try_parse_from(argv) {
         Ok(cli) => cli,
         Err(err) => return report_clap_error(err),
@@ -100,6 +107,7 @@ pub fn main() -> ExitCode {
                 success = ExitCode::FAILURE;
             }
         }),
+        Command::Modes(args) => modes::run(&args, &mut stdout),
         Command::Run(args) => run::run(&args, &mut stdout),
         Command::Bench(args) => bench::run(&args, &mut stdout),
         #[cfg(not(target_arch = "wasm32"))]

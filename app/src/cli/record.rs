@@ -43,6 +43,11 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     tet: i64,
+    /// Also log the eigenvalues of the energy Hessian of the tet given by --tet each frame
+    /// (`modes/eigenvalues`, one series each) and its lowest mode but the translations as arrows
+    /// (`world/modes/lowest`), as `tetlab modes` computes them for the active families.
+    #[arg(long)]
+    modes: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -70,7 +75,7 @@ pub fn main(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
     };
     let session = Session::open(destination, args.simulation.frames, args.quiet)?;
     let rec = session.rec();
-    send_layout(rec, &[""]);
+    send_layout(rec, &[""], args.modes);
     describe(rec, &scene, &simulation, args);
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
     match run(rec, &session, &scene, &mut simulation, &initial, args) {
@@ -90,6 +95,9 @@ fn run(
     args: &Args,
 ) -> Result<(), UsageError> {
     let mut recorder = Recorder::new(rec, "", scene, simulation, args.arrows, args.tet as usize);
+    if args.modes {
+        recorder.log_modes();
+    }
     recorder.log_frame(simulation, initial);
     for _ in 0..args.simulation.frames {
         if session.should_stop() {

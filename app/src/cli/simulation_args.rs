@@ -41,12 +41,12 @@ pub struct SimulationArgs {
     pub settle_edits: bool,
 }
 
-/// The solver's options, the same for every subcommand that simulates (`run`, `record`,
-/// `bench`); each range is [`tetlab_core::input::limits`]'s, and the ground follows gravity
-/// ([`Settings::set_gravity`]). Family names are read once the constraint files are loaded, so
-/// that `--constraints` and `--compliance` can name a file's family in any order.
+/// Which families, with which compliances and material: what every subcommand that simulates
+/// takes (within [`SolverArgs`]), and `tetlab modes`. Family names are read once the constraint
+/// files are loaded, so that `--constraints` and `--compliance` can name a file's family in any
+/// order.
 #[derive(Debug, Clone, clap::Args)]
-pub struct SolverArgs {
+pub struct FamilyArgs {
     /// Active constraint families, comma-separated: edges, height, volume, neohookean, the name
     /// of a --constraint-file's family, or none.
     #[arg(long, default_value = "edges,volume", value_name = "LIST")]
@@ -55,6 +55,55 @@ pub struct SolverArgs {
     /// family is added to the active ones; repeatable.
     #[arg(long = "constraint-file", value_name = "FILE")]
     pub constraint_files: Vec<PathBuf>,
+    /// XPBD compliance of a family, FAMILY=α (0 <= α <= 1e10; 0 is rigid, the default);
+    /// repeatable.
+    #[arg(long, value_name = "FAMILY=α", value_parser = |s: &str| NamedValue::parse(s, &limits::COMPLIANCE), allow_hyphen_values = true)]
+    pub compliance: Vec<NamedValue>,
+    /// The material of the neohookean family: Young's modulus E in Pa (1e-3..=1e13) and
+    /// Poisson's ratio nu (0 <= nu < 0.5), both required; gives its compliances 1/μ and 1/λ
+    /// [default: E=1e6,nu=0.3].
+    #[arg(long, value_name = "E=PA,nu=N", value_parser = Material::parse)]
+    pub material: Option<Material>,
+}
+
+impl FamilyArgs {
+    /// The table with every `--constraint-file`'s families, and `settings` with the active
+    /// families, the material and the compliances these options ask for. An error names the
+    /// option, and for a file the line and column of its mistake.
+    pub fn apply(&self, mut settings: Settings) -> Result<(Settings, Families), UsageError> {
+        let mut families = Families::builtin();
+        let mut files = Vec::new();
+        for path in &self.constraint_files {
+            files.extend(load_constraint_file(path, |loaded| {
+                families.register_all(loaded)
+            })?);
+        }
+        settings.active = families
+            .parse_list(&self.constraints)
+            .map_err(|e| UsageError(format!("--constraints: {e}")))?;
+        for family in files {
+            settings.active.set(family, true);
+        }
+        if let Some(material) = self.material {
+            settings.set_material(material);
+        }
+        for NamedValue { name, value } in &self.compliance {
+            let family = tetlab_core::simulation::settable_family(&families, name)
+                .map_err(|e| UsageError(format!("--compliance {name}={value}: {e}")))?;
+            settings.compliance.set(family, *value);
+        }
+        Ok((settings, families))
+    }
+}
+
+/// The solver's options, the same for every subcommand that simulates (`run`, `record`,
+/// `bench`); each range is [`tetlab_core::input::limits`]'s, and the ground follows gravity
+/// ([`Settings::set_gravity`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SolverArgs {
+    /// The families, their compliances and material.
+    #[command(flatten)]
+    pub families: FamilyArgs,
     /// xpbd or pbd.
     #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
     pub solver: Method,
@@ -79,21 +128,12 @@ pub struct SolverArgs {
     /// Gravity along −y in m/s² (-1e6..=1e6); 0 turns gravity and the ground off.
     #[arg(long, default_value_t = Settings::default().gravity, value_parser = |s: &str| limits::GRAVITY.parse(s), allow_hyphen_values = true)]
     pub gravity: f64,
-    /// XPBD compliance of a family, FAMILY=α (0 <= α <= 1e10; 0 is rigid, the default);
-    /// repeatable.
-    #[arg(long, value_name = "FAMILY=α", value_parser = |s: &str| NamedValue::parse(s, &limits::COMPLIANCE), allow_hyphen_values = true)]
-    pub compliance: Vec<NamedValue>,
     /// PBD stiffness of a family, FAMILY=k with 0 <= k <= 1 (default 1); repeatable.
     #[arg(long, value_name = "FAMILY=k", value_parser = |s: &str| NamedValue::parse(s, &limits::STIFFNESS))]
     pub stiffness: Vec<NamedValue>,
     /// Velocity damping per second (0..=1e6).
     #[arg(long, default_value_t = Settings::default().damping, value_parser = |s: &str| limits::DAMPING.parse(s), allow_hyphen_values = true)]
     pub damping: f64,
-    /// The material of the neohookean family: Young's modulus E in Pa (1e-3..=1e13) and
-    /// Poisson's ratio nu (0 <= nu < 0.5), both required; gives its compliances 1/μ and 1/λ
-    /// [default: E=1e6,nu=0.3].
-    #[arg(long, value_name = "E=PA,nu=N", value_parser = Material::parse)]
-    pub material: Option<Material>,
     /// Project each family's constraints in an order drawn from this seed (on the fast engine:
     /// its colours), instead of the mesh's; a result that changes with it hangs on the order
     /// [default: the mesh's order].
@@ -132,18 +172,9 @@ impl SolverArgs {
     /// families added to the table and to the active ones, then every family name looked up.
     /// An error names the option, and for a file the line and column of its mistake.
     pub fn settings(&self) -> Result<(Settings, Families), UsageError> {
-        let mut families = Families::builtin();
-        let files = self.load_constraint_files(&mut families)?;
-        let mut active = families
-            .parse_list(&self.constraints)
-            .map_err(|e| UsageError(format!("--constraints: {e}")))?;
-        for family in files {
-            active.set(family, true);
-        }
         let mut settings = Settings {
             method: self.solver,
             engine: self.engine.unwrap_or_default(),
-            active,
             substeps: self.substeps,
             iterations: self.iterations,
             dt: self.dt,
@@ -153,36 +184,13 @@ impl SolverArgs {
             ..Settings::default()
         };
         settings.set_gravity(self.gravity);
-        if let Some(material) = self.material {
-            settings.set_material(material);
-        }
-        for (option, values) in [
-            ("--compliance", &self.compliance),
-            ("--stiffness", &self.stiffness),
-        ] {
-            for NamedValue { name, value } in values {
-                let family = tetlab_core::simulation::settable_family(&families, name)
-                    .map_err(|e| UsageError(format!("{option} {name}={value}: {e}")))?;
-                if option == "--compliance" {
-                    settings.compliance.set(family, *value);
-                } else {
-                    settings.stiffness.set(family, *value);
-                }
-            }
+        let (mut settings, families) = self.families.apply(settings)?;
+        for NamedValue { name, value } in &self.stiffness {
+            let family = tetlab_core::simulation::settable_family(&families, name)
+                .map_err(|e| UsageError(format!("--stiffness {name}={value}: {e}")))?;
+            settings.stiffness.set(family, *value);
         }
         Ok((settings, families))
-    }
-
-    /// Loads every `--constraint-file` and adds its families (one per constraint of the file)
-    /// to `families`.
-    fn load_constraint_files(&self, families: &mut Families) -> Result<Vec<Family>, UsageError> {
-        let mut all = Vec::new();
-        for path in &self.constraint_files {
-            all.extend(load_constraint_file(path, |files| {
-                families.register_all(files)
-            })?);
-        }
-        Ok(all)
     }
 
     /// The threads the fast engine runs on: `--threads`, or every core the machine has.
@@ -210,14 +218,14 @@ impl SolverArgs {
             s.dt,
             s.gravity.show()
         );
-        for NamedValue { name, value } in &self.compliance {
+        for NamedValue { name, value } in &self.families.compliance {
             text += &format!(", compliance {name}={value}");
         }
         for NamedValue { name, value } in &self.stiffness {
             text += &format!(", stiffness {name}={value}");
         }
         let uses_material = s.active.families().any(|f| s.from_material[f]);
-        if uses_material || self.material.is_some() {
+        if uses_material || self.families.material.is_some() {
             text += &format!(", material {}", s.material.describe());
         }
         text += &describe_order(s);

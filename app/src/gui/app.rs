@@ -14,6 +14,7 @@ use super::panels::display::DisplayPanel;
 use super::panels::help::Help;
 use super::panels::inspector::Inspector;
 use super::panels::lesson::{LessonPanel, LessonState};
+use super::panels::modes::ModesPanel;
 use super::panels::readouts::Readouts;
 use super::panels::solver::SolverPanel;
 use super::panels::tools::Tools;
@@ -84,6 +85,8 @@ pub struct TetlabApp {
     pub editor: ConstraintEditor,
     /// The inspector window.
     pub inspector: Inspector,
+    /// The modes window.
+    pub modes: ModesPanel,
     /// The help window.
     pub help: Help,
     /// Frames drawn so far (the first one is announced in a browser).
@@ -186,6 +189,7 @@ impl TetlabApp {
             lesson_panel: LessonPanel::default(),
             editor: ConstraintEditor::default(),
             inspector: Inspector::default(),
+            modes: ModesPanel::default(),
             help: Help::default(),
             frames_drawn: 0,
             builtin_shown: Some((builtin, shown_resolution)),
@@ -504,6 +508,7 @@ impl TetlabApp {
             Request::Compare(families) => self.compare(families),
             Request::Settings(settings) => self.set_settings(*settings),
             Request::Constraint(files) => self.define_constraints(files),
+            Request::ShowMode(mode) => self.bench.mode_shown = mode,
         }
     }
 
@@ -522,6 +527,7 @@ impl TetlabApp {
                 self.link_to_copy = Some(url);
             }
             Action::Inspector => self.inspector.open = !self.inspector.open,
+            Action::Modes => self.modes.open = !self.modes.open,
             Action::Help => self.help.open = !self.help.open,
             Action::Lesson => self.show_lesson = !self.show_lesson,
             Action::ConstraintEditor => {
@@ -802,6 +808,7 @@ impl eframe::App for TetlabApp {
                     });
             }
             self.inspector.ui(ui, &context, &mut requests);
+            self.modes.ui(ui, &context, &mut requests);
         }
         self.help.ui(ui, &context, &mut requests);
         egui::CentralPanel::default_margins().show(ui, |ui| self.views(ui));

@@ -5,7 +5,7 @@
 //! nothing.
 
 use super::vertices::{Geometry, Vertex};
-use super::workbench::Workbench;
+use super::workbench::{ModeShown, Workbench};
 use glam::{DVec3, Vec3};
 use tetlab_core::constraints::Family;
 use tetlab_core::constraints::volume::signed_volume;
@@ -159,6 +159,7 @@ struct Key {
     hovered: Option<usize>,
     options: ViewOptions,
     stepping: bool,
+    mode: Option<ModeShown>,
 }
 
 impl ViewGeometry {
@@ -227,6 +228,7 @@ pub fn update(
         hovered,
         options: *options,
         stepping: bench.stepping.is_some(),
+        mode: bench.mode_shown,
     };
     if view.built_from == Some(key) {
         return;
@@ -369,6 +371,25 @@ pub fn update(
         );
     } else {
         tet_arrows(bench, options, arrows);
+    }
+    if let Some(mode) = bench.mode_shown.filter(|m| m.tet < tets.len()) {
+        let corners = tets[mode.tet];
+        let moved = visual::along_mode(positions, corners, &mode.vector, mode.offset);
+        for (a, b) in tetlab_core::scene::mesh::TET_EDGES {
+            line(
+                &mut geometry.overlay_lines,
+                moved[a].as_vec3(),
+                moved[b].as_vec3(),
+                visual::MODE,
+            );
+        }
+        visual::mode_arrows(
+            positions,
+            corners,
+            &mode.vector,
+            options.arrow_scale as f64,
+            arrows,
+        );
     }
     for arrow in arrows.iter() {
         draw_arrow(

@@ -7,6 +7,7 @@ use super::TetlabApp;
 use super::viewport;
 use glam::DVec3;
 use serde::Serialize;
+use tetlab_core::energy::modes::Modes;
 
 /// The workbench's state, as [`TetlabApp::report`] gives it.
 #[derive(Clone, Debug, Serialize)]
@@ -28,6 +29,23 @@ pub struct Report {
     /// The selected tet's selected corner and the centre of its opposite face, in the page's
     /// (CSS) pixels, where both are in front of the camera.
     pub drag: Option<DragReport>,
+    /// While the Modes window is open: what it shows of the selected tet's energy.
+    pub modes: Option<ModesReport>,
+}
+
+/// The Modes window's numbers: the eigenvalues of the selected tet's energy Hessian.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModesReport {
+    /// The tet.
+    pub tet: usize,
+    /// Its twelve eigenvalues, lowest first.
+    pub eigenvalues: Vec<f64>,
+    /// How many count as zero.
+    pub zero: usize,
+    /// How many are negative.
+    pub negative: usize,
+    /// The mode the view draws, by its place lowest first, if one is picked.
+    pub picked: Option<usize>,
 }
 
 /// The lesson open.
@@ -84,7 +102,6 @@ impl TetlabApp {
     pub fn report(&self) -> Report {
         let bench = &self.bench;
         let lesson = self.lesson.as_ref().map(|state| {
-            let metrics = &bench.metrics;
             let comparison = self.comparison.as_ref().map(|c| &c.bench.metrics);
             let families = bench.simulation.families();
             LessonReport {
@@ -98,7 +115,7 @@ impl TetlabApp {
                     .map(|e| CheckReport {
                         expect: e.to_string(),
                         holds: e
-                            .check(families, metrics, comparison)
+                            .check(bench.measured(comparison))
                             .is_some_and(|(_, holds)| holds),
                     })
                     .collect(),
@@ -128,7 +145,23 @@ impl TetlabApp {
             error: self.error.clone(),
             lesson,
             drag: self.drag_report(),
+            modes: self.modes_report(),
         }
+    }
+
+    fn modes_report(&self) -> Option<ModesReport> {
+        let tet = self.bench.selected_tet.filter(|_| self.modes.open)?;
+        let modes = Modes::of_tet(&self.bench.simulation, tet).ok()?;
+        Some(ModesReport {
+            tet,
+            eigenvalues: modes.values(),
+            zero: modes.zero_count(),
+            negative: modes.negative_count(),
+            picked: self
+                .modes
+                .picked
+                .filter(|_| self.bench.mode_shown.is_some()),
+        })
     }
 
     fn drag_report(&self) -> Option<DragReport> {

@@ -3,6 +3,7 @@
 //! so that no panel changes what another is still drawing.
 
 use super::shortcuts::Action;
+use super::workbench::ModeShown;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::PerFamily;
 use tetlab_core::scene::Builtin;
@@ -23,6 +24,8 @@ pub enum Request {
     Settings(Box<Settings>),
     /// A constraint file the editor compiled: its family is (re)defined and switched on.
     Constraint(Vec<ConstraintFile>),
+    /// Show this mode of a tet's energy Hessian in the view, or none.
+    ShowMode(Option<ModeShown>),
 }
 
 /// A scene the user asked for.

@@ -35,6 +35,8 @@ pub enum Action {
     ResetCamera,
     /// Show or hide the inspector.
     Inspector,
+    /// Show or hide the modes of the selected tet's energy.
+    Modes,
     /// Show or hide the lesson window.
     Lesson,
     /// Show or hide the constraint editor.
@@ -56,7 +58,7 @@ pub enum Action {
 }
 
 /// Every shortcut: key, action, what the help says.
-pub const SHORTCUTS: [(Key, Action, &str); 23] = [
+pub const SHORTCUTS: [(Key, Action, &str); 24] = [
     (Key::Space, Action::PlayPause, "play / pause"),
     (Key::N, Action::StepFrame, "step one frame"),
     (Key::U, Action::StepSubstep, "step one substep"),
@@ -87,6 +89,11 @@ pub const SHORTCUTS: [(Key, Action, &str); 23] = [
         Key::E,
         Action::Inspector,
         "inspector (numbers of the selected tet)",
+    ),
+    (
+        Key::D,
+        Action::Modes,
+        "modes (eigenvalues of the selected tet's energy)",
     ),
     (Key::L, Action::Lesson, "lessons"),
     (

@@ -264,6 +264,12 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
             format!("dp, last substep (x{})", options.correction_gain),
         );
     }
+    if bench.mode_shown.is_some() {
+        entry(
+            visual::MODE,
+            "mode of the energy (arrows; the tet moved along it)".to_owned(),
+        );
+    }
 }
 
 /// Where world point `p` appears in a view drawn in `rect`, and its depth (0 near, 1 far); `None`

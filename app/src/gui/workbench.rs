@@ -8,7 +8,7 @@ use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::simulation::divergence::Divergence;
 use tetlab_core::simulation::{Settings, Simulation};
-use tetlab_core::teaching::lesson::Action as LessonAction;
+use tetlab_core::teaching::lesson::{Action as LessonAction, Measured};
 use tetlab_core::teaching::stepper::{Advanced, StepByStep};
 
 /// The threads the fast engine runs on: every core (one in a browser).
@@ -67,6 +67,22 @@ pub struct Workbench {
     /// The edits made since the scene was loaded or reset, in order (what a link replays;
     /// particles dragged are not among them).
     pub edits: Vec<Edit>,
+    /// A mode of a tet's energy Hessian the view shows (the modes panel's pick): drawn only,
+    /// the simulation is untouched.
+    pub mode_shown: Option<ModeShown>,
+}
+
+/// An eigenmode drawn on a tet: arrows of its eigenvector at the corners, and the tet moved
+/// along it ([`tetlab_core::teaching::visual::along_mode`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeShown {
+    /// The tet.
+    pub tet: usize,
+    /// The unit eigenvector: a displacement per corner.
+    pub vector: [DVec3; 4],
+    /// How far the tet is moved along it, in tet sizes (it changes from frame to frame while
+    /// the mode is animated).
+    pub offset: f64,
 }
 
 /// An edit of the body, made from the tools or by a lesson, that a link can replay.
@@ -109,6 +125,7 @@ impl Workbench {
             diverged: None,
             revision: 0,
             edits: Vec::new(),
+            mode_shown: None,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -187,6 +204,17 @@ impl Workbench {
         if let Some(mut stepper) = self.stepping.take() {
             stepper.finish(&mut self.simulation);
             self.last_advance = None;
+        }
+    }
+
+    /// What a lesson's expectations are checked against: this simulation, its selected tet (tet
+    /// 0 when none is), its metrics, and `comparison`'s.
+    pub fn measured<'a>(&'a self, comparison: Option<&'a Metrics>) -> Measured<'a> {
+        Measured {
+            simulation: &self.simulation,
+            tet: self.selected_tet.unwrap_or(0),
+            metrics: &self.metrics,
+            comparison,
         }
     }
 

@@ -4,8 +4,9 @@ use rerun::RecordingStream;
 use tetlab_core::measures::metrics::Metrics;
 
 /// The default layout: a 3D view per root (side by side) on the left, the four metrics stacked on
-/// the right (each plot shows the metric of every root).
-pub fn send_layout(rec: &RecordingStream, roots: &[&str]) {
+/// the right (each plot shows the metric of every root), and with `modes` a plot of the
+/// eigenvalues `record --modes` logs below them.
+pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool) {
     use rerun::blueprint::{
         Blueprint, BlueprintActivation, Horizontal, Spatial3DView, TimeSeriesView, Vertical,
     };
@@ -18,6 +19,18 @@ pub fn send_layout(rec: &RecordingStream, roots: &[&str]) {
             .with_contents(contents)
             .into()
     });
+    // The eigenvalues of `record --modes`, one plot with a series per mode.
+    let modes = modes.then(|| {
+        TimeSeriesView::new("eigenvalues of the tet's energy Hessian")
+            .with_contents(
+                roots
+                    .iter()
+                    .map(|root| format!("+ {root}modes/eigenvalues"))
+                    .collect::<Vec<_>>(),
+            )
+            .into()
+    });
+    let plots: Vec<_> = plots.into_iter().chain(modes).collect();
     let views = roots.iter().map(|root| {
         let title = if root.is_empty() {
             "soft body"

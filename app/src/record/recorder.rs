@@ -5,6 +5,7 @@
 use glam::Vec3;
 use rerun::RecordingStream;
 use tetlab_core::constraints::Families;
+use tetlab_core::energy::modes::Modes;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
 use tetlab_core::simulation::Simulation;
@@ -31,7 +32,9 @@ pub enum ArrowsMode {
 /// `world/gradients/<family>` (and, for a constraint file that gives its own gradient,
 /// `world/gradients/<family>-yours` where it differs from AD's, or `-ad` where the file's is
 /// used), `world/corrections` (Δp of the last substep, at its true length),
-/// `metrics/<name>`.
+/// `metrics/<name>`; with [`Recorder::log_modes`], `modes/eigenvalues` (the twelve eigenvalues
+/// of the energy Hessian of the tet given by --tet, lowest first, one series each) and
+/// `world/modes/lowest` (its lowest mode but the translations, as arrows).
 pub struct Recorder<'a> {
     rec: &'a RecordingStream,
     root: String,
@@ -43,6 +46,7 @@ pub struct Recorder<'a> {
     logged_colours: Option<Vec<Rgba>>,
     points: Vec<Vec3>,
     arrow_scratch: Vec<Arrow>,
+    modes: bool,
 }
 
 impl<'a> Recorder<'a> {
@@ -114,7 +118,26 @@ impl<'a> Recorder<'a> {
             logged_colours: None,
             points: Vec::new(),
             arrow_scratch: Vec::new(),
+            modes: false,
         }
+    }
+
+    /// Also logs, each frame, the eigenvalues of the energy Hessian of the tet given by --tet and
+    /// its lowest mode but the translations as arrows ([`tetlab_core::energy::modes::Modes`]).
+    pub fn log_modes(&mut self) {
+        let rec = self.rec;
+        let log = |path: &str, what: &dyn rerun::AsComponents| {
+            rec.log_static(format!("{}{path}", self.root), what).ok();
+        };
+        log(
+            "modes/eigenvalues",
+            &rerun::SeriesLines::new().with_names((0..12).map(|k| format!("lambda {k}"))),
+        );
+        log(
+            "world/modes/lowest",
+            &rerun::Arrows3D::update_fields().with_colors([rgba(visual::MODE)]),
+        );
+        self.modes = true;
     }
 
     /// The tet whose arrows are logged with [`ArrowsMode::Selected`].
@@ -185,6 +208,9 @@ impl<'a> Recorder<'a> {
             )),
         );
         self.log_arrows(simulation);
+        if self.modes {
+            self.log_modes_now(simulation);
+        }
 
         for (name, value) in metrics.headline() {
             log(&format!("metrics/{name}"), &rerun::Scalars::single(value));
@@ -229,6 +255,42 @@ impl<'a> Recorder<'a> {
     }
 }
 
+impl Recorder<'_> {
+    /// The eigenvalues and lowest mode of the tet's energy Hessian now (nothing while no family
+    /// is active).
+    fn log_modes_now(&mut self, simulation: &Simulation) {
+        let Ok(modes) = Modes::of_tet(simulation, self.tet) else {
+            return;
+        };
+        let root = &self.root;
+        self.rec
+            .log(
+                format!("{root}modes/eigenvalues"),
+                &rerun::Scalars::new(modes.values()),
+            )
+            .ok();
+        self.arrow_scratch.clear();
+        let corners = simulation.tets()[self.tet];
+        let lowest = modes.lowest_deformation();
+        visual::mode_arrows(
+            simulation.positions(),
+            corners,
+            &lowest.vector,
+            1.0,
+            &mut self.arrow_scratch,
+        );
+        let arrows = &self.arrow_scratch;
+        self.rec
+            .log(
+                format!("{root}world/modes/lowest"),
+                &rerun::Arrows3D::update_fields()
+                    .with_origins(arrows.iter().map(|a| a.origin.as_vec3()))
+                    .with_vectors(arrows.iter().map(|a| a.vector.as_vec3())),
+            )
+            .ok();
+    }
+}
+
 /// Where arrows of `quantity` are logged.
 fn arrow_path(families: &Families, quantity: Quantity) -> String {
     match quantity {
@@ -238,6 +300,7 @@ fn arrow_path(families: &Families, quantity: Quantity) -> String {
             format!("world/gradients/{}-{other}", families.name(family))
         }
         Quantity::Correction => "world/corrections".to_owned(),
+        Quantity::Mode => "world/modes/lowest".to_owned(),
     }
 }
 

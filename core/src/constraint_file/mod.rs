@@ -100,12 +100,19 @@ pub struct ConstraintFile {
     prelude: Tape,
     /// How many numbers that is.
     stored: usize,
-    /// C alone: what AD differentiates.
+    /// C alone: what forward-mode AD differentiates, and where C is undefined or kinked.
     value: Tape,
-    /// C, then the gradient entries the file gives.
+    /// C, then ∇C of each particle by AD, compiled ([`program::Program::differentiate`]).
+    gradient: Tape,
+    /// C, then ∇C of each particle as the file gives it (AD's for a particle it gives none for).
     yours: Tape,
-    /// Per particle, the output of `yours` that is the file's gradient for it.
-    gradient_outputs: [Option<usize>; 4],
+    /// Per particle, whether the file gives its gradient.
+    gives: [bool; 4],
+    /// The file's own Hessian blocks (`[hessian]`), each three outputs (its columns) in the
+    /// order of `hessian_blocks`; `None` when it gives none.
+    hessian: Option<Tape>,
+    /// The particles (i, j) of each block: ∂²C/∂pᵢ∂pⱼ.
+    hessian_blocks: Vec<(usize, usize)>,
     rest: Option<Tape>,
     /// Its grade as an exercise, worked out the first time it is asked for ([`ConstraintFile::grade`]).
     grade: GradeOnce,
@@ -367,7 +374,7 @@ impl ConstraintFile {
 
     /// Whether the file gives its own gradient for particle `k`.
     pub fn gives_gradient(&self, k: usize) -> bool {
-        self.gradient_outputs.get(k).is_some_and(Option::is_some)
+        self.gives.get(k).copied().unwrap_or(false)
     }
 
     /// C at `points` with rest value `rest` and what the element stores (NaN where it is
@@ -400,8 +407,32 @@ impl ConstraintFile {
     pub fn yours(&self, points: &[DVec3], rest: f64, stored: &[f64]) -> [Option<DVec3>; 4] {
         let points = self.coordinates(points);
         self.yours.run(&self.inputs(&points, rest, stored), |r| {
-            self.gradient_outputs
-                .map(|o| o.map(|o| DVec3::from_array(r.vector(o))))
+            std::array::from_fn(|k| self.gives[k].then(|| DVec3::from_array(r.vector(1 + k))))
+        })
+    }
+
+    /// The Hessian blocks the file gives (`[hessian]`), ∂²C/∂pᵢ∂pⱼ at `points` with rest value
+    /// `rest`: each (i, j) and the 3 × 3 block, entry (r, c) = ∂²C/∂pᵢ[r]∂pⱼ[c]. Empty when the
+    /// file gives none.
+    pub fn your_hessian(
+        &self,
+        points: &[DVec3],
+        rest: f64,
+        stored: &[f64],
+    ) -> Vec<((usize, usize), glam::DMat3)> {
+        let Some(tape) = &self.hessian else {
+            return Vec::new();
+        };
+        let points = self.coordinates(points);
+        tape.run(&self.inputs(&points, rest, stored), |r| {
+            self.hessian_blocks
+                .iter()
+                .enumerate()
+                .map(|(k, &pair)| {
+                    let [c0, c1, c2] = [0, 1, 2].map(|c| DVec3::from_array(r.vector(3 * k + c)));
+                    (pair, glam::DMat3::from_cols(c0, c1, c2))
+                })
+                .collect()
         })
     }
 
@@ -491,21 +522,33 @@ impl ConstraintFile {
             self.arity()
         );
         let inputs = self.inputs(points, rest, stored);
-        if own {
-            // Where the file gives no gradient, AD's: a student may write one particle's at a
-            // time (the exercise of lesson 9 starts with none).
-            let missing = self.gradient_outputs[..N].iter().any(Option::is_none);
-            let automatic = missing.then(|| self.value.gradient::<_, N>(&inputs).1);
-            self.yours.run(&inputs, |r| {
-                let gradients = std::array::from_fn(|k| match self.gradient_outputs[k] {
-                    Some(o) => r.vector(o),
-                    None => automatic.map_or([T::ZERO; 3], |g: [[T; 3]; N]| g[k]),
-                });
-                (r.scalar(0), gradients)
-            })
-        } else {
-            self.value.gradient(&inputs)
-        }
+        let tape = if own { &self.yours } else { &self.gradient };
+        tape.run(&inputs, read_gradient)
+    }
+
+    /// How many numbers the registers of the tape of C and ∇C are ([`program::Tape::slots`]):
+    /// what [`ConstraintFile::gradient_placed`]'s registers must hold.
+    pub fn gradient_slots(&self, own: bool) -> usize {
+        if own { &self.yours } else { &self.gradient }.slots()
+    }
+
+    /// Runs the tape of C and ∇C (the file's own with `own`, else AD's) in the caller's
+    /// `registers`, at least [`ConstraintFile::gradient_slots`] numbers, with the inputs placed
+    /// there by `place` ([`program::Tape::run_placed`]), and reads it with `read`: output 0 is C,
+    /// output 1 + k the gradient of particle k. For a caller that evaluates many times on wide
+    /// numbers, and whose inputs come in another layout.
+    ///
+    /// # Panics
+    /// When `registers` is too short.
+    #[inline(always)]
+    pub fn gradient_placed<T: Real, R>(
+        &self,
+        (own, registers): (bool, &mut [T]),
+        place: impl FnOnce(&mut [T], &[u8]),
+        read: impl FnOnce(&program::Registers<'_, T>) -> R,
+    ) -> R {
+        let tape = if own { &self.yours } else { &self.gradient };
+        tape.run_placed(registers, place, read)
     }
 
     /// ∇C in f64 as [`ConstraintFile::evaluate_by`] gives it (the file's own with `own`, else
@@ -574,16 +617,16 @@ impl ConstraintFile {
         if rest.is_finite() { rest } else { 0.0 }
     }
 
-    /// C and ∇C at `points` with rest value `rest` by reverse-mode AD alone, in any [`Real`]:
-    /// on [`Tangent`] numbers whose slopes are a direction, the slopes of ∇C are the Hessian of C
-    /// times that direction (forward over reverse).
-    pub fn reverse_gradient<T: Real, const N: usize>(
+    /// C and ∇C at `points` with rest value `rest` by AD alone, in any [`Real`]: on [`Tangent`]
+    /// numbers whose slopes are a direction, the slopes of ∇C are the Hessian of C times that
+    /// direction (forward mode over the compiled reverse mode).
+    pub fn automatic_gradient<T: Real, const N: usize>(
         &self,
         points: &[[T; 3]; N],
         rest: T,
         stored: &[T],
     ) -> (T, [[T; 3]; N]) {
-        self.value.gradient(&self.inputs(points, rest, stored))
+        self.value_and_gradient(points, rest, stored, false)
     }
 
     /// Where and why C is undefined at `points` with rest value `rest`: the first expression, in
@@ -627,15 +670,21 @@ impl ConstraintFile {
         position(&self.source, file_offset(&self.source, base, offset))
     }
 
-    /// The instructions of C's tape and of the tape with the file's gradients, for the record
-    /// of what an evaluation costs.
+    /// The instructions of C's tape and of the tape of C and ∇C by AD, for the record of what an
+    /// evaluation costs.
     pub fn tape_lengths(&self) -> (usize, usize) {
-        (self.value.len(), self.yours.len())
+        (self.value.len(), self.gradient.len())
     }
 
     fn coordinates(&self, points: &[DVec3]) -> ArrayVec<[f64; 3], 4> {
         points.iter().take(4).map(|p| p.to_array()).collect()
     }
+}
+
+/// C and ∇C from the outputs of a tape of C then ∇C of each particle.
+#[inline(always)]
+fn read_gradient<T: Real, const N: usize>(r: &program::Registers<'_, T>) -> (T, [[T; 3]; N]) {
+    (r.scalar(0), std::array::from_fn(|k| r.vector(1 + k)))
 }
 
 /// C and ∇C as a simulation takes them: where either is not finite, degenerate, with C = 0 and

@@ -33,6 +33,8 @@ struct Raw {
     #[serde(default)]
     use_gradient: bool,
     #[serde(default)]
+    hessian: BTreeMap<Spanned<String>, Spanned<String>>,
+    #[serde(default)]
     stiffness: Option<Spanned<String>>,
     #[serde(default)]
     constraint: Vec<RawNamed>,
@@ -49,6 +51,7 @@ struct RawConstraint {
     rest: Option<Spanned<String>>,
     gradient: BTreeMap<Spanned<String>, Spanned<String>>,
     use_gradient: bool,
+    hessian: BTreeMap<Spanned<String>, Spanned<String>>,
     stiffness: Option<Spanned<String>>,
 }
 
@@ -65,6 +68,8 @@ struct RawNamed {
     #[serde(default)]
     use_gradient: bool,
     #[serde(default)]
+    hessian: BTreeMap<Spanned<String>, Spanned<String>>,
+    #[serde(default)]
     stiffness: Option<Spanned<String>>,
 }
 
@@ -75,6 +80,7 @@ impl RawNamed {
             rest: self.rest.clone(),
             gradient: self.gradient.clone(),
             use_gradient: self.use_gradient,
+            hessian: self.hessian.clone(),
             stiffness: self.stiffness.clone(),
         }
     }
@@ -141,6 +147,7 @@ pub(super) fn parse_all(
         rest: raw.rest.clone(),
         gradient: raw.gradient.clone(),
         use_gradient: raw.use_gradient,
+        hessian: raw.hessian.clone(),
         stiffness: raw.stiffness.clone(),
     };
     if raw.constraint.is_empty() {
@@ -171,12 +178,13 @@ pub(super) fn parse_all(
         .into_iter()
         .flatten()
         .chain(raw.gradient.values())
+        .chain(raw.hessian.values())
         .next();
     if let Some(value) = stray {
         return Err(error(
             Some(value.span().start),
             "this file has [[constraint]] tables: give each its own `value`, `rest`, `stiffness` and \
-             [gradient] there, not at the top"
+             [gradient] and [hessian] there, not at the top"
                 .to_owned(),
         ));
     }
@@ -329,8 +337,7 @@ impl Shared<'_> {
         let arity = self.binding.arity();
         let mut program = self.program(true)?;
         let c = self.output(&mut program, value, Type::Scalar, "value")?;
-        let mut outputs = vec![c];
-        let mut gradient_outputs = [None; 4];
+        let mut given = [None; 4];
         for (key, entry) in &raw.gradient {
             let particle = key
                 .get_ref()
@@ -348,13 +355,60 @@ impl Shared<'_> {
                 ));
             };
             let what = format!("gradient.{}", key.get_ref());
-            outputs.push(self.output(&mut program, entry, Type::Vector, &what)?);
-            gradient_outputs[k] = Some(outputs.len() - 1);
+            given[k] = Some(self.output(&mut program, entry, Type::Vector, &what)?);
         }
+        // The file's own Hessian blocks ∂²C/∂pᵢ∂pⱼ, each a matrix (three outputs).
+        let mut blocks = Vec::new();
+        for (key, entry) in &raw.hessian {
+            let pair = hessian_key(key.get_ref(), arity).ok_or_else(|| {
+                self.error(
+                    Some(key.span().start),
+                    format!(
+                        "hessian entry `{}`: name a block of two particles, pIpJ with I and J in \
+                         0…{} (`p0p1` is ∂²C/∂p0∂p1, a matrix)",
+                        key.get_ref(),
+                        arity - 1
+                    ),
+                )
+            })?;
+            if blocks
+                .iter()
+                .any(|&(p, _)| p == pair || p == (pair.1, pair.0))
+            {
+                return Err(self.error(
+                    Some(key.span().start),
+                    format!(
+                        "hessian entry `{}`: that block is given twice (p{}p{} is the transpose of \
+                         p{}p{})",
+                        key.get_ref(),
+                        pair.0,
+                        pair.1,
+                        pair.1,
+                        pair.0
+                    ),
+                ));
+            }
+            let what = format!("hessian.{}", key.get_ref());
+            blocks.push((pair, self.output(&mut program, entry, Type::Matrix, &what)?));
+        }
+        // ∇C by AD, compiled: C's tape with it, and the file's own where it gives none.
+        program.at(value.span().start);
+        let automatic = program
+            .differentiate(c)
+            .map_err(|e| self.compile_error(value.span().start, e, value.get_ref(), "value"))?;
+        let mut by_ad = vec![c];
+        by_ad.extend(&automatic);
+        let mut yours = vec![c];
+        yours.extend((0..arity).map(|k| given[k].unwrap_or(automatic[k])));
+        let hessian_outputs: Vec<usize> = blocks
+            .iter()
+            .flat_map(|&(_, first)| first..first + 3)
+            .collect();
         let compiled = program
-            .compiled(&[&[c], &outputs])
+            .compiled(&[&[c], &by_ad, &yours, &hessian_outputs])
             .map_err(|message| self.error(Some(value.span().start), message))?;
-        let [value_tape, yours] = <[_; 2]>::try_from(compiled.tapes).expect("two groups");
+        let [value_tape, gradient, yours, hessian] =
+            <[_; 4]>::try_from(compiled.tapes).expect("four groups");
         let rest = match &raw.rest {
             Some(rest) => {
                 let mut program = self.program(false)?;
@@ -411,12 +465,23 @@ impl Shared<'_> {
             prelude: compiled.prelude,
             stored: compiled.stored,
             value: value_tape,
+            gradient,
             yours,
-            gradient_outputs,
+            gives: given.map(|g| g.is_some()),
+            hessian: (!blocks.is_empty()).then_some(hessian),
+            hessian_blocks: blocks.iter().map(|&(pair, _)| pair).collect(),
             rest,
             grade: GradeOnce::default(),
         })
     }
+}
+
+/// The particles (i, j) of a Hessian block's key `pIpJ`, both below `arity`.
+fn hessian_key(key: &str, arity: usize) -> Option<(usize, usize)> {
+    let rest = key.strip_prefix('p')?;
+    let (i, j) = rest.split_once('p')?;
+    let (i, j) = (i.parse::<usize>().ok()?, j.parse::<usize>().ok()?);
+    (i < arity && j < arity && key.len() == 4).then_some((i, j))
 }
 
 /// Line and column (from 1, in characters) of byte `offset` of `text`.

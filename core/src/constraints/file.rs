@@ -19,6 +19,8 @@ pub struct FileConstraint<'a, const N: usize, const SHAPE: bool>(pub &'a Constra
 
 impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, SHAPE> {
     const USES_REST_SHAPE: bool = SHAPE;
+    // What a file's tapes read of the rest shape at each projection is stored.
+    const STORED_USES_REST_SHAPE: bool = false;
     // μ and λ may appear in what an element stores and in its rest value.
     const REST_USES_MATERIAL: bool = true;
     // The tape's dispatch on each instruction, paid once for GROUP batches.
@@ -63,39 +65,12 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
         _: &[[Vec3x8; N]; GROUP],
         stored: [&[F32x8]; GROUP],
     ) -> [Evaluation<Vec3x8, N>; GROUP] {
-        // Plain indexed loops, not `array::map`, `from_fn` or iterators over arrays: those
-        // compiled to copies of these wide arrays (memcpy), which cost more than the tape.
-        let file = self.0;
-        let mut points = [[Block::<F32x8, GROUP>::ZERO; 3]; N];
-        for j in 0..GROUP {
-            for k in 0..N {
-                let v = p[j][k];
-                (points[k][0].0[j], points[k][1].0[j], points[k][2].0[j]) = (v.x, v.y, v.z);
-            }
-        }
-        let mut blocks: ArrayVec<Block<F32x8, GROUP>, MAX_STORED> = ArrayVec::new();
-        for i in 0..file.stored_len() {
-            let mut block = Block::<F32x8, GROUP>::ZERO;
-            for j in 0..GROUP {
-                block.0[j] = stored[j][i];
-            }
-            blocks.push(block);
-        }
-        let (value, gradients) = through_tape(file, &points, Block(rest), &blocks);
         let mut out = [Evaluation {
             value: F32x8::ZERO,
             gradients: [Vec3x8::ZERO; N],
             degenerate: F32x8::ZERO.finite(),
         }; GROUP];
-        for j in 0..GROUP {
-            let mut g = [[F32x8::ZERO; 3]; N];
-            for k in 0..N {
-                for c in 0..3 {
-                    g[k][c] = gradients[k][c].0[j];
-                }
-            }
-            out[j] = sound::<Vec3x8, N>(value.0[j], g);
-        }
+        through_tape(self.0, p, (rest, stored), &mut out);
         out
     }
 
@@ -115,12 +90,61 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
 /// The file's C and ∇C on a block of batches, as a call of its own: one copy of the interpreter
 /// for every family and pair of this arity, which the instruction cache holds, rather than one
 /// inlined into each kernel.
+///
+/// Its registers are this thread's [`SCRATCH`], not a new stack frame each call: a frame that
+/// holds the most registers a tape may have (a hundred kilobytes of these wide numbers) costs more
+/// to enter than a short tape costs to run.
 #[inline(never)]
+// Plain indexed loops, not `array::map`, `from_fn` or iterators over arrays: those compiled to
+// copies of these wide arrays (memcpy), which cost more than the tape.
+#[allow(clippy::needless_range_loop)]
 fn through_tape<const N: usize>(
     file: &ConstraintFile,
-    points: &[[Block<F32x8, GROUP>; 3]; N],
-    rest: Block<F32x8, GROUP>,
-    stored: &[Block<F32x8, GROUP>],
-) -> (Block<F32x8, GROUP>, [[Block<F32x8, GROUP>; 3]; N]) {
-    file.value_and_gradient(points, rest, stored, file.use_gradient)
+    p: &[[Vec3x8; N]; GROUP],
+    (rest, stored): ([F32x8; GROUP], [&[F32x8]; GROUP]),
+    out: &mut [Evaluation<Vec3x8, N>; GROUP],
+) {
+    let own = file.use_gradient;
+    SCRATCH.with_borrow_mut(|scratch| {
+        let slots = file.gradient_slots(own);
+        if scratch.len() < slots {
+            // Once per thread and tape size: a later call of the same size allocates nothing.
+            scratch.resize(slots, Block::ZERO);
+        }
+        // Each batch's lanes written into the registers where the tape reads them, a batch at a
+        // time (never gathered into a block first and copied whole: a wide copy of what was
+        // just written in halves waits for the writes to land), and taken out the same way.
+        let place = |r: &mut [Block<F32x8, GROUP>], loads: &[u8]| {
+            for j in 0..GROUP {
+                for k in 0..N {
+                    let v = p[j][k];
+                    (r[3 * k].0[j], r[3 * k + 1].0[j], r[3 * k + 2].0[j]) = (v.x, v.y, v.z);
+                }
+                r[3 * N].0[j] = rest[j];
+                for (i, &at) in loads.iter().enumerate() {
+                    r[3 * N + 1 + i].0[j] = stored[j][at as usize];
+                }
+            }
+        };
+        file.gradient_placed((own, scratch), place, |r| {
+            for j in 0..GROUP {
+                let mut g = [[F32x8::ZERO; 3]; N];
+                for k in 0..N {
+                    let v = r.numbers(1 + k, 3);
+                    for c in 0..3 {
+                        g[k][c] = v[c].0[j];
+                    }
+                }
+                out[j] = sound::<Vec3x8, N>(r.numbers(0, 1)[0].0[j], g);
+            }
+        });
+    })
+}
+
+thread_local! {
+    /// The registers of a file's tape, kept by each thread that projects a file's family on the
+    /// fast engine ([`through_tape`]): grown to the largest tape it has run, never shrunk.
+    static SCRATCH: std::cell::RefCell<Vec<Block<F32x8, GROUP>>> = const {
+        std::cell::RefCell::new(Vec::new())
+    };
 }

@@ -58,6 +58,11 @@ pub trait Constraint<const N: usize>: Sync {
     /// the current positions there, and the solvers save themselves the loads.
     const USES_REST_SHAPE: bool = false;
 
+    /// Whether [`Constraint::evaluate_stored`], what the solvers call, reads `rest_shape`: a
+    /// family that stores what it needs of its rest shape ([`Constraint::store`]) does not, and
+    /// the solvers then gather no rest positions for it.
+    const STORED_USES_REST_SHAPE: bool = Self::USES_REST_SHAPE;
+
     /// Whether [`Constraint::rest_value`] depends on the material, so that the rest values are
     /// measured again when it changes.
     const REST_USES_MATERIAL: bool = false;

@@ -1,8 +1,9 @@
 //! Forward-mode automatic differentiation for the constraint code: [`Tangent`], a dual number
-//! a + a′ε (ε² = 0) over any [`Real`], and [`DualVec3`], a 3-vector of f64 ones, as a
-//! [`Vector3`]. Any formula written over those traits (the built-in families, a constraint file's
-//! compiled program) then gives, beside its value, its derivative along one direction of the
-//! inputs: seed one coordinate's slope with 1 and read ∂C/∂x from the value's slope.
+//! a + a′ε (ε² = 0) over any [`Real`], and [`DualVec3`], a 3-vector of them, as a [`Vector3`].
+//! Any formula written over those traits (the built-in families, a constraint file's compiled
+//! program) then gives, beside its value, its derivative along one direction of the inputs: seed
+//! one coordinate's slope with 1 and read ∂C/∂x from the value's slope. A dual number of dual
+//! numbers, seeded along two directions, gives a second derivative.
 
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 
@@ -180,9 +181,39 @@ impl<T: Real> Real for Tangent<T> {
 /// A dual number over f64.
 pub type Dual64 = Tangent<f64>;
 
-/// A 3-vector of dual numbers over f64.
+/// The numbers `x` (N groups of three, a point each) as dual numbers with number `j` (group j / 3,
+/// entry j % 3) seeded: the slope of anything computed from them is its derivative along that one
+/// number. One pass of forward mode.
+pub fn seed_one<const N: usize>(x: &[[f64; 3]; N], j: usize) -> [[Tangent<f64>; 3]; N] {
+    std::array::from_fn(|k| {
+        std::array::from_fn(|a| Tangent::new(x[k][a], if 3 * k + a == j { 1.0 } else { 0.0 }))
+    })
+}
+
+/// The numbers `x` as second-order dual numbers, number `i` seeded along the inner ε₁ and `j`
+/// along the outer ε₂: the ε₁ε₂ part (`.slope.slope`) of anything computed from them is its second
+/// derivative ∂²/∂xᵢ∂xⱼ.
+pub fn seed_two<const N: usize>(
+    x: &[[f64; 3]; N],
+    i: usize,
+    j: usize,
+) -> [[Tangent<Tangent<f64>>; 3]; N] {
+    let one = |at: usize, k: usize| if at == k { 1.0 } else { 0.0 };
+    std::array::from_fn(|k| {
+        std::array::from_fn(|a| {
+            let at = 3 * k + a;
+            Tangent::new(
+                Tangent::new(x[k][a], one(at, i)),
+                Tangent::new(one(at, j), 0.0),
+            )
+        })
+    })
+}
+
+/// A 3-vector of dual numbers: over f64 ([`Dual64`], the default), or of any number that compares
+/// to a `bool` (dual numbers of dual numbers, for second derivatives), as a [`Vector3`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DualVec3(pub [Dual64; 3]);
+pub struct DualVec3<T = Dual64>(pub [T; 3]);
 
 impl DualVec3 {
     /// The point `p` with the slopes `direction`.
@@ -191,51 +222,51 @@ impl DualVec3 {
     }
 }
 
-impl Add for DualVec3 {
+impl<T: Real<Mask = bool>> Add for DualVec3<T> {
     type Output = Self;
     fn add(self, b: Self) -> Self {
         DualVec3([0, 1, 2].map(|i| self.0[i] + b.0[i]))
     }
 }
-impl Sub for DualVec3 {
+impl<T: Real<Mask = bool>> Sub for DualVec3<T> {
     type Output = Self;
     fn sub(self, b: Self) -> Self {
         DualVec3([0, 1, 2].map(|i| self.0[i] - b.0[i]))
     }
 }
-impl Neg for DualVec3 {
+impl<T: Real<Mask = bool>> Neg for DualVec3<T> {
     type Output = Self;
     fn neg(self) -> Self {
         DualVec3(self.0.map(|x| -x))
     }
 }
-impl Mul<Dual64> for DualVec3 {
+impl<T: Real<Mask = bool>> Mul<T> for DualVec3<T> {
     type Output = Self;
-    fn mul(self, k: Dual64) -> Self {
+    fn mul(self, k: T) -> Self {
         DualVec3(self.0.map(|x| x * k))
     }
 }
-impl Div<Dual64> for DualVec3 {
+impl<T: Real<Mask = bool>> Div<T> for DualVec3<T> {
     type Output = Self;
-    fn div(self, k: Dual64) -> Self {
+    fn div(self, k: T) -> Self {
         DualVec3(self.0.map(|x| x / k))
     }
 }
-impl AddAssign for DualVec3 {
+impl<T: Real<Mask = bool>> AddAssign for DualVec3<T> {
     fn add_assign(&mut self, b: Self) {
         *self = *self + b;
     }
 }
-impl SubAssign for DualVec3 {
+impl<T: Real<Mask = bool>> SubAssign for DualVec3<T> {
     fn sub_assign(&mut self, b: Self) {
         *self = *self - b;
     }
 }
 
-impl Vector3 for DualVec3 {
-    type Real = Dual64;
-    const ZERO: Self = DualVec3([Dual64::ZERO; 3]);
-    fn dot(self, b: Self) -> Dual64 {
+impl<T: Real<Mask = bool>> Vector3 for DualVec3<T> {
+    type Real = T;
+    const ZERO: Self = DualVec3([T::ZERO; 3]);
+    fn dot(self, b: Self) -> T {
         self.0[0] * b.0[0] + self.0[1] * b.0[1] + self.0[2] * b.0[2]
     }
     fn cross(self, b: Self) -> Self {
@@ -247,21 +278,21 @@ impl Vector3 for DualVec3 {
         ])
     }
     fn from_f64s(x: f64, y: f64, z: f64) -> Self {
-        DualVec3([x, y, z].map(Dual64::from_f64))
+        DualVec3([x, y, z].map(T::from_f64))
     }
-    fn y(self) -> Dual64 {
+    fn y(self) -> T {
         self.0[1]
     }
-    fn set_y(&mut self, y: Dual64) {
+    fn set_y(&mut self, y: T) {
         self.0[1] = y;
     }
     fn select(mask: bool, if_true: Self, if_false: Self) -> Self {
         if mask { if_true } else { if_false }
     }
-    fn to_array(self) -> [Dual64; 3] {
+    fn to_array(self) -> [T; 3] {
         self.0
     }
-    fn from_array(a: [Dual64; 3]) -> Self {
+    fn from_array(a: [T; 3]) -> Self {
         DualVec3(a)
     }
 }

@@ -271,7 +271,7 @@ impl Visit for Sweep<'_> {
             let c = self.which.at(self.set, k);
             let idx = self.set.indices::<N>(c);
             let p = idx.map(|i| self.positions[i as usize]);
-            let shape = if C::USES_REST_SHAPE {
+            let shape = if C::STORED_USES_REST_SHAPE {
                 idx.map(|i| self.rest_positions[i as usize])
             } else {
                 p

@@ -93,7 +93,7 @@ fn show(
     bench: &Workbench,
     comparison: Option<&Metrics>,
 ) -> Option<LessonRequest> {
-    let (families, metrics) = (bench.simulation.families(), &bench.metrics);
+    let families = bench.simulation.families();
     let mut request = None;
     let size = if large { 22.0 } else { 14.0 };
     if !large || state.is_none() {
@@ -158,7 +158,7 @@ fn show(
     ui.label(egui::RichText::new(&step.text).size(size));
     ui.add_space(size * 0.4);
     for expectation in &step.expect {
-        let (mark, colour, measured) = match expectation.check(families, metrics, comparison) {
+        let (mark, colour, measured) = match expectation.check(bench.measured(comparison)) {
             Some((value, true)) => ("[ok]", egui::Color32::from_rgb(60, 180, 90), value),
             Some((value, false)) => ("[..]", egui::Color32::from_rgb(220, 160, 40), value),
             None => ("[..]", egui::Color32::GRAY, f64::NAN),

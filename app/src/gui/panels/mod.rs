@@ -11,6 +11,7 @@ pub mod display;
 pub mod help;
 pub mod inspector;
 pub mod lesson;
+pub mod modes;
 pub mod readouts;
 pub mod solver;
 pub mod tools;

@@ -69,6 +69,11 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>, actions: &mut Vec<Action>) {
                         "E: C, grad C, w, lambda of this tet's constraints",
                         Action::Inspector,
                     ),
+                    (
+                        "Modes",
+                        "D: the eigenvalues and modes of this tet's energy",
+                        Action::Modes,
+                    ),
                 ] {
                     if ui.button(label).on_hover_text(hint).clicked() {
                         actions.push(action);

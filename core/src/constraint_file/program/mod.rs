@@ -1,37 +1,44 @@
 //! A constraint file's expressions, type-checked and compiled once ([`Program`]), then cut into
 //! flat tapes ([`Tape`]): each instruction defines one register from earlier ones (single
-//! assignment), so a tape runs front to back for values and back to front for gradients.
+//! assignment), and a tape runs front to back.
 //!
 //! Running a tape allocates nothing (its registers live on the stack, at most
-//! [`MAX_REGISTERS`]) and is generic over the scalar type ([`Real`]): f64, f32, SIMD lanes, or
-//! the dual numbers of forward-mode automatic differentiation ([`crate::numbers::dual::Tangent`]).
+//! [`MAX_REGISTERS`], or in the caller's) and is generic over the scalar type ([`Real`]): f64,
+//! f32, SIMD lanes, or the dual numbers of forward-mode automatic differentiation
+//! ([`crate::numbers::dual::Tangent`]).
 //!
 //! # Types
 //! Scalars, 3-vectors and 3×3 matrices. A matrix is compiled into its three columns, each a
 //! vector register, and every matrix operation into vector and scalar instructions (`M v` is
-//! Σⱼ cⱼ vⱼ; `inverse(M)` has the rows (c₁×c₂, c₂×c₀, c₀×c₁) / det M), so a tape knows only
-//! scalars and vectors and each instruction's derivative rule covers matrices too.
+//! Σⱼ cⱼ vⱼ, one instruction; `inverse(M)` has the rows (c₁×c₂, c₂×c₀, c₀×c₁) / det M), so a
+//! tape knows only scalars and vectors and each instruction's derivative rule covers matrices
+//! too. The same instruction on the same registers is compiled once (common subexpressions),
+//! x·1, x/1 and −(−x) are x, and what a constant gives is folded.
 //!
 //! # What is worked out once per element
 //! An instruction that reads only the rest shape (`q0`…, `Dm`, `V0`) and the material (`mu`,
 //! `lambda`, `gamma`), never the particles, has the same value at every projection of its
 //! element. [`Program::compiled`] cuts those into a prelude, run once per element when the rest
-//! values are measured, whose results the element stores ([`Op::Stored`]); the tapes that run at
+//! values are measured, whose results the element stores; the tapes that run at
 //! every projection read them.
 //!
 //! # Gradients, two ways
 //! - **Forward mode** ([`Tape::run`] over [`crate::numbers::dual::Tangent`] numbers): one pass per
 //!   coordinate, 3N passes for N particles. Independent of everything below; `tetlab
 //!   check-gradients` checks your gradient against it.
-//! - **Reverse mode** ([`Tape::gradient`]): one pass forward for the values, one backward that
-//!   carries ∂C/∂(register) from C to the particles, each instruction by its own derivative rule
-//!   (for r = a·b: ā += r̄ b, b̄ += r̄ a). About three forward passes' work for the whole gradient:
-//!   what a simulation uses. The two agree to rounding (`core/tests/constraint_files.rs`).
+//! - **Reverse mode, compiled** ([`Program::differentiate`], in `derivative.rs`): the backward
+//!   pass that carries ∂C/∂(register) from C to the particles, each instruction by its own
+//!   derivative rule (for r = a·b: ā += r̄ b, b̄ += r̄ a), carried out once when the file is
+//!   compiled, into instructions of the program. ∇C is then outputs of one tape that runs
+//!   forward, about three times C's work: what a simulation uses. The two agree to rounding
+//!   (`core/tests/constraint_files.rs`).
 
+mod derivative;
 mod op;
 mod tape;
 
-pub use op::{Inputs, MAX_REGISTERS, MAX_STORED};
+pub use op::{Inputs, MAX_REGISTERS, MAX_STORED, MAX_WRITTEN};
+use tape::InputLayout;
 pub use tape::{Registers, Switch, Tape, Undefined};
 
 use super::expression::{BinaryOp, Expr, Span};
@@ -285,8 +292,8 @@ impl Program {
         Ok(())
     }
 
-    /// Adds an output of type `wanted` (a scalar or a vector); returns its index, for
-    /// [`Program::tape`].
+    /// Adds an output of type `wanted`; returns its index, for [`Program::tape`]. A matrix is
+    /// three outputs, its columns, from that index on.
     pub fn output(&mut self, expr: &Expr, wanted: Type, what: &str) -> Result<usize, CompileError> {
         let value = self.compile(expr)?;
         if value.ty != wanted {
@@ -299,8 +306,10 @@ impl Program {
                 ),
             });
         }
-        self.outputs.push(value.r[0]);
-        Ok(self.outputs.len() - 1)
+        let first = self.outputs.len();
+        let columns = if wanted == Type::Matrix { 3 } else { 1 };
+        self.outputs.extend_from_slice(&value.r[..columns]);
+        Ok(first)
     }
 
     /// The instructions outputs `outputs` need and no other, in order, renumbered: a definition
@@ -318,12 +327,6 @@ impl Program {
     /// assert_eq!(tape.run(&Inputs::of(&points, 1.0), |r| r.scalar(0)), 4.0);
     /// let points32 = [[3.0f32, 0.0, 4.0], [0.0; 3]];
     /// assert_eq!(tape.run(&Inputs::of(&points32, 1.0), |r| r.scalar(0)), 4.0f32);
-    /// // Its gradient, by the backward pass: ∇p0 C is the unit vector from p1 to p0, and
-    /// // ∇p1 C = −∇p0 C.
-    /// let (value, [g0, g1]) = tape.gradient::<f64, 2>(&Inputs::of(&points, 1.0));
-    /// assert_eq!(value, 4.0);
-    /// assert!((g0[0] - 0.6).abs() < 1e-15 && g0[1] == 0.0 && (g0[2] - 0.8).abs() < 1e-15);
-    /// assert_eq!(g1, g0.map(|x| -x));
     /// ```
     pub fn tape(&self, outputs: &[usize]) -> Tape {
         let regs: Vec<Reg> = outputs.iter().map(|&o| self.outputs[o]).collect();
@@ -437,19 +440,53 @@ impl Program {
                 }
             }
         }
-        // Each register renumbered to where its value starts among the tape's numbers.
+        // Each register renumbered to where its value starts among the tape's numbers: first
+        // the inputs (the particles, `rest`, the stored registers it reads), then one register
+        // per instruction.
         let mut map = vec![0 as Reg; self.ops.len()];
+        let mut slots = 3 * self.arity + 1;
+        let (mut loads, mut loaded) = (Vec::new(), Vec::new());
+        for (r, op) in self.ops.iter().enumerate() {
+            if !needed[r] {
+                continue;
+            }
+            if let Some(&(at, vector)) = stored.get(&(r as Reg)) {
+                map[r] = slots as Reg;
+                loaded.push((slots as Reg, vector, self.origins[r]));
+                let width = if vector { 3 } else { 1 };
+                loads.extend(at..at + width);
+                slots += width as usize;
+            } else if let Op::Particle(k) = op {
+                map[r] = 3 * *k as Reg;
+            } else if *op == Op::Rest {
+                map[r] = 3 * self.arity as Reg;
+            }
+        }
+        // Then the constants, placed with the inputs (no instruction works them out).
+        let mut constants = Vec::new();
+        for (r, op) in self.ops.iter().enumerate() {
+            let value = match *op {
+                Op::Const(x) => &[x][..],
+                Op::ConstVector(ref v) => &v[..],
+                _ => continue,
+            };
+            if needed[r] && !stored.contains_key(&(r as Reg)) {
+                map[r] = slots as Reg;
+                constants.extend_from_slice(value);
+                slots += value.len();
+            }
+        }
         let mut ops = Vec::new();
         let mut origins = Vec::new();
         let mut vector = Vec::new();
-        let mut slots = 0usize;
         for (r, op) in self.ops.iter().enumerate() {
-            if needed[r] {
+            let input = matches!(
+                op,
+                Op::Particle(_) | Op::Rest | Op::Const(_) | Op::ConstVector(_)
+            ) || stored.contains_key(&(r as Reg));
+            if needed[r] && !input {
                 map[r] = slots as Reg;
-                ops.push(match stored.get(&(r as Reg)) {
-                    Some(&(at, vector)) => Op::Stored(at, vector),
-                    None => op.renumbered(&map),
-                });
+                ops.push(op.renumbered(&map));
                 origins.push(self.origins[r]);
                 let wide = self.is_vector(r as Reg);
                 vector.push(wide);
@@ -457,6 +494,12 @@ impl Program {
             }
         }
         Tape::new(
+            InputLayout {
+                arity: self.arity,
+                loads,
+                loaded,
+                constants,
+            },
             ops,
             origins,
             vector,
@@ -477,7 +520,7 @@ impl Program {
         let depends = match op {
             Op::Const(_) | Op::ConstVector(_) => Depends::Nothing,
             Op::RestParticle(_) | Op::Material(_) => Depends::Element,
-            Op::Particle(_) | Op::Rest | Op::Stored(..) => Depends::Projection,
+            Op::Particle(_) | Op::Rest => Depends::Projection,
             _ => op
                 .inputs()
                 .iter()
@@ -498,13 +541,52 @@ impl Program {
     /// Adds `op`, from the text at `span` that `what` names, folded to a constant when every
     /// input is one; an error when that constant is not finite.
     fn emit(&mut self, op: Op, span: Span, what: &'static str) -> Result<Reg, CompileError> {
-        if self.ops.len() + 1 >= MAX_REGISTERS {
+        if self.ops.len() + 1 >= MAX_WRITTEN {
             return Err(CompileError {
                 span,
                 message: format!(
-                    "the expressions are too long: more than {MAX_REGISTERS} operations in all"
+                    "the expressions are too long: more than {MAX_WRITTEN} operations in all"
                 ),
             });
+        }
+        self.emit_unchecked(op, span, what)
+    }
+
+    /// Adds `op` for the derivative of the instruction that came from `origin`
+    /// ([`Program::differentiate`]), placed where that instruction is.
+    fn emit_from(&mut self, op: Op, origin: Origin) -> Result<Reg, CompileError> {
+        let span = Span {
+            start: origin.offset,
+            end: origin.offset,
+        };
+        if self.ops.len() + 1 >= MAX_REGISTERS {
+            return Err(CompileError {
+                span: Span { start: 0, end: 0 },
+                message: format!(
+                    "its gradient is too long to compile: more than {MAX_REGISTERS} operations \
+                     with C's"
+                ),
+            });
+        }
+        let base = std::mem::replace(&mut self.base, origin.base);
+        let emitted = self.emit_unchecked(op, span, origin.what);
+        self.base = base;
+        emitted
+    }
+
+    /// [`Program::emit`] without the limit: folded when every input is a constant, an identity
+    /// (x·1, x/1, −(−x)) reduced to what it is.
+    fn emit_unchecked(
+        &mut self,
+        op: Op,
+        span: Span,
+        what: &'static str,
+    ) -> Result<Reg, CompileError> {
+        if let Some(same) = self.identity(op) {
+            return Ok(same);
+        }
+        if let Some(fused) = self.fused(op, span, what)? {
+            return Ok(fused);
         }
         let constant = |r: Reg| match self.ops[r as usize] {
             Op::Const(x) => Some([x, 0.0, 0.0]),
@@ -524,9 +606,11 @@ impl Program {
                 at
             });
             let start = registers.len();
-            laid_out.apply(&mut registers, &Inputs::of(&[], 0.0));
+            registers.extend([0.0; 3]);
+            laid_out.apply(&mut registers, start, &Inputs::of(&[], 0.0));
+            let width = if op.is_vector() { 3 } else { 1 };
             let mut folded = [0.0; 3];
-            folded[..registers.len() - start].copy_from_slice(&registers[start..]);
+            folded[..width].copy_from_slice(&registers[start..start + width]);
             if !folded.iter().all(|x| x.is_finite()) {
                 return Err(CompileError {
                     span,
@@ -540,7 +624,66 @@ impl Program {
             };
             return Ok(self.record(constant, span, what));
         }
+        // The same instruction on the same registers, when there is one, is the same value
+        // (common subexpressions): but for a switch, whose every place is a kink of its own.
+        if !op.switches() {
+            let earlier = self.ops.iter().rposition(|&o| o.same_as(op));
+            if let Some(r) = earlier {
+                return Ok(r as Reg);
+            }
+        }
         Ok(self.record(op, span, what))
+    }
+
+    /// One instruction for a chain of them, where it computes the same numbers in the same order:
+    /// (a x + b y) + c z of vectors a, b, c and scalars x, y, z is a matrix times a vector
+    /// ([`Op::MatVec`]), which the gradient of a matrix product is made of.
+    fn fused(
+        &mut self,
+        op: Op,
+        span: Span,
+        what: &'static str,
+    ) -> Result<Option<Reg>, CompileError> {
+        let Op::AddV(sum, last) = op else {
+            return Ok(None);
+        };
+        let (Op::AddV(first, second), Op::Scale(c, z)) =
+            (self.ops[sum as usize], self.ops[last as usize])
+        else {
+            return Ok(None);
+        };
+        let (Op::Scale(a, x), Op::Scale(b, y)) =
+            (self.ops[first as usize], self.ops[second as usize])
+        else {
+            return Ok(None);
+        };
+        let v = self.emit_unchecked(Op::Vec3(x, y, z), span, what)?;
+        Ok(Some(self.emit_unchecked(
+            Op::MatVec(a, b, c, v),
+            span,
+            what,
+        )?))
+    }
+
+    /// The register `op` would equal exactly, bit for bit, when it is an identity: x·1, 1·x, v·1,
+    /// x/1, v/1, −(−x).
+    fn identity(&self, op: Op) -> Option<Reg> {
+        let one = |r: Reg| self.ops[r as usize] == Op::Const(1.0);
+        match op {
+            Op::MulS(a, b) if one(b) => Some(a),
+            Op::MulS(a, b) if one(a) => Some(b),
+            Op::Scale(v, f) | Op::Shrink(v, f) if one(f) => Some(v),
+            Op::DivS(a, b) if one(b) => Some(a),
+            Op::NegS(a) => match self.ops[a as usize] {
+                Op::NegS(x) => Some(x),
+                _ => None,
+            },
+            Op::NegV(a) => match self.ops[a as usize] {
+                Op::NegV(x) => Some(x),
+                _ => None,
+            },
+            _ => None,
+        }
     }
 
     /// `op` applied to each column of matrix `m` (`column` gives the instruction for one).
@@ -558,18 +701,10 @@ impl Program {
         Ok(Value::matrix(out))
     }
 
-    /// M v = Σⱼ cⱼ vⱼ.
+    /// M v = Σⱼ cⱼ vⱼ, one instruction ([`Op::MatVec`]).
     fn times_vector(&mut self, m: Value, v: Reg, span: Span) -> Result<Reg, CompileError> {
-        let mut sum = None;
-        for j in 0..3 {
-            let component = self.emit(Op::Component(v, j as u8), span, "*")?;
-            let term = self.emit(Op::Scale(m.r[j], component), span, "*")?;
-            sum = Some(match sum {
-                None => term,
-                Some(s) => self.emit(Op::AddV(s, term), span, "*")?,
-            });
-        }
-        Ok(sum.expect("three terms"))
+        let [c0, c1, c2] = m.r;
+        self.emit(Op::MatVec(c0, c1, c2, v), span, "*")
     }
 
     /// Mᵀ: its rows as columns.

@@ -1,6 +1,7 @@
 //! The instructions of a tape ([`Op`]): what each computes from the registers it reads
 //! ([`Op::apply`], generic over [`Real`]), the registers it reads, and why its value is not
-//! finite when it is not. The derivative rules are the backward pass's ([`super::tape`]).
+//! finite when it is not. Its derivative rule is in `derivative.rs`
+//! ([`super::Program::differentiate`]).
 
 use crate::constraint_file::expression::CompareOp;
 use crate::numbers::vector::Real;
@@ -11,9 +12,13 @@ use arrayvec::ArrayVec;
 /// scalar is one number there, a vector three.
 pub(super) type Reg = u16;
 
-/// The most registers (instructions) a program may have: tapes keep their registers on the stack,
-/// so that an evaluation allocates nothing.
-pub const MAX_REGISTERS: usize = 160;
+/// The most operations the expressions of a file may take in all.
+pub const MAX_WRITTEN: usize = 160;
+
+/// The most registers (instructions) a program may have, its gradient's included
+/// ([`super::Program::differentiate`]): tapes keep their registers on the stack, so that an
+/// evaluation allocates nothing.
+pub const MAX_REGISTERS: usize = 4 * MAX_WRITTEN;
 
 pub use crate::constraints::MAX_STORED;
 
@@ -32,8 +37,6 @@ pub(super) enum Op {
     RestParticle(u8),
     /// μ, λ or γ = 1 + μ/λ of the material.
     Material(u8),
-    /// A number (`false`) or vector (`true`) stored per element, from this offset.
-    Stored(u8, bool),
     Rest,
     NegS(Reg),
     NegV(Reg),
@@ -56,6 +59,10 @@ pub(super) enum Op {
     Min(Reg, Reg),
     Max(Reg, Reg),
     Det(Reg, Reg, Reg),
+    /// A matrix (its columns c₀, c₁, c₂) times a vector v: c₀ v.x + c₁ v.y + c₂ v.z, summed in
+    /// that order. One instruction for what would be eight (three components, three scalings,
+    /// two sums): a matrix product is three of them.
+    MatVec(Reg, Reg, Reg, Reg),
     Sin(Reg),
     Cos(Reg),
     Exp(Reg),
@@ -80,8 +87,7 @@ impl Op {
     pub(super) fn map_inputs(self, mut f: impl FnMut(Reg) -> Reg) -> Op {
         use Op::*;
         match self {
-            Const(_) | ConstVector(_) | Particle(_) | RestParticle(_) | Material(_)
-            | Stored(..) | Rest => self,
+            Const(_) | ConstVector(_) | Particle(_) | RestParticle(_) | Material(_) | Rest => self,
             NegS(a) => NegS(f(a)),
             NegV(a) => NegV(f(a)),
             Length(a) => Length(f(a)),
@@ -111,6 +117,11 @@ impl Op {
             Max(a, b) => Max(f(a), f(b)),
             Atan2(a, b) => Atan2(f(a), f(b)),
             Det(a, b, c) => Det(f(a), f(b), f(c)),
+            MatVec(a, b, c, v) => {
+                let (a, b) = (f(a), f(b));
+                let (c, v) = (f(c), f(v));
+                MatVec(a, b, c, v)
+            }
             Vec3(a, b, c) => Vec3(f(a), f(b), f(c)),
             If(cmp, a, b, t, e) => {
                 let (a, b) = (f(a), f(b));
@@ -122,6 +133,16 @@ impl Op {
                 let (t, e) = (f(t), f(e));
                 IfVector(cmp, a, b, t, e)
             }
+        }
+    }
+
+    /// Whether it is `other`, to the bit: constants are compared by their bits, so that 0 and −0
+    /// are two.
+    pub(super) fn same_as(self, other: Op) -> bool {
+        match (self, other) {
+            (Op::Const(a), Op::Const(b)) => a.to_bits() == b.to_bits(),
+            (Op::ConstVector(a), Op::ConstVector(b)) => a.map(f64::to_bits) == b.map(f64::to_bits),
+            _ => self == other,
         }
     }
 
@@ -142,22 +163,22 @@ impl Op {
 
     /// Whether its value is a vector.
     pub(super) fn is_vector(self) -> bool {
-        match self {
+        matches!(
+            self,
             Op::Particle(_)
-            | Op::RestParticle(_)
-            | Op::NegV(_)
-            | Op::AddV(..)
-            | Op::SubV(..)
-            | Op::Scale(..)
-            | Op::Shrink(..)
-            | Op::Cross(..)
-            | Op::Normalize(_)
-            | Op::Vec3(..) => true,
-            Op::ConstVector(_) => true,
-            Op::Stored(_, vector) => vector,
-            Op::IfVector(..) => true,
-            _ => false,
-        }
+                | Op::RestParticle(_)
+                | Op::NegV(_)
+                | Op::AddV(..)
+                | Op::SubV(..)
+                | Op::Scale(..)
+                | Op::Shrink(..)
+                | Op::Cross(..)
+                | Op::Normalize(_)
+                | Op::Vec3(..)
+                | Op::MatVec(..)
+                | Op::ConstVector(_)
+                | Op::IfVector(..)
+        )
     }
 
     /// Whether C has a kink (or a jump) where this instruction switches: the zeros of `abs`'s
@@ -169,11 +190,11 @@ impl Op {
         )
     }
 
-    /// Its value, from the registers `r` it reads (earlier ones) and the inputs, pushed onto `r`:
-    /// one number for a scalar, three for a vector.
+    /// Its value, from the registers `r` it reads (earlier ones) and the inputs, written into `r`
+    /// from `at`: one number for a scalar, three for a vector.
     #[inline(always)]
-    pub(super) fn apply<T: Real>(self, r: &mut ArrayVec<T, MAX_SLOTS>, inputs: &Inputs<'_, T>) {
-        // Each arm pushes its own value, so that nothing wider than it is moved.
+    pub(super) fn apply<T: Real>(self, r: &mut [T], at: usize, inputs: &Inputs<'_, T>) {
+        // Each arm writes its own value, so that nothing wider than it is moved.
         macro_rules! s {
             ($i:expr) => {
                 r[$i as usize]
@@ -181,22 +202,22 @@ impl Op {
         }
         macro_rules! v {
             ($i:expr) => {{
-                let at = $i as usize;
-                [r[at], r[at + 1], r[at + 2]]
+                let from = $i as usize;
+                [r[from], r[from + 1], r[from + 2]]
             }};
         }
         macro_rules! scalar {
             ($x:expr) => {{
                 let x = $x;
-                r.push(x)
+                r[at] = x;
             }};
         }
         macro_rules! vector {
             ($v:expr) => {{
                 let [x, y, z] = $v;
-                r.push(x);
-                r.push(y);
-                r.push(z);
+                r[at] = x;
+                r[at + 1] = y;
+                r[at + 2] = z;
             }};
         }
         match self {
@@ -205,15 +226,6 @@ impl Op {
             Op::Particle(k) => vector!(inputs.points[k as usize]),
             Op::RestParticle(k) => vector!(inputs.shape[k as usize]),
             Op::Material(k) => scalar!(inputs.material[k as usize]),
-            Op::Stored(at, vector) => {
-                let at = at as usize;
-                let s = inputs.stored;
-                if vector {
-                    vector!([s[at], s[at + 1], s[at + 2]])
-                } else {
-                    scalar!(s[at])
-                }
-            }
             Op::Rest => scalar!(inputs.rest),
             Op::NegS(a) => scalar!(-s!(a)),
             Op::NegV(a) => vector!(scale(v!(a), -T::ONE)),
@@ -243,6 +255,7 @@ impl Op {
                 scalar!(T::select(x.gt(y), x, y))
             }
             Op::Det(a, b, c) => scalar!(dot(v!(a), cross(v!(b), v!(c)))),
+            Op::MatVec(a, b, c, x) => vector!(mat_vec([v!(a), v!(b), v!(c)], v!(x))),
             Op::Sin(a) => scalar!(s!(a).sin()),
             Op::Cos(a) => scalar!(s!(a).cos()),
             Op::Exp(a) => scalar!(s!(a).exp()),
@@ -286,7 +299,7 @@ impl Op {
 }
 
 /// What a tape reads besides its instructions: the particles, their rest positions, the rest
-/// value, the material (μ, λ, γ) and the numbers stored for the element ([`Op::Stored`]).
+/// value, the material (μ, λ, γ) and the numbers stored for the element.
 #[derive(Clone, Copy, Debug)]
 pub struct Inputs<'a, T> {
     /// p0, p1, …
@@ -348,6 +361,15 @@ pub(super) fn shrink<T: Real>(a: [T; 3], k: T) -> [T; 3] {
 #[inline(always)]
 pub(super) fn dot<T: Real>(a: [T; 3], b: [T; 3]) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The matrix of columns `m` times `v`: m₀ v.x + m₁ v.y + m₂ v.z, summed in that order.
+#[inline(always)]
+pub(super) fn mat_vec<T: Real>(m: [[T; 3]; 3], v: [T; 3]) -> [T; 3] {
+    add3(
+        add3(scale(m[0], v[0]), scale(m[1], v[1])),
+        scale(m[2], v[2]),
+    )
 }
 
 #[inline(always)]

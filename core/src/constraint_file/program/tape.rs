@@ -1,18 +1,32 @@
 //! A tape ([`Tape`]): what some outputs of a [`super::Program`] need, as flat single-assignment
-//! instructions, run front to back for values ([`Tape::run`]) and back to front for gradients
-//! ([`Tape::gradient`], reverse mode), on the stack, in any [`Real`].
+//! instructions, run front to back ([`Tape::run`]) on the stack or in the caller's registers
+//! ([`Tape::run_in`]), in any [`Real`]. A gradient is outputs like any other: its instructions
+//! were compiled ([`super::Program::differentiate`]).
 
 use super::Origin;
-use super::op::{Inputs, MAX_SLOTS, Op, Reg, add3, cross, dot, holds, scale, shrink, sub3};
+use super::op::{Inputs, MAX_SLOTS, Op, Reg};
 use crate::numbers::vector::Real;
 use arrayvec::ArrayVec;
 
-/// What some outputs of a [`Program`] need, as flat single-assignment instructions: instruction k
-/// defines the next register from earlier ones. The registers are numbers side by side, one for
-/// a scalar and three for a vector, and an instruction names each register it reads by where
-/// its value starts ([`Reg`]), so that a scalar instruction reads and writes one number.
+/// What some outputs of a [`Program`] need, as flat single-assignment instructions.
+///
+/// The registers are numbers side by side, one for a scalar and three for a vector, and an
+/// instruction names each register it reads by where its value starts ([`Reg`]), so that a scalar
+/// instruction reads and writes one number. The first registers are the tape's inputs, placed
+/// there before any instruction runs: the particles (three numbers each, p0 from 0), `rest`, then
+/// the stored numbers the tape reads ([`Op`] has no instruction for them, so that reading an input
+/// costs no dispatch). Instruction k then defines the next register from earlier ones.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tape {
+    /// How many particles the inputs begin with.
+    arity: usize,
+    /// Per stored number the tape reads, in the order of its registers, where it is among the
+    /// numbers the element stores.
+    loads: Vec<u8>,
+    /// The stored registers: where each starts, whether a vector, and the text it came from.
+    loaded: Vec<(Reg, bool, Origin)>,
+    /// The constants' numbers, which follow the stored ones among the inputs.
+    constants: Vec<f64>,
     pub(super) ops: Vec<Op>,
     pub(super) origins: Vec<Origin>,
     /// Whether each instruction's value is a vector.
@@ -20,13 +34,13 @@ pub struct Tape {
     /// Where each instruction's value starts.
     starts: Vec<Reg>,
     pub(super) outputs: Vec<Reg>,
-    /// The instruction that defines output 0 (C): the backward pass starts there.
-    first_output: usize,
     /// For a prelude, whether each output is a vector (three stored numbers) or a scalar.
     pub(super) widths: Vec<bool>,
-    /// Per number, whether it depends on a particle: the backward pass skips the others, and
-    /// carries no adjoint into them (a stored number, a constant, `rest`).
-    varying: Vec<bool>,
+    /// How many numbers the registers are, inputs included.
+    slots: usize,
+    /// Whether an instruction reads the rest shape or the material (a prelude's, a rest
+    /// value's), not only the inputs it is given in its registers.
+    reads_element: bool,
 }
 
 /// The registers of a tape after [`Tape::run`]: read its outputs.
@@ -52,6 +66,13 @@ impl<T: Copy> Registers<'_, T> {
         ]
     }
 
+    /// Output `i` of the tape where it is: one number for a scalar, three for a vector (a caller
+    /// that takes only part of each number reads only that part).
+    pub fn numbers(&self, i: usize, width: usize) -> &[T] {
+        let at = self.outputs[i] as usize;
+        &self.registers[at..at + width]
+    }
+
     /// A prelude's outputs, in order, into `out`: a scalar's one number, a vector's three
     /// ([`super::Compiled::stored`] of them in all).
     pub fn write_all(&self, out: &mut [T]) {
@@ -63,13 +84,6 @@ impl<T: Copy> Registers<'_, T> {
             at += width;
         }
     }
-}
-
-/// What the backward pass adds into a register.
-#[derive(Clone, Copy)]
-enum Adjoint<T> {
-    Scalar(T),
-    Vector([T; 3]),
 }
 
 /// Where a tape's value stops being finite ([`Tape::undefined_at`]).
@@ -97,43 +111,55 @@ pub struct Switch {
     pub decides: f64,
 }
 
+/// A tape's inputs, placed in its registers ahead of its instructions: `arity` particles, `rest`,
+/// the stored numbers (`loads`: per number, its place among the element's stored numbers;
+/// `loaded`: per stored register, where it starts, whether a vector, its text), then the numbers
+/// of its `constants`.
+pub(super) struct InputLayout {
+    pub arity: usize,
+    pub loads: Vec<u8>,
+    pub loaded: Vec<(Reg, bool, Origin)>,
+    pub constants: Vec<f64>,
+}
+
 impl Tape {
-    /// The tape of instructions `ops` (each reading registers by where they start), from the
-    /// text `origins` says, whose values are vectors where `vector` says, with `outputs`.
+    /// The tape whose inputs are placed as `inputs` says, then the instructions `ops` (each
+    /// reading registers by where they start), from the text `origins` says, whose values are
+    /// vectors where `vector` says, with `outputs`.
     pub(super) fn new(
+        InputLayout {
+            arity,
+            loads,
+            loaded,
+            constants,
+        }: InputLayout,
         ops: Vec<Op>,
         origins: Vec<Origin>,
         vector: Vec<bool>,
         outputs: Vec<Reg>,
     ) -> Tape {
+        let reads_element = ops
+            .iter()
+            .any(|op| matches!(op, Op::RestParticle(_) | Op::Material(_)));
+        let mut slots = 3 * arity + 1 + loads.len() + constants.len();
         let mut starts = Vec::with_capacity(ops.len());
-        let mut varying: Vec<bool> = Vec::new();
-        for (op, &wide) in ops.iter().zip(&vector) {
-            starts.push(varying.len() as Reg);
-            let v = match op {
-                Op::Particle(_) => true,
-                Op::Const(_)
-                | Op::ConstVector(_)
-                | Op::Rest
-                | Op::RestParticle(_)
-                | Op::Material(_)
-                | Op::Stored(..) => false,
-                _ => op.inputs().iter().any(|&i| varying[i as usize]),
-            };
-            varying.extend(std::iter::repeat_n(v, if wide { 3 } else { 1 }));
+        for &wide in &vector {
+            starts.push(slots as Reg);
+            slots += if wide { 3 } else { 1 };
         }
-        let first_output = outputs
-            .first()
-            .map_or(0, |&o| starts.iter().position(|&s| s == o).unwrap_or(0));
         Tape {
+            arity,
+            loads,
+            loaded,
+            constants,
             ops,
             origins,
             vector,
             starts,
             outputs,
-            first_output,
             widths: Vec::new(),
-            varying,
+            slots,
+            reads_element,
         }
     }
 
@@ -142,7 +168,13 @@ impl Tape {
         self.ops.iter().any(|op| matches!(op, Op::RestParticle(_)))
     }
 
-    /// How many instructions (and registers) it has.
+    /// How many numbers its registers are, inputs included: what [`Tape::run_in`]'s slice must
+    /// hold.
+    pub fn slots(&self) -> usize {
+        self.slots
+    }
+
+    /// How many instructions it has.
     pub fn len(&self) -> usize {
         self.ops.len()
     }
@@ -159,10 +191,62 @@ impl Tape {
         inputs: &Inputs<'_, T>,
         read: impl FnOnce(&Registers<'_, T>) -> R,
     ) -> R {
-        let mut registers = ArrayVec::new();
-        self.forward(inputs, &mut registers);
+        let mut registers: ArrayVec<T, MAX_SLOTS> = ArrayVec::new();
+        registers.extend(std::iter::repeat_n(T::ZERO, self.slots));
+        self.run_in(inputs, &mut registers, read)
+    }
+
+    /// [`Tape::run`] in the caller's registers `r`, at least [`Tape::slots`] numbers (what they
+    /// hold before does not matter: each is written before it is read). A caller that runs the
+    /// tape many times on wide numbers keeps them, rather than a stack frame of [`MAX_SLOTS`]
+    /// of them for each run.
+    #[inline(always)]
+    pub fn run_in<T: Real, R>(
+        &self,
+        inputs: &Inputs<'_, T>,
+        r: &mut [T],
+        read: impl FnOnce(&Registers<'_, T>) -> R,
+    ) -> R {
+        self.load(inputs, r);
+        for (op, &at) in self.ops.iter().zip(&self.starts) {
+            op.apply(r, at as usize, inputs);
+        }
         read(&Registers {
-            registers: &registers,
+            registers: r,
+            outputs: &self.outputs,
+            widths: &self.widths,
+        })
+    }
+
+    /// [`Tape::run_in`] with the inputs placed by the caller: `place` gets the registers and, per
+    /// stored number the tape reads, where it is among the element's, and writes the particles'
+    /// coordinates into registers 0, 1, 2, … (p0's x first), `rest` after them, then those stored
+    /// numbers in that order. For a caller whose inputs come in another layout (the fast
+    /// engine's batches): each number is written once, where the tape reads it, and in the
+    /// width it is read in.
+    ///
+    /// # Panics
+    /// When the tape reads the rest shape or the material (a tape that runs at each projection
+    /// reads them from what is stored), or `r` is shorter than [`Tape::slots`].
+    #[inline(always)]
+    pub fn run_placed<T: Real, R>(
+        &self,
+        r: &mut [T],
+        place: impl FnOnce(&mut [T], &[u8]),
+        read: impl FnOnce(&Registers<'_, T>) -> R,
+    ) -> R {
+        assert!(
+            !self.reads_element,
+            "a tape that reads the rest shape or the material is run from its inputs"
+        );
+        place(r, &self.loads);
+        self.load_constants(r);
+        let none = Inputs::of(&[], T::ZERO);
+        for (op, &at) in self.ops.iter().zip(&self.starts) {
+            op.apply(r, at as usize, &none);
+        }
+        read(&Registers {
+            registers: r,
             outputs: &self.outputs,
             widths: &self.widths,
         })
@@ -172,17 +256,38 @@ impl Tape {
     /// is, at `points` with `rest`: where and why C is undefined there. `None` where every value
     /// is finite.
     pub fn undefined_at(&self, inputs: &Inputs<'_, f64>) -> Option<Undefined> {
-        let mut r: ArrayVec<f64, MAX_SLOTS> = ArrayVec::new();
-        for (op, origin) in self.ops.iter().zip(&self.origins) {
-            let start = r.len();
-            op.apply(&mut r, inputs);
+        let mut r = vec![0.0; self.slots()];
+        self.load(inputs, &mut r);
+        // A stored number is not finite where the rest shape makes it so (a flat rest tet's
+        // inverse(Dm)): named where its expression is.
+        for &(at, vector, origin) in &self.loaded {
+            let at = at as usize;
+            if !r[at..at + if vector { 3 } else { 1 }]
+                .iter()
+                .all(|x| x.is_finite())
+            {
+                return Some(Undefined {
+                    base: origin.base,
+                    offset: origin.offset,
+                    message: format!(
+                        "`{}` is undefined on the rest shape: what the element stores is not \
+                         finite",
+                        origin.what
+                    ),
+                });
+            }
+        }
+        for (k, (op, origin)) in self.ops.iter().zip(&self.origins).enumerate() {
+            let start = self.starts[k] as usize;
+            op.apply(&mut r, start, inputs);
             let finite = |at: Reg| {
                 let at = at as usize;
                 r[at..at + self.width_at(at as Reg)]
                     .iter()
                     .all(|x| x.is_finite())
             };
-            if !r[start..].iter().all(|x| x.is_finite()) && op.inputs().iter().all(|&i| finite(i)) {
+            let value = &r[start..start + self.width(k)];
+            if !value.iter().all(|x| x.is_finite()) && op.inputs().iter().all(|&i| finite(i)) {
                 return Some(Undefined {
                     base: origin.base,
                     offset: origin.offset,
@@ -202,9 +307,10 @@ impl Tape {
     /// `points` of what decides it (the argument of `abs`, the difference of `min`'s two, the
     /// two sides of a condition): the kink is where that value is 0.
     pub fn switches_at(&self, inputs: &Inputs<'_, f64>) -> Vec<Switch> {
-        let mut r: ArrayVec<f64, MAX_SLOTS> = ArrayVec::new();
+        let mut r = vec![0.0; self.slots()];
+        self.load(inputs, &mut r);
         let mut out = Vec::new();
-        for (op, origin) in self.ops.iter().zip(&self.origins) {
+        for (k, (op, origin)) in self.ops.iter().zip(&self.origins).enumerate() {
             if op.switches() {
                 let s = |i: Reg| r[i as usize];
                 let decides = match *op {
@@ -220,7 +326,7 @@ impl Tape {
                     decides,
                 });
             }
-            op.apply(&mut r, inputs);
+            op.apply(&mut r, self.starts[k] as usize, inputs);
         }
         out
     }
@@ -232,208 +338,39 @@ impl Tape {
 
     /// How many numbers the register starting at `at` is.
     fn width_at(&self, at: Reg) -> usize {
-        self.starts.binary_search(&at).map_or(1, |k| self.width(k))
+        if let Ok(k) = self.starts.binary_search(&at) {
+            return self.width(k);
+        }
+        if let Some(&(_, vector, _)) = self.loaded.iter().find(|l| l.0 == at) {
+            return if vector { 3 } else { 1 };
+        }
+        // A particle; else `rest`, or a number of a constant (finite, folding saw to it).
+        if (at as usize) < 3 * self.arity { 3 } else { 1 }
     }
 
-    /// Output 0, C, and its gradient with respect to every particle, by reverse mode: the values
-    /// forward, then r̄ = ∂C/∂r from C back to the particles, each instruction by the derivative
-    /// rule of what it computes. Non-finite where the gradient is undefined (a zero vector's
-    /// length or direction, a division by zero, `acos` at ±1).
-    ///
-    /// Generic over [`Real`]: run on [`crate::numbers::dual::Tangent`] numbers it gives the
-    /// derivative of the gradient along the tangents, a column of the Hessian.
+    /// The inputs into the first registers of `r`: the particles, `rest`, the stored numbers the
+    /// tape reads, then the constants.
     #[inline(always)]
-    pub fn gradient<T: Real, const N: usize>(&self, inputs: &Inputs<'_, T>) -> (T, [[T; 3]; N]) {
-        let mut r = ArrayVec::new();
-        self.forward(inputs, &mut r);
-        let r = &r;
-        let last = self.first_output;
-        let out = self.outputs[0] as usize;
-        let mut adjoint: ArrayVec<T, MAX_SLOTS> = ArrayVec::new();
-        for _ in 0..self.starts[last] as usize + self.width(last) {
-            adjoint.push(T::ZERO);
+    fn load<T: Real>(&self, inputs: &Inputs<'_, T>, r: &mut [T]) {
+        let particles = 3 * self.arity;
+        for (k, p) in inputs.points[..self.arity].iter().enumerate() {
+            r[3 * k] = p[0];
+            r[3 * k + 1] = p[1];
+            r[3 * k + 2] = p[2];
         }
-        adjoint[out] = T::ONE;
-        let mut gradient = [[T::ZERO; 3]; N];
-        let varying = &self.varying;
-        for k in (0..=last).rev() {
-            let at = self.starts[k] as usize;
-            if !varying[at] {
-                continue;
-            }
-            let bar = if self.vector[k] {
-                read3(&adjoint, at as Reg)
-            } else {
-                [adjoint[at], T::ZERO, T::ZERO]
-            };
-            let s = bar[0];
-            let value = |i: Reg| read3(r, i);
-            let x = |i: Reg| r[i as usize];
-            // This instruction's own value.
-            let own = r[at];
-            let own3 = || read3(r, at as Reg);
-            // r̄ into register i: all three numbers for a vector, the one for a scalar; nothing
-            // into (and no work for) a register that does not depend on a particle.
-            macro_rules! add {
-                ($i:expr, $v:expr) => {{
-                    let i = $i as usize;
-                    if varying[i] {
-                        match $v {
-                            Adjoint::Vector(v) => {
-                                adjoint[i] += v[0];
-                                adjoint[i + 1] += v[1];
-                                adjoint[i + 2] += v[2];
-                            }
-                            Adjoint::Scalar(x) => adjoint[i] += x,
-                        }
-                    }
-                }};
-            }
-            let scalar = |x: T| Adjoint::Scalar(x);
-            let vector = |v: [T; 3]| Adjoint::Vector(v);
-            match self.ops[k] {
-                Op::Const(_)
-                | Op::ConstVector(_)
-                | Op::Rest
-                | Op::Sign(_)
-                | Op::RestParticle(_)
-                | Op::Material(_)
-                | Op::Stored(..) => {}
-                Op::Particle(p) if (p as usize) < N => {
-                    gradient[p as usize] = add3(gradient[p as usize], bar)
-                }
-                Op::Particle(_) => {}
-                Op::NegS(a) => add!(a, scalar(-s)),
-                Op::NegV(a) => add!(a, vector(scale(bar, -T::ONE))),
-                Op::AddS(a, b) => {
-                    add!(a, scalar(s));
-                    add!(b, scalar(s));
-                }
-                Op::SubS(a, b) => {
-                    add!(a, scalar(s));
-                    add!(b, scalar(-s));
-                }
-                Op::MulS(a, b) => {
-                    add!(a, scalar(s * x(b)));
-                    add!(b, scalar(s * x(a)));
-                }
-                Op::DivS(a, b) => {
-                    // r = a / b: ā += r̄ / b, b̄ −= r̄ r / b.
-                    let d = x(b);
-                    add!(a, scalar(s / d));
-                    add!(b, scalar(-(s * own) / d));
-                }
-                Op::AddV(a, b) => {
-                    add!(a, vector(bar));
-                    add!(b, vector(bar));
-                }
-                Op::SubV(a, b) => {
-                    add!(a, vector(bar));
-                    add!(b, vector(scale(bar, -T::ONE)));
-                }
-                Op::Scale(v, f) => {
-                    // r = v f: v̄ += r̄ f, f̄ += r̄·v.
-                    add!(v, vector(scale(bar, x(f))));
-                    add!(f, scalar(dot(bar, value(v))));
-                }
-                Op::Shrink(v, f) => {
-                    // r = v / f: v̄ += r̄ / f, f̄ −= r̄·r / f.
-                    let d = x(f);
-                    add!(v, vector(shrink(bar, d)));
-                    add!(f, scalar(-dot(bar, own3()) / d));
-                }
-                Op::Dot(a, b) => {
-                    add!(a, vector(scale(value(b), s)));
-                    add!(b, vector(scale(value(a), s)));
-                }
-                Op::Cross(a, b) => {
-                    // r = a × b: ā += b × r̄, b̄ += r̄ × a.
-                    add!(a, vector(cross(value(b), bar)));
-                    add!(b, vector(cross(bar, value(a))));
-                }
-                Op::Length(a) => add!(a, vector(scale(value(a), s / own))),
-                Op::Normalize(a) => {
-                    // r = a / |a|: ā += (r̄ − r (r·r̄)) / |a|.
-                    let n = own3();
-                    let length = dot(value(a), value(a)).sqrt();
-                    let along = dot(n, bar);
-                    add!(a, vector(shrink(sub3(bar, scale(n, along)), length)));
-                }
-                Op::Sqrt(a) => add!(a, scalar(s / (own + own))),
-                Op::Abs(a) => add!(a, scalar(T::select(x(a).le(T::ZERO), -s, s))),
-                Op::Min(a, b) => {
-                    let first = x(a).le(x(b));
-                    add!(a, scalar(T::select(first, s, T::ZERO)));
-                    add!(b, scalar(T::select(first, T::ZERO, s)));
-                }
-                Op::Max(a, b) => {
-                    let first = x(a).gt(x(b));
-                    add!(a, scalar(T::select(first, s, T::ZERO)));
-                    add!(b, scalar(T::select(first, T::ZERO, s)));
-                }
-                Op::Det(a, b, c) => {
-                    // r = a·(b × c): ā += r̄ b×c, b̄ += r̄ c×a, c̄ += r̄ a×b.
-                    let (a_, b_, c_) = (value(a), value(b), value(c));
-                    add!(a, vector(scale(cross(b_, c_), s)));
-                    add!(b, vector(scale(cross(c_, a_), s)));
-                    add!(c, vector(scale(cross(a_, b_), s)));
-                }
-                // r = sin a: ā += r̄ cos a; r = cos a: ā −= r̄ sin a.
-                Op::Sin(a) => add!(a, scalar(s * x(a).cos())),
-                Op::Cos(a) => add!(a, scalar(-(s * x(a).sin()))),
-                // r = eᵃ: ā += r̄ r; r = log a: ā += r̄ / a.
-                Op::Exp(a) => add!(a, scalar(s * own)),
-                Op::Ln(a) => add!(a, scalar(s / x(a))),
-                Op::Atan2(y, x_) => {
-                    // r = atan2(y, x): ȳ += r̄ x / (x² + y²), x̄ −= r̄ y / (x² + y²).
-                    let (yv, xv) = (x(y), x(x_));
-                    let d = xv * xv + yv * yv;
-                    add!(y, scalar(s * xv / d));
-                    add!(x_, scalar(-(s * yv) / d));
-                }
-                // r = asin a: ā += r̄ / √(1 − a²); r = acos a: ā −= r̄ / √(1 − a²).
-                Op::Asin(a) => add!(a, scalar(s / (T::ONE - x(a) * x(a)).sqrt())),
-                Op::Acos(a) => add!(a, scalar(-(s / (T::ONE - x(a) * x(a)).sqrt()))),
-                // r = ∛a: ā += r̄ / (3 r²).
-                Op::Cbrt(a) => add!(a, scalar(s / (T::from_f64(3.0) * own * own))),
-                Op::Component(a, i) => {
-                    let mut v = [T::ZERO; 3];
-                    v[i as usize] = s;
-                    add!(a, vector(v));
-                }
-                Op::Vec3(a, b, c) => {
-                    add!(a, scalar(bar[0]));
-                    add!(b, scalar(bar[1]));
-                    add!(c, scalar(bar[2]));
-                }
-                Op::If(cmp, a, b, t, e) => {
-                    let mask = holds(cmp, x(a), x(b));
-                    add!(t, scalar(T::select(mask, s, T::ZERO)));
-                    add!(e, scalar(T::select(mask, T::ZERO, s)));
-                }
-                Op::IfVector(cmp, a, b, t, e) => {
-                    let mask = holds(cmp, x(a), x(b));
-                    add!(t, vector(bar.map(|v| T::select(mask, v, T::ZERO))));
-                    add!(e, vector(bar.map(|v| T::select(mask, T::ZERO, v))));
-                }
-            }
+        r[particles] = inputs.rest;
+        for (k, &at) in self.loads.iter().enumerate() {
+            r[particles + 1 + k] = inputs.stored[at as usize];
         }
-        (r[out], gradient)
+        self.load_constants(r);
     }
 
-    /// Every register's value, instruction by instruction, into `r` (empty; the caller's, so
-    /// that it is never moved).
+    /// The constants' numbers into their registers, after the stored numbers'.
     #[inline(always)]
-    fn forward<T: Real>(&self, inputs: &Inputs<'_, T>, r: &mut ArrayVec<T, MAX_SLOTS>) {
-        for op in &self.ops {
-            op.apply(r, inputs);
+    fn load_constants<T: Real>(&self, r: &mut [T]) {
+        let first = 3 * self.arity + 1 + self.loads.len();
+        for (k, &x) in self.constants.iter().enumerate() {
+            r[first + k] = T::from_f64(x);
         }
     }
-}
-
-/// The vector whose numbers start at `at`.
-#[inline(always)]
-fn read3<T: Copy>(r: &[T], at: Reg) -> [T; 3] {
-    let at = at as usize;
-    [r[at], r[at + 1], r[at + 2]]
 }

@@ -84,24 +84,30 @@ fn project_batches<const N: usize, C: Constraint<N>>(
     let mut skips = SkipCounts::default();
     let read = access.read;
     let write = access.sums.unwrap_or(read);
-    let mut project = |b: usize, evaluation: &Evaluation<Vec3x8, N>| {
-        let (skipped, d) =
-            correction_lanes(*evaluation, weights[b], lambda[b], rule, size[b] * reach);
-        skips.add(skipped);
-        lambda[b] += d.delta_lambda;
-        for (&indices, delta) in particles[b].iter().zip(d.delta_x) {
-            scatter_add(write, indices, delta);
-        }
-    };
+    // A macro rather than a closure, so that the correction is inlined at both of its places
+    // (as a closure called twice, it was not, and its evaluation went through memory).
+    macro_rules! project {
+        ($b:expr, $evaluation:expr) => {{
+            let b = $b;
+            let (skipped, d) =
+                correction_lanes($evaluation, weights[b], lambda[b], rule, size[b] * reach);
+            skips.add(skipped);
+            lambda[b] += d.delta_lambda;
+            for (&indices, delta) in particles[b].iter().zip(d.delta_x) {
+                scatter_add(write, indices, delta);
+            }
+        }};
+    }
     let mut b = 0;
     if C::GROUPED {
         // GROUP batches at a time: they share no particle, so that gathering them all before
         // writing any changes nothing.
         while b + GROUP <= particles.len() {
-            let (p, shape, rows) = gather_group((access, C::USES_REST_SHAPE), particles, rest, b);
+            let (p, shape, rows) =
+                gather_group((access, C::STORED_USES_REST_SHAPE), particles, rest, b);
             let evaluations = constraint.evaluate_batches(&p, rows.0, &shape, rows.1);
             for (j, evaluation) in evaluations.iter().enumerate() {
-                project(b + j, evaluation);
+                project!(b + j, *evaluation);
             }
             b += GROUP;
         }
@@ -114,12 +120,12 @@ fn project_batches<const N: usize, C: Constraint<N>>(
         next = particles
             .get(b + 1)
             .map(|indices| gather_batch(read, indices));
-        let shape = if C::USES_REST_SHAPE {
+        let shape = if C::STORED_USES_REST_SHAPE {
             gather_batch(access.rest_shape, &particles[b])
         } else {
             p
         };
-        project(b, &constraint.evaluate_stored(&p, rest, &shape, stored));
+        project!(b, constraint.evaluate_stored(&p, rest, &shape, stored));
         b += 1;
     }
     skips
@@ -264,15 +270,21 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
 ) -> [SkipCounts; 2] {
     assert_eq!(N, M, "a pair shares its particles");
     let mut skips = [SkipCounts::default(); 2];
-    let mut project =
-        |b: usize, first_evaluation: &Evaluation<Vec3x8, N>, e: &Evaluation<Vec3x8, M>| {
+    // A macro rather than a closure, as in project_batches: inlined at both of its places.
+    macro_rules! project {
+        ($b:expr, $first:expr, $second:expr) => {{
+            let (b, e) = ($b, $second);
+            let mut gradients = [Vec3x8::ZERO; N];
+            for (k, g) in gradients.iter_mut().enumerate() {
+                *g = e.gradients[k];
+            }
             let second_evaluation = Evaluation {
                 value: e.value,
-                gradients: std::array::from_fn(|k| e.gradients[k]),
+                gradients,
                 degenerate: e.degenerate,
             };
             let d = pair_correction_lanes(
-                *first_evaluation,
+                $first,
                 second_evaluation,
                 weights[b],
                 [lambda_a[b], lambda_b[b]],
@@ -284,14 +296,13 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
             }
             lambda_a[b] += d.delta_lambda[0];
             lambda_b[b] += d.delta_lambda[1];
+            let write = access.sums.unwrap_or(access.read);
             for (i, &indices) in particles[b].iter().enumerate() {
-                match access.sums {
-                    Some(sums) => scatter_add(sums, indices, d.delta_x[i]),
-                    None => scatter_add(access.read, indices, d.delta_x[i]),
-                }
+                scatter_add(write, indices, d.delta_x[i]);
             }
-        };
-    let uses_rest_shape = A::USES_REST_SHAPE || B::USES_REST_SHAPE;
+        }};
+    }
+    let uses_rest_shape = A::STORED_USES_REST_SHAPE || B::STORED_USES_REST_SHAPE;
     let mut b = 0;
     if A::GROUPED && B::GROUPED {
         // GROUP batches at a time, as in project_batches.
@@ -312,7 +323,7 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
             }
             let second = second.evaluate_batches(&p2, rest_b_rows, &shape2, stored_b);
             for j in 0..GROUP {
-                project(b + j, &first[j], &second[j]);
+                project!(b + j, first[j], second[j]);
             }
             b += GROUP;
         }
@@ -329,7 +340,7 @@ fn project_pair_batches<const N: usize, A: Constraint<N>, const M: usize, B: Con
         let p2: [Vec3x8; M] = std::array::from_fn(|k| p[k]);
         let shape2: [Vec3x8; M] = std::array::from_fn(|k| shape[k]);
         let e = second.evaluate_stored(&p2, rest_second, &shape2, stored_b);
-        project(b, &first_evaluation, &e);
+        project!(b, first_evaluation, e);
     }
     skips
 }

@@ -2,6 +2,7 @@
 
 use super::format::finite;
 use super::*;
+use crate::energy::modes::Modes;
 
 /// A relation a step expects between a metric and a number.
 #[derive(Clone, Debug, PartialEq)]
@@ -12,6 +13,8 @@ pub struct Expectation {
     pub metric: String,
     /// For [`GRADIENT_ERROR`]: the family (of a constraint file) whose gradient it is about.
     pub gradient_of: Option<Family>,
+    /// For [`MODE_METRICS`]: what of the selected tet's energy Hessian it counts.
+    pub of_modes: Option<ModeCount>,
     /// The comparison.
     pub op: Op,
     /// The number compared with.
@@ -72,24 +75,61 @@ impl Op {
 /// configurations; infinite when the file leaves a particle's gradient out).
 pub const GRADIENT_ERROR: &str = "gradient_error";
 
+/// What a lesson can count of the selected tet's energy Hessian
+/// ([`crate::energy::modes::Modes::of_tet`]: the energy of the active families on it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeCount {
+    /// `zero_modes`: how many eigenvalues count as zero ([`crate::energy::modes::ZERO`]).
+    Zero,
+    /// `negative_modes`: how many are negative: the directions along which the energy is not
+    /// convex.
+    Negative,
+}
+
+/// The metrics of the selected tet's energy Hessian, by name.
+pub const MODE_METRICS: [(&str, ModeCount); 2] = [
+    ("zero_modes", ModeCount::Zero),
+    ("negative_modes", ModeCount::Negative),
+];
+
+/// What an expectation is checked against: the simulation, its selected tet, and the metrics of
+/// it and of the comparison (`None` when there is none).
+#[derive(Clone, Copy)]
+pub struct Measured<'a> {
+    /// The simulation (its families, whose files the gradient errors are of).
+    pub simulation: &'a Simulation,
+    /// The selected tet (the one whose modes are counted).
+    pub tet: usize,
+    /// Its metrics.
+    pub metrics: &'a Metrics,
+    /// The comparison's metrics.
+    pub comparison: Option<&'a Metrics>,
+}
+
 impl Expectation {
     /// The metric's current value, and whether the expectation holds for it (never for a value
     /// that is not finite); `None` when it is about the comparison and there is none.
-    /// `families` is the table the lesson simulates, whose files the gradient errors are of.
-    pub fn check(
-        &self,
-        families: &Families,
-        metrics: &Metrics,
-        comparison: Option<&Metrics>,
-    ) -> Option<(f64, bool)> {
+    pub fn check(&self, measured: Measured<'_>) -> Option<(f64, bool)> {
+        let holds =
+            |value: f64| Some((value, value.is_finite() && self.op.holds(value, self.value)));
         if let Some(family) = self.gradient_of {
-            let value = gradient_error(families, family);
-            return Some((value, value.is_finite() && self.op.holds(value, self.value)));
+            return holds(gradient_error(measured.simulation.families(), family));
+        }
+        if let Some(count) = self.of_modes {
+            // No active family, or no such tet: no count (NaN, which never holds).
+            let value = Modes::of_tet(measured.simulation, measured.tet).map_or(f64::NAN, |m| {
+                let count = match count {
+                    ModeCount::Zero => m.zero_count(),
+                    ModeCount::Negative => m.negative_count(),
+                };
+                count as f64
+            });
+            return holds(value);
         }
         let metrics = if self.of_comparison {
-            comparison?
+            measured.comparison?
         } else {
-            metrics
+            measured.metrics
         };
         let value = metrics
             .headline()
@@ -97,7 +137,7 @@ impl Expectation {
             .find(|(name, _)| *name == self.metric)
             .map(|(_, v)| v)
             .expect("the metric name was checked when the lesson was read");
-        Some((value, value.is_finite() && self.op.holds(value, self.value)))
+        holds(value)
     }
 
     pub(super) fn parse(families: &Families, text: &str) -> Result<Expectation, String> {
@@ -123,6 +163,17 @@ impl Expectation {
                 of_comparison: false,
                 metric: format!("{GRADIENT_ERROR}.{name}"),
                 gradient_of: Some(family),
+                of_modes: None,
+                op,
+                value,
+            });
+        }
+        if let Some(&(name, count)) = MODE_METRICS.iter().find(|(name, _)| *name == metric) {
+            return Ok(Expectation {
+                of_comparison: false,
+                metric: name.to_owned(),
+                gradient_of: None,
+                of_modes: Some(count),
                 op,
                 value,
             });
@@ -133,15 +184,18 @@ impl Expectation {
         };
         let names = Metrics::default().headline().map(|(name, _)| name);
         if !names.contains(&metric) {
+            let modes = MODE_METRICS.map(|(name, _)| name);
             return Err(format!(
-                "'{metric}' is not a metric: expected one of {}, or {GRADIENT_ERROR}.FAMILY",
-                names.join(", ")
+                "'{metric}' is not a metric: expected one of {}, {}, or {GRADIENT_ERROR}.FAMILY",
+                names.join(", "),
+                modes.join(", ")
             ));
         }
         Ok(Expectation {
             of_comparison,
             metric: metric.to_owned(),
             gradient_of: None,
+            of_modes: None,
             op,
             value,
         })

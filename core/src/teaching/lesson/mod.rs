@@ -23,7 +23,9 @@
 //! A lesson may bring constraint files (`constraint_files = ["../constraints/height.toml"]`,
 //! relative to the lesson): their families join the table when it is read, and its settings and
 //! steps name them like the built-in ones; `gradient_error.NAME` measures how far such a file's
-//! gradient is from automatic differentiation ([`GRADIENT_ERROR`]).
+//! gradient is from automatic differentiation ([`GRADIENT_ERROR`]). `zero_modes` and
+//! `negative_modes` count the eigenvalues of the selected tet's energy Hessian that are zero and
+//! negative ([`MODE_METRICS`]).
 //!
 //! Actions: `reset`, `invert` (the lesson's tet, through its first corner), `invert:K`, `mirror`,
 //! `flatten`, `scramble:SEED`, `select:K`, `constraints:LIST`, `solver:xpbd|pbd`,
@@ -57,7 +59,7 @@ mod tests;
 
 pub use action::Action;
 pub use builtin::{BUILTIN, BuiltinLesson, LessonHeader};
-pub use expectation::{Expectation, GRADIENT_ERROR, Op};
+pub use expectation::{Expectation, GRADIENT_ERROR, MODE_METRICS, Measured, ModeCount, Op};
 pub use format::MAX_STEP_FRAMES;
 pub use runner::{LessonRun, StepOutcome};
 

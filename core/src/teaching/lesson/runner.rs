@@ -179,12 +179,18 @@ impl LessonRun {
             checks: step
                 .expect
                 .iter()
-                .map(
-                    |e| match e.check(self.simulation.families(), metrics, comparison) {
+                .map(|e| {
+                    let measured = Measured {
+                        simulation: &self.simulation,
+                        tet: self.tet,
+                        metrics,
+                        comparison,
+                    };
+                    match e.check(measured) {
                         Some((value, holds)) => (e.clone(), Some(value), holds),
                         None => (e.clone(), None, false),
-                    },
-                )
+                    }
+                })
                 .collect(),
         }
     }

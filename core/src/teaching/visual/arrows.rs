@@ -19,7 +19,13 @@ pub enum Quantity {
     /// Δp, the correction the last substep's projections made (see
     /// [`Simulation::corrections`]).
     Correction,
+    /// One eigenmode of the selected tet's energy Hessian: its displacement at each corner
+    /// ([`crate::energy::modes`]).
+    Mode,
 }
+
+/// The colour of the mode arrows and of the tet moved along a mode: teal.
+pub const MODE: Rgba = [20, 170, 150, 255];
 
 impl Quantity {
     /// The arrow colour: [`family_colour`] for gradients, the same lightened halfway to white
@@ -33,6 +39,7 @@ impl Quantity {
                 [light(r), light(g), light(b), a]
             }
             Quantity::Correction => CORRECTION,
+            Quantity::Mode => MODE,
         }
     }
 
@@ -55,6 +62,7 @@ impl Quantity {
                 )
             }
             Quantity::Correction => "dp".to_owned(),
+            Quantity::Mode => "mode".to_owned(),
         }
     }
 }
@@ -265,6 +273,45 @@ pub fn correction_arrows(
         let delta = corrections[particle as usize];
         out.extend(correction_arrow(positions, particle, delta, gain));
     }
+}
+
+/// The arrows of an eigenmode of tet `corners` (its unit eigenvector `vector`, one displacement
+/// per corner): the longest drawn `gain` × [`GRADIENT_ARROW_LENGTH`] × the tet's size long, from
+/// the corners at `positions`. A corner that does not move has no arrow. Appends to `out`.
+pub fn mode_arrows(
+    positions: &[DVec3],
+    corners: [u32; 4],
+    vector: &[DVec3; 4],
+    gain: f64,
+    out: &mut Vec<Arrow>,
+) {
+    let first = out.len();
+    for (&particle, &value) in corners.iter().zip(vector) {
+        if value != DVec3::ZERO {
+            out.push(Arrow {
+                quantity: Quantity::Mode,
+                particle,
+                origin: positions[particle as usize],
+                value,
+                vector: DVec3::ZERO,
+            });
+        }
+    }
+    let length = gain * GRADIENT_ARROW_LENGTH * tet_size(positions, &corners);
+    scale_to_longest(&mut out[first..], length);
+}
+
+/// The corners of tet `corners` moved along a mode: each at its position plus `offset` × the
+/// tet's size × its share of the unit eigenvector `vector` (for display only: an eigenvector says
+/// a direction, and `offset` how far to go along it, in tet sizes).
+pub fn along_mode(
+    positions: &[DVec3],
+    corners: [u32; 4],
+    vector: &[DVec3; 4],
+    offset: f64,
+) -> [DVec3; 4] {
+    let size = tet_size(positions, &corners);
+    std::array::from_fn(|k| positions[corners[k] as usize] + vector[k] * (offset * size))
 }
 
 /// Whose arrows are shown: no tet's, one tet's (the selected one), or every tet's.

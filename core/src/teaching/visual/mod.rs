@@ -6,8 +6,9 @@ mod arrows;
 mod surface;
 
 pub use arrows::{
-    Arrow, ArrowSelection, CORRECTION, DISAGREEMENT, GRADIENT_ARROW_LENGTH, Quantity,
-    correction_arrows, projection_arrows, selected_arrows, tet_gradient_arrows,
+    Arrow, ArrowSelection, CORRECTION, DISAGREEMENT, GRADIENT_ARROW_LENGTH, MODE, Quantity,
+    along_mode, correction_arrows, mode_arrows, projection_arrows, selected_arrows,
+    tet_gradient_arrows,
 };
 pub use surface::{
     ALL_FACES_UP_TO, display_edges, display_faces, edge_strips, faces_with_tets, inverted_tets,

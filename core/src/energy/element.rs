@@ -1,0 +1,290 @@
+//! The energy of some families on one tet ([`ElementEnergy`]): their constraints on the tet, each
+//! with its rest value, what it stores and its compliance, and E = Σ ½ C² / α of them, in any
+//! number type that compares to a `bool` (f64, and the dual numbers of [`super::hessian`]).
+//!
+//! Which constraints lie on a tet is what each family's binding lays on a mesh of that one tet
+//! ([`crate::constraints::Binding::particles`]): one volume, four heights, six edges; for a family
+//! of the surface, the tet's own four faces and six hinges, as if it stood alone.
+
+use crate::constraints::material::Material;
+use crate::constraints::{Constraint, Families, Family, PerFamily, Stored, Visit};
+use crate::numbers::dual::DualVec3;
+use crate::numbers::vector::{Real, Vector3};
+use crate::scene::mesh::TetMesh;
+use crate::simulation::{DENSITY, Settings, Simulation};
+use glam::DVec3;
+
+/// Where a family's compliance α in E = ½ C² / α comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Compliance {
+    /// The family's own (`--compliance`), or the material's (the neo-Hookean pair, a file's
+    /// `stiffness`).
+    Given(f64),
+    /// The family is rigid (α = 0): its energy is taken with α = 1.
+    Rigid,
+}
+
+impl Compliance {
+    /// The α used.
+    pub fn alpha(self) -> f64 {
+        match self {
+            Compliance::Given(alpha) => alpha,
+            Compliance::Rigid => 1.0,
+        }
+    }
+}
+
+/// One constraint on the tet.
+#[derive(Clone, Debug)]
+pub struct Term {
+    /// Its family.
+    pub family: Family,
+    /// Its particles, as corners of the tet (0…3), the first `arity` of them.
+    pub corners: [usize; 4],
+    /// How many particles it has.
+    pub arity: usize,
+    /// Its rest value.
+    pub rest: f64,
+    /// What it stores, worked out from the rest shape and the material.
+    pub stored: Stored,
+    /// 1/α.
+    pub stiffness: f64,
+}
+
+/// The energy E = Σ ½ C² / α of some families' constraints on one tet, at rest at `rest_shape`.
+#[derive(Clone, Debug)]
+pub struct ElementEnergy {
+    families: Families,
+    rest_shape: [DVec3; 4],
+    terms: Vec<Term>,
+    /// Per family whose constraints are on the tet, in table order: its compliance.
+    pub compliances: Vec<(Family, Compliance)>,
+}
+
+impl ElementEnergy {
+    /// The energy of the `active` families of `families` on a tet at rest at `rest_shape`, with
+    /// the compliances and material of `settings`. An error when none of them has a constraint
+    /// on a tet (no family is active).
+    pub fn new(
+        families: &Families,
+        active: &PerFamily<bool>,
+        settings: &Settings,
+        rest_shape: [DVec3; 4],
+    ) -> Result<ElementEnergy, String> {
+        let mesh = TetMesh {
+            positions: rest_shape.to_vec(),
+            tets: vec![[0, 1, 2, 3]],
+        };
+        let material = &settings.material;
+        let mut terms = Vec::new();
+        let mut compliances = Vec::new();
+        for family in families.all().filter(|&f| active[f]) {
+            let compliance = match families.compliance_from_material(family) {
+                Some(from) => Compliance::Given(from(material)),
+                None if settings.compliance[family] > 0.0 => {
+                    Compliance::Given(settings.compliance[family])
+                }
+                None => Compliance::Rigid,
+            };
+            let arity = families.arity(family);
+            let particles = families.binding(family).particles(&mesh);
+            for chunk in particles.chunks(arity) {
+                let mut corners = [0; 4];
+                for (k, &p) in chunk.iter().enumerate() {
+                    corners[k] = p as usize;
+                }
+                let shape: Vec<DVec3> = chunk.iter().map(|&p| rest_shape[p as usize]).collect();
+                terms.push(Term {
+                    family,
+                    corners,
+                    arity,
+                    rest: families.rest_value(family, &shape, material),
+                    stored: store(families, family, &shape, material),
+                    stiffness: 1.0 / compliance.alpha(),
+                });
+            }
+            compliances.push((family, compliance));
+        }
+        if terms.is_empty() {
+            return Err(
+                "no family is active: name one (--constraints or --constraint-file)".into(),
+            );
+        }
+        Ok(ElementEnergy {
+            families: families.clone(),
+            rest_shape,
+            terms,
+            compliances,
+        })
+    }
+
+    /// The energy of `simulation`'s active families on its tet `tet`, at rest at the tet's rest
+    /// corners, with the simulation's compliances and material; and the tet's corners now. An
+    /// error when no family is active or there is no such tet.
+    pub fn of_tet(
+        simulation: &Simulation,
+        tet: usize,
+    ) -> Result<(ElementEnergy, [DVec3; 4]), String> {
+        let corners = simulation
+            .tets()
+            .get(tet)
+            .ok_or_else(|| format!("there is no tet {tet} ({} tets)", simulation.tets().len()))?;
+        let at = |positions: &[DVec3]| corners.map(|i| positions[i as usize]);
+        let settings = simulation.settings();
+        let energy = ElementEnergy::new(
+            simulation.families(),
+            &settings.active,
+            settings,
+            at(simulation.rest_positions()),
+        )?;
+        Ok((energy, at(simulation.positions())))
+    }
+
+    /// Its constraints.
+    pub fn terms(&self) -> &[Term] {
+        &self.terms
+    }
+
+    /// The families it is the energy of.
+    pub fn families(&self) -> &Families {
+        &self.families
+    }
+
+    /// The rest shape.
+    pub fn rest_shape(&self) -> [DVec3; 4] {
+        self.rest_shape
+    }
+
+    /// The mass of each corner: density × |V₀| / 4, the tet's own share of the lumped masses
+    /// the simulation uses ([`crate::simulation::DENSITY`]).
+    pub fn corner_mass(&self) -> f64 {
+        DENSITY * crate::constraints::volume::signed_volume(&self.rest_shape).abs() / 4.0
+    }
+
+    /// C and ∇C of term `t` at the corners `x`, in any number type `T` that compares to a bool:
+    /// ∇C as the family gives it (its formula, or a file's compiled AD: never a file's own
+    /// gradient, which is what is checked against it), scattered to the tet's corners (a corner
+    /// the constraint does not touch gets 0).
+    pub fn evaluate<T: Real<Mask = bool>>(&self, t: usize, x: &[[T; 3]; 4]) -> (T, [[T; 3]; 4]) {
+        let term = &self.terms[t];
+        fn on<T: Real<Mask = bool>, const N: usize>(
+            e: &ElementEnergy,
+            term: &Term,
+            x: &[[T; 3]; 4],
+        ) -> (T, [[T; 3]; 4]) {
+            let p: [[T; 3]; N] = std::array::from_fn(|k| x[term.corners[k]]);
+            let shape: [DVec3; N] = std::array::from_fn(|k| e.rest_shape[term.corners[k]]);
+            let (value, gradients) = constraint(
+                &e.families,
+                term.family,
+                &p,
+                (term.rest, &term.stored),
+                &shape,
+            );
+            let mut out = [[T::ZERO; 3]; 4];
+            for (k, g) in gradients.iter().enumerate() {
+                for (a, b) in out[term.corners[k]].iter_mut().zip(g) {
+                    *a += *b;
+                }
+            }
+            (value, out)
+        }
+        match term.arity {
+            2 => on::<T, 2>(self, term, x),
+            3 => on::<T, 3>(self, term, x),
+            _ => on::<T, 4>(self, term, x),
+        }
+    }
+
+    /// E at the corners `x`.
+    pub fn energy<T: Real<Mask = bool>>(&self, x: &[[T; 3]; 4]) -> T {
+        let mut sum = T::ZERO;
+        for (t, term) in self.terms.iter().enumerate() {
+            let (c, _) = self.evaluate(t, x);
+            sum += T::from_f64(0.5 * term.stiffness) * c * c;
+        }
+        sum
+    }
+
+    /// Each family's share of E at `x`, in the order of [`ElementEnergy::compliances`].
+    pub fn energy_by_family(&self, x: &[DVec3; 4]) -> Vec<(Family, f64)> {
+        let x = x.map(|p| p.to_array());
+        self.compliances
+            .iter()
+            .map(|&(family, _)| {
+                let share = (0..self.terms.len())
+                    .filter(|&t| self.terms[t].family == family)
+                    .map(|t| {
+                        let c = self.evaluate(t, &x).0;
+                        0.5 * self.terms[t].stiffness * c * c
+                    })
+                    .sum();
+                (family, share)
+            })
+            .collect()
+    }
+}
+
+/// C and ∇C of one constraint of `family` at `x`, with its rest value and stored numbers `rest`
+/// and rest shape `rest_shape`, in any number type `T` that compares to a bool: ∇C by the
+/// family's formula, or for a file by its compiled AD (never the file's own gradient).
+pub fn constraint<T: Real<Mask = bool>, const N: usize>(
+    families: &Families,
+    family: Family,
+    x: &[[T; 3]; N],
+    (rest, stored): (f64, &[f64]),
+    rest_shape: &[DVec3; N],
+) -> (T, [[T; 3]; N]) {
+    let stored: arrayvec::ArrayVec<T, { crate::constraints::MAX_STORED }> =
+        stored.iter().map(|&s| T::from_f64(s)).collect();
+    if let Some(file) = families.file(family) {
+        let (value, gradients) = file.automatic_gradient(x, T::from_f64(rest), &stored);
+        let sound = crate::constraint_file::sound::<DualVec3<T>, N>(value, gradients);
+        return (sound.value, sound.gradients.map(|g| g.0));
+    }
+    families.visit(
+        family,
+        At {
+            x,
+            rest: T::from_f64(rest),
+            stored: &stored,
+            rest_shape,
+        },
+    )
+}
+
+/// What a family stores for a constraint at rest at `shape` ([`Constraint::store`]).
+pub fn store(families: &Families, family: Family, shape: &[DVec3], material: &Material) -> Stored {
+    struct Store<'a>(&'a [DVec3], &'a Material);
+    impl Visit for Store<'_> {
+        type Output = Stored;
+        fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Stored {
+            let shape: [DVec3; N] = std::array::from_fn(|k| self.0[k]);
+            c.store(&shape, self.1)
+        }
+    }
+    families.visit(family, Store(shape, material))
+}
+
+/// One constraint of a built-in family evaluated at `x`, in the number type of `x`.
+struct At<'a, T, const M: usize> {
+    x: &'a [[T; 3]; M],
+    rest: T,
+    stored: &'a [T],
+    rest_shape: &'a [DVec3; M],
+}
+
+impl<T: Real<Mask = bool>, const M: usize> Visit for At<'_, T, M> {
+    type Output = (T, [[T; 3]; M]);
+
+    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
+        assert_eq!(N, M, "the family's arity");
+        let p: [DualVec3<T>; N] = std::array::from_fn(|k| DualVec3(self.x[k]));
+        let shape: [DualVec3<T>; N] = std::array::from_fn(|k| {
+            let q = self.rest_shape[k];
+            DualVec3::<T>::from_f64s(q.x, q.y, q.z)
+        });
+        let e = c.evaluate_stored(&p, self.rest, &shape, self.stored);
+        (e.value, std::array::from_fn(|k| e.gradients[k].to_array()))
+    }
+}
