@@ -42,6 +42,28 @@ if [ "$body" -lt 20000 ]; then
 fi
 echo "web page OK"
 
+# The build without SIMD, which the page loads where a browser rejects WebAssembly SIMD: forced
+# with ?nosimd, it starts and draws the body too.
+fallback="$work/web-nosimd.png"
+echo "== opening http://127.0.0.1:$port/?nosimd (the build without SIMD)"
+chromium --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking \
+  --disable-component-update --disable-sync --disable-quic --enable-unsafe-swiftshader \
+  --user-data-dir="$work/profile-nosimd" --window-size=1280,800 --virtual-time-budget=15000 \
+  --enable-logging=stderr --v=0 --screenshot="$fallback" "http://127.0.0.1:$port/?nosimd" \
+  >"$work/chromium-nosimd.log" 2>&1 || true
+if ! grep -q "tetlab ready" "$work/chromium-nosimd.log"; then
+  echo "the build without SIMD did not say \"tetlab ready\"; the browser's console:" >&2
+  grep -i "console\|error" "$work/chromium-nosimd.log" | tail -20 >&2 || true
+  exit 1
+fi
+body=$(python3 scripts/png_colour_count.py "$fallback" 150 180 210)
+echo "screenshot $fallback: $body pixels of the body's colour"
+if [ "$body" -lt 20000 ]; then
+  echo "the build without SIMD does not show the soft body" >&2
+  exit 1
+fi
+echo "web page without SIMD OK"
+
 # Then driven as a user would (tests/web/drive.mjs: puppeteer-core from the npm registry, against
 # Debian's chromium; no browser is downloaded): a tet dragged inside out, Space, M, a lesson and a
 # Gmsh mesh dropped, a broken file dropped, each exercise graded (a wrong answer, then a right

@@ -119,7 +119,12 @@ try {
   const started = Date.now();
   await page.goto(url);
   const first = await expect("ready", (s) => s.scene && s.tets > 0 && s.drag, 60);
-  console.log(`ready after ${((Date.now() - started) / 1000).toFixed(1)} s`);
+  console.log(`ready after ${((Date.now() - started) / 1000).toFixed(1)} s; SIMD lanes in ${first?.lanes}`);
+  // The page loads the build with WebAssembly SIMD where the browser has it (Chromium does).
+  if (!first?.lanes?.includes("WebAssembly SIMD")) {
+    console.log(`FAIL the page runs the build without SIMD: ${first?.lanes}`);
+    failed = true;
+  }
 
   // Drag the selected particle through its opposite face, paused: the tet inverts.
   const { from, to } = first.drag;
@@ -210,6 +215,29 @@ try {
     await page.goto(`${url}#lesson=6`);
     await expect("lesson-6-on-the-fetched-bunny",
       (s) => s.lesson && s.lesson.title.startsWith("6.") && s.tets === 1351, 60);
+    // Its step time as it plays (the readouts' "step time"), for docs/performance.md: the median
+    // of 30 frames, in this build and, with ?nosimd, in the build without SIMD.
+    for (const build of ["", "?nosimd"]) {
+      await page.goto("about:blank");
+      await page.goto(`${url}${build}#lesson=6`);
+      await expect(`lesson-6${build}-opened`, (s) => s.lesson && s.tets === 1351, 60);
+      await page.keyboard.press("Space");
+      const times = [];
+      let last = -1;
+      const deadline = Date.now() + 60000;
+      while (times.length < 30 && Date.now() < deadline) {
+        const s = await state();
+        if (s && s.playing && s.frame !== last && s.step_ms > 0) {
+          times.push(s.step_ms);
+          last = s.frame;
+        }
+        await new Promise((resolve) => setTimeout(resolve, 20));
+      }
+      times.sort((a, b) => a - b);
+      const median = times[Math.floor(times.length / 2)];
+      console.log(`     lesson 6 (the bunny), ${build ? "without SIMD" : "with SIMD"}: ` +
+        `${median?.toFixed(2)} ms a step, median of ${times.length} frames`);
+    }
   } else if (process.env.CI === "true") {
     console.log("FAIL lesson 6: ../shared/meshes/bunny.node is not beside the repository, and CI must have it");
     failed = true;

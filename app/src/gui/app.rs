@@ -52,7 +52,7 @@ pub struct TetlabApp {
     pub viewport: Viewport,
     /// The last error to show (a mesh that did not load, …).
     pub error: Option<String>,
-    step_time: Duration,
+    pub(crate) step_time: Duration,
     /// The time between the last two frames drawn, smoothed.
     frame_time: Duration,
     /// When the last frame was drawn.
@@ -832,9 +832,10 @@ impl eframe::App for TetlabApp {
         }
         if self.frames_drawn == 2 {
             self.platform.log(&format!(
-                "tetlab ready: {} with {} tets drawn",
+                "tetlab ready: {} with {} tets drawn; SIMD lanes in {}",
                 self.bench.scene.name,
-                self.bench.simulation.tets().len()
+                self.bench.simulation.tets().len(),
+                tetlab_core::numbers::lanes::REGISTERS
             ));
         }
     }

@@ -31,6 +31,11 @@ pub struct Report {
     pub drag: Option<DragReport>,
     /// While the Modes window is open: what it shows of the selected tet's energy.
     pub modes: Option<ModesReport>,
+    /// How this build holds the fast engine's lanes ([`tetlab_core::numbers::lanes::REGISTERS`]):
+    /// WebAssembly SIMD registers, or arrays in the page's build without SIMD.
+    pub lanes: &'static str,
+    /// How long the last simulation step took, in milliseconds.
+    pub step_ms: f64,
 }
 
 /// The Modes window's numbers: the eigenvalues of the selected tet's energy Hessian.
@@ -146,6 +151,8 @@ impl TetlabApp {
             lesson,
             drag: self.drag_report(),
             modes: self.modes_report(),
+            lanes: tetlab_core::numbers::lanes::REGISTERS,
+            step_ms: self.step_time.as_secs_f64() * 1e3,
         }
     }
 

@@ -89,13 +89,6 @@ impl<'a> RestRows<'a> {
             &self.stored[b * self.len..(b + 1) * self.len],
         )
     }
-
-    /// How many batches.
-    #[inline]
-    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
-    pub(crate) fn len(self) -> usize {
-        self.values.len()
-    }
 }
 
 /// A layout with its arity N known: what the kernels read.

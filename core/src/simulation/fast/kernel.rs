@@ -7,6 +7,7 @@
 
 use super::batches::{Batches, Layout, RestRows, Typed};
 use super::particles::Particles;
+use super::team::{Disjoint, SharedSkips, Team};
 use crate::constraints::{Constraint, Evaluation, GROUP};
 use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
 use crate::numbers::vector::{Real, Vector3};
@@ -15,12 +16,7 @@ use glam::Vec3A;
 
 /// Colours with fewer elements than this are projected on one thread even when several are
 /// available: below it, handing out the work costs more than it saves.
-pub const PARALLEL_MIN: usize = 1024;
-
-/// Batches per task when threads share a colour. Which thread projects a batch does not change
-/// what it computes, so the result is the same bits for any thread count.
-#[cfg(feature = "parallel")]
-const CHUNK: usize = 64;
+pub const PARALLEL_MIN: usize = 256;
 
 /// The particles `indices` (one per lane) as eight x, eight y and eight z.
 #[inline(always)]
@@ -169,8 +165,8 @@ fn in_order(order: &[u32], k: usize) -> usize {
 
 /// Projects every constraint of a family (`batches`, on `layout`), colour by colour in `order`
 /// (empty: the layout's), moving `positions` (Gauss–Seidel) or, given `sums`, adding the
-/// corrections to `sums` (Jacobi: `positions` stay as they are); with `parallel`, large colours
-/// are shared by the threads of the current pool. Returns how many constraints it projected, and
+/// corrections to `sums` (Jacobi: `positions` stay as they are); with a `team`, large colours
+/// are shared by its threads, each projecting a contiguous share of the colour's batches. Returns how many constraints it projected, and
 /// how many of them were skipped for a counted reason.
 #[inline]
 #[allow(clippy::too_many_arguments)]
@@ -183,7 +179,7 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
     rest_positions: &mut [Vec3A],
     sums: Option<&mut [Vec3A]>,
     (rule, reach): (Rule<f64>, f64),
-    parallel: bool,
+    team: Option<&Team>,
 ) -> (usize, SkipCounts) {
     let rule: Rule<F32x8> = rule.to();
     let reach = F32x8::from_f64(reach);
@@ -212,32 +208,26 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
             rest.batches(range.clone()),
             &mut lambda[range],
         );
-        let skipped = match parallel && colour.elements >= PARALLEL_MIN {
-            #[cfg(feature = "parallel")]
-            true => {
-                use rayon::prelude::*;
-                let batches = rest.len();
-                lambda
-                    .par_chunks_mut(CHUNK)
-                    .zip(particles.par_chunks(CHUNK))
-                    .zip(weights.par_chunks(CHUNK))
-                    .zip(size.par_chunks(CHUNK))
-                    .enumerate()
-                    .map(|(i, (((lambda, particles), weights), size))| {
-                        project_batches::<N, C>(
-                            constraint,
-                            particles,
-                            weights,
-                            (size, reach),
-                            rest.batches(i * CHUNK..((i + 1) * CHUNK).min(batches)),
-                            lambda,
-                            access,
-                            rule,
-                        )
-                    })
-                    .reduce(SkipCounts::default, |a, b| a + b)
+        let skipped = match team.filter(|_| colour.elements >= PARALLEL_MIN) {
+            Some(team) => {
+                let lambda = Disjoint::new([lambda], team.threads());
+                let totals = SharedSkips::default();
+                team.run(&|worker| {
+                    let ([lambda], share) = lambda.take(worker);
+                    totals.add(project_batches::<N, C>(
+                        constraint,
+                        &particles[share.clone()],
+                        &weights[share.clone()],
+                        (&size[share.clone()], reach),
+                        rest.batches(share),
+                        lambda,
+                        access,
+                        rule,
+                    ));
+                });
+                totals.get()
             }
-            _ => project_batches::<N, C>(
+            None => project_batches::<N, C>(
                 constraint,
                 particles,
                 weights,
@@ -359,7 +349,7 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
     rest_positions: &mut [Vec3A],
     sums: Option<&mut [Vec3A]>,
     (rules, reach): ([Rule<f64>; 2], f64),
-    parallel: bool,
+    team: Option<&Team>,
 ) -> (usize, [SkipCounts; 2]) {
     let rules: [Rule<F32x8>; 2] = rules.map(Rule::to);
     let reach = F32x8::from_f64(reach);
@@ -387,34 +377,27 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         let size = &size[range.clone()];
         let rest = (rest_a.batches(range.clone()), rest_b.batches(range.clone()));
         let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
-        let skipped = match parallel && colour.elements >= PARALLEL_MIN {
-            #[cfg(feature = "parallel")]
-            true => {
-                use rayon::prelude::*;
-                let batches = rest.0.len();
-                lambda_a
-                    .par_chunks_mut(CHUNK)
-                    .zip(lambda_b.par_chunks_mut(CHUNK))
-                    .zip(particles.par_chunks(CHUNK))
-                    .zip(weights.par_chunks(CHUNK).zip(size.par_chunks(CHUNK)))
-                    .enumerate()
-                    .map(
-                        |(i, (((lambda_a, lambda_b), particles), (weights, size)))| {
-                            let range = i * CHUNK..((i + 1) * CHUNK).min(batches);
-                            project_pair_batches::<N, A, M, B>(
-                                constraints,
-                                particles,
-                                (weights, size, reach),
-                                (rest.0.batches(range.clone()), rest.1.batches(range)),
-                                (lambda_a, lambda_b),
-                                access,
-                                rules,
-                            )
-                        },
-                    )
-                    .reduce(|| [SkipCounts::default(); 2], add)
+        let skipped = match team.filter(|_| colour.elements >= PARALLEL_MIN) {
+            Some(team) => {
+                let lambdas = Disjoint::new([lambda_a, lambda_b], team.threads());
+                let totals = [SharedSkips::default(), SharedSkips::default()];
+                team.run(&|worker| {
+                    let ([lambda_a, lambda_b], share) = lambdas.take(worker);
+                    let skipped = project_pair_batches::<N, A, M, B>(
+                        constraints,
+                        &particles[share.clone()],
+                        (&weights[share.clone()], &size[share.clone()], reach),
+                        (rest.0.batches(share.clone()), rest.1.batches(share)),
+                        (lambda_a, lambda_b),
+                        access,
+                        rules,
+                    );
+                    totals[0].add(skipped[0]);
+                    totals[1].add(skipped[1]);
+                });
+                [totals[0].get(), totals[1].get()]
             }
-            _ => project_pair_batches::<N, A, M, B>(
+            None => project_pair_batches::<N, A, M, B>(
                 constraints,
                 particles,
                 (weights, size, reach),

@@ -19,17 +19,20 @@
 //!   on [`crate::numbers::lanes::Vec3x8`], eight x, eight y and eight z in SIMD registers; a batch's
 //!   particles are loaded as padded 3-vectors and transposed, its inverse masses, rest values and
 //!   multipliers are stored lane by lane beside it; the loads skip their bounds checks
-//!   ([`particles`], the one `unsafe` module);
+//!   ([`particles`], one of the two `unsafe` modules, with [`team`]);
 //! - f32 instead of f64;
-//! - optionally the [`Order::Jacobi`] order, for comparison.
+//! - optionally the [`Order::Jacobi`] order, for comparison;
+//! - large colours shared by a [`Team`] of threads kept for the simulation's life.
 
 pub mod batches;
 mod kernel;
 mod morton;
 mod particles;
+mod team;
 
 pub use batches::{Batches, Colour, Layout};
 pub use kernel::PARALLEL_MIN;
+pub use team::Team;
 
 use super::constraint_set::ConstraintSet;
 use super::settings::Settings;
@@ -102,8 +105,8 @@ pub struct FastSimulation {
     colour_orders: PerFamily<Vec<u32>>,
     tets: usize,
     jacobi: Option<Jacobi>,
-    #[cfg(feature = "parallel")]
-    pool: Option<rayon::ThreadPool>,
+    /// The threads large colours are shared with, kept for the simulation's life (none: one).
+    team: Option<Team>,
     timings: Timings,
     /// Projections skipped for a counted reason since the last [`FastSimulation::take_skipped`].
     skipped: PerFamily<SkipCounts>,
@@ -404,8 +407,9 @@ impl FastSimulation {
                 && layouts.tet_vertices.colouring_is_valid(n)
         );
         let positions = take(simulation.positions);
+        // Without the feature (the page), one thread.
         #[cfg(not(feature = "parallel"))]
-        let _ = threads;
+        let threads = threads.min(1);
         let colour_orders = colour_orders(simulation.families, simulation.settings, &layouts);
         FastSimulation {
             families: simulation.families.clone(),
@@ -425,15 +429,7 @@ impl FastSimulation {
             sets,
             tets: simulation.tets.len(),
             jacobi: None,
-            #[cfg(feature = "parallel")]
-            pool: (threads > 1)
-                .then(|| {
-                    rayon::ThreadPoolBuilder::new()
-                        .num_threads(threads)
-                        .build()
-                        .ok()
-                })
-                .flatten(),
+            team: (threads > 1).then(|| Team::new(threads)),
             timings: Timings::default(),
             skipped: PerFamily::default(),
             frame: 0,
@@ -519,11 +515,7 @@ impl FastSimulation {
 
     /// The threads the projections run on.
     pub fn threads(&self) -> usize {
-        #[cfg(feature = "parallel")]
-        if let Some(pool) = &self.pool {
-            return pool.current_num_threads();
-        }
-        1
+        self.team.as_ref().map_or(1, Team::threads)
     }
 
     /// The constraints of `family`, coloured and in batches (empty when it is not active).
@@ -770,8 +762,8 @@ impl FastSimulation {
     }
 
     /// Advances one frame: `substeps` substeps of predict, sweeps, velocities. With several
-    /// threads, the whole frame runs inside the thread pool (entering it once per frame, not once
-    /// per colour).
+    /// threads, large colours are shared with the simulation's [`Team`], whose threads wait for
+    /// the next colour spinning, not asleep, while a frame is under way.
     pub fn step(&mut self) {
         self.step_frame(&FrameInputs::default());
     }
@@ -779,19 +771,14 @@ impl FastSimulation {
     /// [`FastSimulation::step`], holding a grabbed particle, settling an edit or keeping Δp as
     /// `inputs` ask. Allocates nothing once Δp has been kept once.
     pub fn step_frame(&mut self, inputs: &FrameInputs) {
-        #[cfg(feature = "parallel")]
-        if let Some(pool) = self.pool.take() {
-            pool.install(|| self.step_on(true, inputs));
-            self.pool = Some(pool);
-            self.frame += 1;
-            return;
-        }
-        self.step_on(false, inputs);
+        let team = self.team.take();
+        self.step_on(team.as_ref(), inputs);
+        self.team = team;
         self.frame += 1;
     }
 
-    /// One frame; `parallel`: large colours are shared by the threads of the current pool.
-    fn step_on(&mut self, parallel: bool, inputs: &FrameInputs) {
+    /// One frame; large colours are shared with `team`'s threads, when there is one.
+    fn step_on(&mut self, team: Option<&Team>, inputs: &FrameInputs) {
         self.recentre();
         let settings = self.settings;
         let h = settings.dt / settings.substeps.max(1) as f64;
@@ -849,7 +836,7 @@ impl FastSimulation {
             }
             let mut grab_lambda = 0.0;
             for _ in 0..settings.iterations.max(1) {
-                self.sweep(h, parallel, grab, &mut grab_lambda);
+                self.sweep(h, team, grab, &mut grab_lambda);
             }
             if track {
                 let c = &mut self.corrections;
@@ -897,7 +884,7 @@ impl FastSimulation {
     fn sweep(
         &mut self,
         h: f64,
-        parallel: bool,
+        team: Option<&Team>,
         grab: Option<(usize, Vec3A, f64)>,
         grab_lambda: &mut f32,
     ) {
@@ -919,7 +906,7 @@ impl FastSimulation {
                     sums: Option<&'a mut [Vec3A]>,
                     rules: [Rule<f64>; 2],
                     reach: f64,
-                    parallel: bool,
+                    team: Option<&'a Team>,
                 }
                 impl VisitPair for ProjectPair<'_> {
                     type Output = (usize, [SkipCounts; 2]);
@@ -943,7 +930,7 @@ impl FastSimulation {
                             self.rest_positions,
                             self.sums,
                             (self.rules, self.reach),
-                            self.parallel,
+                            self.team,
                         )
                     }
                 }
@@ -960,7 +947,7 @@ impl FastSimulation {
                         sums,
                         rules,
                         reach: self.settings.reach,
-                        parallel,
+                        team,
                     },
                 );
                 self.apply_jacobi(family);
@@ -982,7 +969,7 @@ impl FastSimulation {
                 sums: Option<&'a mut [Vec3A]>,
                 rule: Rule<f64>,
                 reach: f64,
-                parallel: bool,
+                team: Option<&'a Team>,
             }
             impl Visit for Project<'_> {
                 type Output = (usize, SkipCounts);
@@ -1001,7 +988,7 @@ impl FastSimulation {
                         self.rest_positions,
                         self.sums,
                         (self.rule, self.reach),
-                        self.parallel,
+                        self.team,
                     )
                 }
             }
@@ -1016,7 +1003,7 @@ impl FastSimulation {
                     sums,
                     rule,
                     reach: self.settings.reach,
-                    parallel,
+                    team,
                 },
             );
             self.apply_jacobi(family);
