@@ -5,9 +5,9 @@
 # top of the folder, and without it in nosimd/, which the page loads where the browser's
 # WebAssembly.validate rejects SIMD (web/index.html; `?nosimd` forces it, for tests).
 # Installs what it needs when missing: the wasm32 target (rustup), wasm-bindgen-cli of the
-# version in Cargo.lock (cargo install) and binaryen's wasm-opt (the npm registry's `binaryen`,
-# in $TETLAB_WEB_CACHE, default ~/.cache/tetlab-web), whose result is cached there by the hash of
-# its input. Prints the size of each .wasm, plain and gzipped.
+# version in Cargo.lock (cargo install) and, with TETLAB_WASM_OPT=1, binaryen's wasm-opt (the npm
+# registry's `binaryen`, in $TETLAB_WEB_CACHE, default ~/.cache/tetlab-web), whose result is cached
+# there by the hash of its input. Prints the size of each .wasm, plain and gzipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-site}"
@@ -56,17 +56,18 @@ for name in $(sed -n 's|^scene = ".*shared/meshes/\([^"]*\)".*|\1|p' assets/less
   done
 done
 
-# Binaryen's optimiser (-Oz), from the npm registry's `binaryen` package (its JavaScript build
-# runs on the machine's Node.js; Debian 12's binaryen 108 is too old for wasm-bindgen's externref
-# table: "WebAssembly.Table.set(): Argument 1 is invalid"). It takes minutes on the page, so its
-# output is kept in the cache under the hash of its input, and an unchanged build is not optimised
-# again. TETLAB_WASM_OPT=0 leaves it out.
+# Binaryen's optimiser (-Oz) with TETLAB_WASM_OPT=1, from the npm registry's `binaryen` package
+# (its JavaScript build runs on the machine's Node.js; Debian 12's binaryen 108 is too old for
+# wasm-bindgen's externref table: "WebAssembly.Table.set(): Argument 1 is invalid"). It takes
+# about 1.5 minutes a build here, so its output is kept in the cache under the hash of its input
+# and an unchanged build is not optimised again. It is off by default: it makes the .wasm 6 %
+# smaller but the gzipped page, what a browser downloads, 0.2 % larger (docs/performance.md).
 binaryen_version=132.0.0
 cache="${TETLAB_WEB_CACHE:-$HOME/.cache/tetlab-web}"
 optimise() {
   local wasm=$1
-  if [ "${TETLAB_WASM_OPT:-1}" = 0 ]; then
-    echo "== wasm-opt left out (TETLAB_WASM_OPT=0)"
+  if [ "${TETLAB_WASM_OPT:-0}" != 1 ]; then
+    echo "== wasm-opt left out (TETLAB_WASM_OPT=1 runs it)"
     return
   fi
   if ! command -v npm >/dev/null; then
