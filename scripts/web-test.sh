@@ -20,49 +20,35 @@ server=$!
 trap 'kill $server 2>/dev/null || true' EXIT
 sleep 1
 
-shot="${TETLAB_WEB_SCREENSHOT:-$work/web.png}"
-echo "== opening http://127.0.0.1:$port/ in headless chromium"
-chromium --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking \
-  --disable-component-update --disable-sync --disable-quic --enable-unsafe-swiftshader \
-  --user-data-dir="$work/profile" --window-size=1280,800 --virtual-time-budget=15000 \
-  --enable-logging=stderr --v=0 --screenshot="$shot" "http://127.0.0.1:$port/" \
-  >"$work/chromium.log" 2>&1 || true
-
-if ! grep -q "tetlab ready" "$work/chromium.log"; then
-  echo "the page did not say \"tetlab ready\"; the browser's console:" >&2
-  grep -i "console\|error" "$work/chromium.log" | tail -20 >&2 || true
-  exit 1
-fi
-grep -o 'tetlab: drawing with [^"]*\|tetlab ready[^"]*' "$work/chromium.log" | head -2
-body=$(python3 scripts/png_colour_count.py "$shot" 150 180 210)
-echo "screenshot $shot: $body pixels of the body's colour"
-if [ "$body" -lt 20000 ]; then
-  echo "the screenshot does not show the soft body" >&2
-  exit 1
-fi
-echo "web page OK"
-
+# Opens the page at address suffix $1 (what it is: $2) in headless Chromium, screenshots it into
+# $3, and checks that it said "tetlab ready" and shows the soft body's colour.
+open_and_look() {
+  local suffix=$1 what=$2 shot=$3 log="$work/chromium-$4.log"
+  echo "== opening http://127.0.0.1:$port/$suffix ($what) in headless chromium"
+  chromium --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking \
+    --disable-component-update --disable-sync --disable-quic --enable-unsafe-swiftshader \
+    --user-data-dir="$work/profile-$4" --window-size=1280,800 --virtual-time-budget=15000 \
+    --enable-logging=stderr --v=0 --screenshot="$shot" "http://127.0.0.1:$port/$suffix" \
+    >"$log" 2>&1 || true
+  if ! grep -q "tetlab ready" "$log"; then
+    echo "$what did not say \"tetlab ready\"; the browser's console:" >&2
+    grep -i "console\|error" "$log" | tail -20 >&2 || true
+    exit 1
+  fi
+  grep -o 'tetlab: drawing with [^"]*\|tetlab ready[^"]*' "$log" | head -2
+  local body
+  body=$(python3 scripts/png_colour_count.py "$shot" 150 180 210)
+  echo "screenshot $shot: $body pixels of the body's colour"
+  if [ "$body" -lt 20000 ]; then
+    echo "the screenshot of $what does not show the soft body" >&2
+    exit 1
+  fi
+  echo "$what OK"
+}
+open_and_look "" "the page" "${TETLAB_WEB_SCREENSHOT:-$work/web.png}" simd
 # The build without SIMD, which the page loads where a browser rejects WebAssembly SIMD: forced
 # with ?nosimd, it starts and draws the body too.
-fallback="$work/web-nosimd.png"
-echo "== opening http://127.0.0.1:$port/?nosimd (the build without SIMD)"
-chromium --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking \
-  --disable-component-update --disable-sync --disable-quic --enable-unsafe-swiftshader \
-  --user-data-dir="$work/profile-nosimd" --window-size=1280,800 --virtual-time-budget=15000 \
-  --enable-logging=stderr --v=0 --screenshot="$fallback" "http://127.0.0.1:$port/?nosimd" \
-  >"$work/chromium-nosimd.log" 2>&1 || true
-if ! grep -q "tetlab ready" "$work/chromium-nosimd.log"; then
-  echo "the build without SIMD did not say \"tetlab ready\"; the browser's console:" >&2
-  grep -i "console\|error" "$work/chromium-nosimd.log" | tail -20 >&2 || true
-  exit 1
-fi
-body=$(python3 scripts/png_colour_count.py "$fallback" 150 180 210)
-echo "screenshot $fallback: $body pixels of the body's colour"
-if [ "$body" -lt 20000 ]; then
-  echo "the build without SIMD does not show the soft body" >&2
-  exit 1
-fi
-echo "web page without SIMD OK"
+open_and_look "?nosimd" "the page's build without SIMD" "$work/web-nosimd.png" nosimd
 
 # Then driven as a user would (tests/web/drive.mjs: puppeteer-core from the npm registry, against
 # Debian's chromium; no browser is downloaded): a tet dragged inside out, Space, M, a lesson and a

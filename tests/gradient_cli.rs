@@ -882,10 +882,34 @@ fn modes_prints_the_classified_eigenmodes_and_their_checks() {
         "{table}"
     );
 
+    // Coincident corners: the edges are degenerate (their gradient taken as 0), the
+    // second-order check has no value there, and it says so instead of printing NaN.
+    let coincident = ["modes", "--points", "0,0,0", "0,0,0", "0,0,0", "0,0,0"];
+    let table = tetlab(&coincident);
+    assert!(table.status.success(), "{}", stderr(&table));
+    let text = stdout(&table);
+    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+    assert!(
+        text.contains("against second-order dual numbers undefined"),
+        "{text}"
+    );
+    let degenerate = json(&[&coincident[..], &["--json"]].concat());
+    assert!(degenerate["against_second_order"].is_null(), "{degenerate}");
     for (args, names) in [
         (
             &["modes", "--points", "0,0,0", "1,0,0", "0,1,0"][..],
             "--points",
+        ),
+        (
+            &[
+                "modes",
+                "--rest-shape",
+                "0,0,0",
+                "1e200,0,0",
+                "0,1e200,0",
+                "0,0,1e200",
+            ][..],
+            "--rest-shape: the rest tet's volume is not finite",
         ),
         (
             &["modes", "--rest-shape", "0,0,0", "1,0,0", "2,0,0", "3,0,0"][..],

@@ -82,8 +82,10 @@ struct Output {
     corner_mass: f64,
     /// max |H − Hᵀ| / max |H|.
     asymmetry: f64,
-    /// max |H − H₂| / max |H|, H₂ by second-order dual numbers.
-    against_second_order: f64,
+    /// max |H − H₂| / max |H|, H₂ by second-order dual numbers; `None` where H₂ is not finite
+    /// (a constraint is degenerate there: its second derivatives do not exist, and AD's H takes
+    /// its gradient as zero).
+    against_second_order: Option<f64>,
     /// Central differences of ∇E: (step relative to the tet's size, error relative to max |H|).
     convergence: Vec<(f64, f64)>,
     convergence_slope: f64,
@@ -99,7 +101,12 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let (settings, families) = args.families.apply(Settings::default())?;
     let rest = corners(&args.rest_shape, "--rest-shape", UNIT_TET)?;
     let volume = tetlab_core::constraints::volume::signed_volume(&rest);
-    // (NaN, from corners far out of range, is refused too.)
+    if !volume.is_finite() {
+        return Err(UsageError(format!(
+            "--rest-shape: the rest tet's volume is not finite ({volume:e}): its coordinates are \
+             too large for f64"
+        )));
+    }
     let flat = volume
         .abs()
         .partial_cmp(&(1e-12 * rest_size(&rest).powi(3)));
@@ -142,7 +149,10 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         rest_shape: rest.map(|p| p.to_array()),
         corner_mass: energy.corner_mass(),
         asymmetry: asymmetry(&h),
-        against_second_order: (h - independent).amax() / h.amax().max(f64::MIN_POSITIVE),
+        against_second_order: independent
+            .iter()
+            .all(|v| v.is_finite())
+            .then(|| (h - independent).amax() / h.amax().max(f64::MIN_POSITIVE)),
         convergence: check.steps.clone(),
         convergence_slope: check.slope,
         convergence_decades: check.decades,
@@ -234,11 +244,17 @@ fn write_table(o: &Output, check: &Convergence, out: &mut impl Write) -> std::io
         writeln!(out, "            {name}: α = {}{note}", alpha.show())?;
     }
     writeln!(out, "            E = {} at these points", o.energy.show())?;
+    let against = match o.against_second_order {
+        Some(e) => format!("{e:.1e}"),
+        None => "undefined (a constraint is degenerate here: coincident corners or a flat \
+                 face; its gradient is taken as 0)"
+            .to_owned(),
+    };
     writeln!(
         out,
         "hessian     12 × 12 by AD (forward mode over ∇C); symmetric to {:.1e}; against \
-         second-order dual numbers {:.1e}",
-        o.asymmetry, o.against_second_order
+         second-order dual numbers {against}",
+        o.asymmetry
     )?;
     let steps: Vec<String> = check
         .steps

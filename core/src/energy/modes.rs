@@ -103,10 +103,22 @@ impl Modes {
     }
 
     /// The modes of tet `tet` of `simulation` now: the energy of its active families
-    /// ([`ElementEnergy::of_tet`]) at its corners. An error when no family is active.
+    /// ([`ElementEnergy::of_tet`]) at its corners. An error when no family is active, or where
+    /// the Hessian is not finite (numbers too large for f64).
     pub fn of_tet(simulation: &crate::simulation::Simulation, tet: usize) -> Result<Modes, String> {
         let (energy, x) = ElementEnergy::of_tet(simulation, tet)?;
-        Ok(Modes::of(&energy, &x))
+        let h = hessian(&energy, &coordinates(&x));
+        if !h.iter().all(|v| v.is_finite()) {
+            return Err(format!(
+                "the Hessian of tet {tet} is not finite at its corners"
+            ));
+        }
+        Ok(Modes::of_matrix(
+            h,
+            &x,
+            &energy.rest_shape(),
+            energy.corner_mass(),
+        ))
     }
 
     /// The modes of the symmetric `h` (its lower triangle is read), for a tet at `x` with rest
