@@ -496,8 +496,18 @@ impl Families {
             type Output = W::Output;
             #[inline]
             fn visit<const M: usize, B: Constraint<M>>(self, _: Family, second: &B) -> W::Output {
-                self.visitor.visit_pair::<N, A, M, B>(self.first, second)
+                // Only two types that can be a pair get pair code: the branch not taken is not
+                // compiled, since its condition is a constant of the two types.
+                if IsPair::<N, A, M, B>::VALUE {
+                    self.visitor.visit_pair::<N, A, M, B>(self.first, second)
+                } else {
+                    unreachable!("visit_pair of two families that are not a pair")
+                }
             }
+        }
+        struct IsPair<const N: usize, A, const M: usize, B>(std::marker::PhantomData<(A, B)>);
+        impl<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>> IsPair<N, A, M, B> {
+            const VALUE: bool = super::pairs::<N, A, M, B>();
         }
         impl<W: VisitPair> Visit for Outer<'_, W> {
             type Output = W::Output;

@@ -1,7 +1,7 @@
 //! A constraint file's family as a [`Constraint`]: its compiled tape gives C and ∇C. The file
 //! joins the table of families in [`super::Families`].
 
-use super::{Constraint, Evaluation};
+use super::{Constraint, Evaluation, PairGroup};
 use super::{GROUP, MAX_STORED, Stored};
 use crate::constraint_file::{ConstraintFile, sound};
 use crate::constraints::material::Material;
@@ -25,6 +25,8 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
     const REST_USES_MATERIAL: bool = true;
     // The tape's dispatch on each instruction, paid once for GROUP batches.
     const GROUPED: bool = true;
+    // A file's `pair`.
+    const PAIR_GROUP: PairGroup = PairGroup::File;
 
     /// C and ∇C with what the element stores worked out here from `rest_shape` and the default
     /// material: for the checkers and readers that hold no stored values (the solvers call

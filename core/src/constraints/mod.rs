@@ -51,6 +51,33 @@ pub const MAX_STORED: usize = 48;
 /// What an element stores ([`Constraint::store`]).
 pub type Stored = arrayvec::ArrayVec<f64, MAX_STORED>;
 
+/// The constraints that can be projected together as a pair ([`Constraint::PAIR_GROUP`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PairGroup {
+    /// Never half of a pair.
+    None,
+    /// The two halves of the built-in neo-Hookean energy.
+    NeoHookean,
+    /// The constraints of constraint files (a file's `pair`).
+    File,
+}
+
+/// Whether constraints of types `A` and `B` can be a pair: the same group, other than
+/// [`PairGroup::None`], and the same particles (N = M).
+///
+/// ```
+/// use tetlab_core::constraints::neohookean::{Deviatoric, Hydrostatic};
+/// use tetlab_core::constraints::{pairs, volume::Volume};
+/// assert!(pairs::<4, Deviatoric, 4, Hydrostatic>());
+/// assert!(!pairs::<4, Volume, 4, Hydrostatic>());
+/// assert!(!pairs::<4, Volume, 4, Volume>());
+/// ```
+pub const fn pairs<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>() -> bool {
+    N == M
+        && !matches!(A::PAIR_GROUP, PairGroup::None)
+        && A::PAIR_GROUP as u8 == B::PAIR_GROUP as u8
+}
+
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or
 /// eight constraints at once in SIMD lanes).
 pub trait Constraint<const N: usize>: Sync {
@@ -66,6 +93,11 @@ pub trait Constraint<const N: usize>: Sync {
     /// Whether [`Constraint::rest_value`] depends on the material, so that the rest values are
     /// measured again when it changes.
     const REST_USES_MATERIAL: bool = false;
+
+    /// Which constraints of another family this one may be projected together with, as a pair
+    /// ([`Row::projected_with`]): those of the same group. The solvers' pair kernels are compiled
+    /// for such two types only, not for every two families of the table ([`pairs`]).
+    const PAIR_GROUP: PairGroup = PairGroup::None;
 
     /// C and ∇C at `p`, with rest value `rest` (d, V) and the particles' rest positions
     /// `rest_shape`.

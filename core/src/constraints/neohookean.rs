@@ -41,7 +41,7 @@
 //! assert!(h.value < 0.0 && h.gradients[1].x > 0.0);
 //! ```
 
-use super::{Constraint, Evaluation, first_from_rest};
+use super::{Constraint, Evaluation, PairGroup, first_from_rest};
 use crate::constraints::material::Material;
 use crate::numbers::vector::{Real, Vector3};
 use glam::{DMat3, DVec3};
@@ -180,6 +180,7 @@ pub struct Deviatoric;
 
 impl Constraint<4> for Deviatoric {
     const USES_REST_SHAPE: bool = true;
+    const PAIR_GROUP: PairGroup = PairGroup::NeoHookean;
 
     #[inline(always)]
     fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, shape: &[V; 4]) -> Evaluation<V, 4> {
@@ -202,6 +203,7 @@ pub struct Hydrostatic;
 impl Constraint<4> for Hydrostatic {
     const USES_REST_SHAPE: bool = true;
     const REST_USES_MATERIAL: bool = true;
+    const PAIR_GROUP: PairGroup = PairGroup::NeoHookean;
 
     #[inline(always)]
     fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, shape: &[V; 4]) -> Evaluation<V, 4> {

@@ -242,17 +242,16 @@ impl Vec3x8 {
     }
 
     /// Lane k of the result is (x, y, z) of `rows[k]`, the register of a padded 3-vector (its
-    /// fourth component ignored): two 4 × 4 transposes.
+    /// fourth component ignored). With AVX: each two rows k and k + 4 side by side in one
+    /// register, then one 4 × 4 transpose in both halves at once (11 shuffles); elsewhere two
+    /// 4 × 4 transposes of `wide`. The same bits either way: only data moves.
     #[inline(always)]
     pub fn from_rows(rows: [f32x4; LANES]) -> Self {
-        let [r0, r1, r2, r3, r4, r5, r6, r7] = rows;
-        let [x0, y0, z0, _] = f32x4::transpose([r0, r1, r2, r3]);
-        let [x1, y1, z1, _] = f32x4::transpose([r4, r5, r6, r7]);
-        let join = |a: f32x4, b: f32x4| F32x8(bytemuck::cast([a, b]));
+        let [x, y, z] = transpose::from_rows(rows);
         Vec3x8 {
-            x: join(x0, x1),
-            y: join(y0, y1),
-            z: join(z0, z1),
+            x: F32x8(x),
+            y: F32x8(y),
+            z: F32x8(z),
         }
     }
 
@@ -260,11 +259,7 @@ impl Vec3x8 {
     /// [`Vec3x8::from_rows`].
     #[inline(always)]
     pub fn rows(self) -> [f32x4; LANES] {
-        let split = |a: F32x8| bytemuck::cast::<f32x8, [f32x4; 2]>(a.0);
-        let ([x0, x1], [y0, y1], [z0, z1]) = (split(self.x), split(self.y), split(self.z));
-        let [a0, a1, a2, a3] = f32x4::transpose([x0, y0, z0, f32x4::ZERO]);
-        let [b0, b1, b2, b3] = f32x4::transpose([x1, y1, z1, f32x4::ZERO]);
-        [a0, a1, a2, a3, b0, b1, b2, b3]
+        transpose::rows([self.x.0, self.y.0, self.z.0])
     }
 
     /// Lane k as a 3-vector.
@@ -403,6 +398,95 @@ impl Vector3 for Vec3x8 {
     }
 }
 
+/// The two transposes between eight padded 3-vectors and [`Vec3x8`]'s eight x, y and z: what the
+/// fast engine does at each gather and each write-back of a batch.
+mod transpose {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    pub(super) use avx::{from_rows, rows};
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    pub(super) use portable::{from_rows, rows};
+
+    /// Two 4 × 4 transposes of `wide`, and the halves joined or split.
+    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
+    pub(super) mod portable {
+        use super::super::LANES;
+        use wide::{f32x4, f32x8};
+
+        /// The x, y and z of the eight rows.
+        #[inline(always)]
+        pub(crate) fn from_rows(rows: [f32x4; LANES]) -> [f32x8; 3] {
+            let [r0, r1, r2, r3, r4, r5, r6, r7] = rows;
+            let [x0, y0, z0, _] = f32x4::transpose([r0, r1, r2, r3]);
+            let [x1, y1, z1, _] = f32x4::transpose([r4, r5, r6, r7]);
+            let join = |a: f32x4, b: f32x4| bytemuck::cast([a, b]);
+            [join(x0, x1), join(y0, y1), join(z0, z1)]
+        }
+
+        /// Eight rows (x, y, z, 0) of `xyz`.
+        #[inline(always)]
+        pub(crate) fn rows(xyz: [f32x8; 3]) -> [f32x4; LANES] {
+            let split = |a: f32x8| bytemuck::cast::<f32x8, [f32x4; 2]>(a);
+            let [[x0, x1], [y0, y1], [z0, z1]] = xyz.map(split);
+            let [a0, a1, a2, a3] = f32x4::transpose([x0, y0, z0, f32x4::ZERO]);
+            let [b0, b1, b2, b3] = f32x4::transpose([x1, y1, z1, f32x4::ZERO]);
+            [a0, a1, a2, a3, b0, b1, b2, b3]
+        }
+    }
+
+    /// The same in AVX shuffles (`safe_arch`'s safe wrappers of the intrinsics), working on both
+    /// 128-bit halves of a register at once: rows k and k + 4 share a register (the low half
+    /// and the high half). 4 inserts, 4 unpacks and 3 shuffles to gather (19 shuffles and joins
+    /// in `portable`); 4 unpacks, 4 shuffles and 4 extracts to write back (19 there).
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    mod avx {
+        use super::super::LANES;
+        use safe_arch::{
+            cast_to_m128_from_m256, extract_m128_from_m256, m128, m256, set_m128_m256,
+            shuffle_m256, unpack_hi_m256, unpack_lo_m256, zeroed_m256,
+        };
+        use wide::{f32x4, f32x8};
+
+        /// Lanes 0, 1 of `a` and 0, 1 of `b`, in each half.
+        const LOW_PAIRS: i32 = 0b01_00_01_00;
+        /// Lanes 2, 3 of `a` and 2, 3 of `b`, in each half.
+        const HIGH_PAIRS: i32 = 0b11_10_11_10;
+
+        /// The x, y and z of the eight rows.
+        #[inline(always)]
+        pub(crate) fn from_rows(rows: [f32x4; LANES]) -> [f32x8; 3] {
+            let r: [m128; LANES] = bytemuck::cast(rows);
+            let (a0, a1) = (set_m128_m256(r[4], r[0]), set_m128_m256(r[5], r[1]));
+            let (a2, a3) = (set_m128_m256(r[6], r[2]), set_m128_m256(r[7], r[3]));
+            // x0 x1 y0 y1 | x4 x5 y4 y5 and z0 z1 . . | z4 z5 . ., the same of rows 2, 3, 6, 7.
+            let (t0, t1) = (unpack_lo_m256(a0, a1), unpack_hi_m256(a0, a1));
+            let (t2, t3) = (unpack_lo_m256(a2, a3), unpack_hi_m256(a2, a3));
+            let x = shuffle_m256::<LOW_PAIRS>(t0, t2);
+            let y = shuffle_m256::<HIGH_PAIRS>(t0, t2);
+            let z = shuffle_m256::<LOW_PAIRS>(t1, t3);
+            bytemuck::cast([x, y, z])
+        }
+
+        /// Eight rows (x, y, z, 0) of `xyz`.
+        #[inline(always)]
+        pub(crate) fn rows(xyz: [f32x8; 3]) -> [f32x4; LANES] {
+            let [x, y, z]: [m256; 3] = bytemuck::cast(xyz);
+            let zero = zeroed_m256();
+            // x0 y0 x1 y1 | x4 y4 x5 y5, x2 y2 x3 y3 | x6 ..., z0 0 z1 0 | z4 ..., z2 0 z3 0 | ...
+            let (t0, t1) = (unpack_lo_m256(x, y), unpack_hi_m256(x, y));
+            let (t2, t3) = (unpack_lo_m256(z, zero), unpack_hi_m256(z, zero));
+            let a = [
+                shuffle_m256::<LOW_PAIRS>(t0, t2),
+                shuffle_m256::<HIGH_PAIRS>(t0, t2),
+                shuffle_m256::<LOW_PAIRS>(t1, t3),
+                shuffle_m256::<HIGH_PAIRS>(t1, t3),
+            ];
+            let low = a.map(cast_to_m128_from_m256);
+            let high = a.map(extract_m128_from_m256::<1>);
+            bytemuck::cast([low, high])
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -448,6 +532,36 @@ mod tests {
             }
             assert!(v.degenerate.lane(3));
             assert!(v.gradients.iter().all(|g| g.lane(3) == Vec3A::ZERO));
+        }
+    }
+
+    /// The transposes the fast engine uses (AVX shuffles where the build has AVX) give `wide`'s
+    /// portable transposes' bits, and writing back inverts gathering, with a zero fourth lane.
+    #[test]
+    fn the_transposes_move_every_lane_where_the_portable_ones_do() {
+        let mut rng = SplitMix64::new(17);
+        for _ in 0..100 {
+            let rows: [f32x4; LANES] = std::array::from_fn(|_| {
+                let p = rng.in_cube(10.0).as_vec3a();
+                f32x4::new([p.x, p.y, p.z, rng.in_cube(1.0).x as f32])
+            });
+            let bits = |v: [f32x8; 3]| v.map(|v| v.to_array().map(f32::to_bits));
+            assert_eq!(
+                bits(transpose::from_rows(rows)),
+                bits(transpose::portable::from_rows(rows))
+            );
+            let v = Vec3x8::from_rows(rows);
+            let back = v.rows();
+            for k in 0..LANES {
+                let [x, y, z, _] = rows[k].to_array();
+                assert_eq!(back[k].to_array(), [x, y, z, 0.0]);
+                assert_eq!(v.lane(k), Vec3A::new(x, y, z));
+            }
+            let xyz = [v.x.0, v.y.0, v.z.0];
+            assert_eq!(
+                transpose::rows(xyz).map(|r| r.to_array().map(f32::to_bits)),
+                transpose::portable::rows(xyz).map(|r| r.to_array().map(f32::to_bits))
+            );
         }
     }
 }
