@@ -115,6 +115,31 @@ fn two_and_three_threads_give_the_same_bits_as_one() {
 }
 
 #[test]
+fn the_threads_shares_of_a_colour_keep_mostly_to_their_own_particles() {
+    // Each thread takes a contiguous share of a colour's batches, and a colour's elements are
+    // sorted by their lowest particle in Morton order: a share is a region of the body, the same
+    // one colour after colour, and only the lines of particles at its border were written by
+    // another thread since this one last touched them. (Shares dealt batch by batch in turn
+    // would find about half their lines written by another thread.)
+    let simulation = cube(15, PerFamily::builtin_list("edges,volume").unwrap());
+    let fast = FastSimulation::new(simulation.fast_start(), 1);
+    for family in [Family::EDGES, Family::VOLUME] {
+        assert_eq!(fast.lines_from_other_threads(family, 1), (0, 0), "{family}");
+        let fraction = |threads| {
+            let (other, lines) = fast.lines_from_other_threads(family, threads);
+            assert!(lines > 0 && other <= lines, "{family}: {other} of {lines}");
+            other as f64 / lines as f64
+        };
+        let (two, three) = (fraction(2), fraction(3));
+        assert!(two > 0.0 && two < 0.15, "{family}, two threads: {two}");
+        assert!(
+            three > two,
+            "{family}: three threads have more borders ({three} ≤ {two})"
+        );
+    }
+}
+
+#[test]
 fn a_mirrored_cube_recovers_in_jacobi_order_too() {
     let mut reference = cube(3, PerFamily::splat(true));
     reference.perturb(Perturbation::Mirror);

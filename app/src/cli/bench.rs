@@ -88,6 +88,14 @@ struct Report {
     colours: Option<Named<usize>>,
     /// How the fast solver's SIMD lanes are held on this build.
     lanes: Option<String>,
+    /// With tetlab-core's feature `share-timers`: the large colours' and each thread's share's
+    /// mean time (a diagnostic of the threads; docs/performance.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    share_timings: Option<String>,
+    /// With two threads or more, per family: of the particles' cache lines each thread's share
+    /// of a large colour touches, the fraction another thread wrote since (fast engine).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lines_from_other_threads: Option<Named<f64>>,
     /// After the run, per active family: √(mean (C / rest value)²).
     #[serde(serialize_with = "active_only")]
     relative_error: Option<Named<Option<f64>>>,
@@ -231,6 +239,16 @@ fn time_fast(
         Some(colours),
     );
     report.lanes = Some(format!("{LANES} f32 per batch, in {REGISTERS}"));
+    report.share_timings = fast.share_timings();
+    if fast.threads() > 1 {
+        let fraction = |family| {
+            let (other, lines) = fast.lines_from_other_threads(family, fast.threads());
+            other as f64 / lines.max(1) as f64
+        };
+        report.lines_from_other_threads = Some(
+            families.named(&families.per_family(|f| if active[f] { fraction(f) } else { 0.0 })),
+        );
+    }
     let relative_error = fast.relative_error();
     for family in families.all() {
         if let Some(error) = relative_error.get(family)
@@ -303,6 +321,8 @@ fn report(
         peak_rss_bytes: peak_rss(),
         colours,
         lanes: None,
+        share_timings: None,
+        lines_from_other_threads: None,
         relative_error: None,
     }
 }
@@ -360,6 +380,19 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
     }
     if let Some(lanes) = &r.lanes {
         writeln!(out, "SIMD lanes             {lanes}")?;
+    }
+    if let Some(lines) = &r.lines_from_other_threads {
+        let each = of_active(
+            lines
+                .0
+                .iter()
+                .map(|(n, v)| (n, format!("{:.1} %", 100.0 * v)))
+                .collect(),
+        );
+        writeln!(out, "other thread's lines   {each}")?;
+    }
+    if let Some(timings) = &r.share_timings {
+        writeln!(out, "shared colours         {timings}")?;
     }
     if let Some(error) = &r.relative_error {
         let shown: Vec<String> = error

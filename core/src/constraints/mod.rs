@@ -52,30 +52,44 @@ pub const MAX_STORED: usize = 48;
 pub type Stored = arrayvec::ArrayVec<f64, MAX_STORED>;
 
 /// The constraints that can be projected together as a pair ([`Constraint::PAIR_GROUP`]).
+///
+/// A pair is projected by the family that comes first in the table
+/// ([`Families::partner_in`](families::Families::partner_in)): the built-in neo-Hookean pair
+/// always by its deviatoric half, a pair of files by either.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PairGroup {
     /// Never half of a pair.
     None,
-    /// The two halves of the built-in neo-Hookean energy.
-    NeoHookean,
+    /// The built-in neo-Hookean energy's deviatoric half, which leads its pair.
+    NeoHookeanDeviatoric,
+    /// The built-in neo-Hookean energy's hydrostatic half, which the deviatoric one leads.
+    NeoHookeanHydrostatic,
     /// The constraints of constraint files (a file's `pair`).
     File,
 }
 
-/// Whether constraints of types `A` and `B` can be a pair: the same group, other than
-/// [`PairGroup::None`], and the same particles (N = M).
+/// Whether constraints of types `A` and `B` can be a pair led by `A`: the neo-Hookean
+/// deviatoric half before the hydrostatic one, or two constraint files, on the same particles
+/// (N = M). The solvers' pair code is compiled for these only.
 ///
 /// ```
 /// use tetlab_core::constraints::neohookean::{Deviatoric, Hydrostatic};
 /// use tetlab_core::constraints::{pairs, volume::Volume};
 /// assert!(pairs::<4, Deviatoric, 4, Hydrostatic>());
+/// assert!(!pairs::<4, Hydrostatic, 4, Deviatoric>()); // the table puts the deviatoric half first
+/// assert!(!pairs::<4, Deviatoric, 4, Deviatoric>());
 /// assert!(!pairs::<4, Volume, 4, Hydrostatic>());
 /// assert!(!pairs::<4, Volume, 4, Volume>());
 /// ```
 pub const fn pairs<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>() -> bool {
     N == M
-        && !matches!(A::PAIR_GROUP, PairGroup::None)
-        && A::PAIR_GROUP as u8 == B::PAIR_GROUP as u8
+        && matches!(
+            (A::PAIR_GROUP, B::PAIR_GROUP),
+            (
+                PairGroup::NeoHookeanDeviatoric,
+                PairGroup::NeoHookeanHydrostatic
+            ) | (PairGroup::File, PairGroup::File)
+        )
 }
 
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or

@@ -180,7 +180,7 @@ pub struct Deviatoric;
 
 impl Constraint<4> for Deviatoric {
     const USES_REST_SHAPE: bool = true;
-    const PAIR_GROUP: PairGroup = PairGroup::NeoHookean;
+    const PAIR_GROUP: PairGroup = PairGroup::NeoHookeanDeviatoric;
 
     #[inline(always)]
     fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, shape: &[V; 4]) -> Evaluation<V, 4> {
@@ -203,7 +203,7 @@ pub struct Hydrostatic;
 impl Constraint<4> for Hydrostatic {
     const USES_REST_SHAPE: bool = true;
     const REST_USES_MATERIAL: bool = true;
-    const PAIR_GROUP: PairGroup = PairGroup::NeoHookean;
+    const PAIR_GROUP: PairGroup = PairGroup::NeoHookeanHydrostatic;
 
     #[inline(always)]
     fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, shape: &[V; 4]) -> Evaluation<V, 4> {

@@ -184,6 +184,10 @@ pub static TABLE: [Row; 5] = [
     },
 ];
 
+// The neo-Hookean pair is led by its deviatoric half ([`super::PairGroup`]): pair code is compiled
+// only in that order, so the table must keep that half first.
+const _: () = assert!(Family::NEOHOOKEAN_DEVIATORIC.0 < Family::NEOHOOKEAN_HYDROSTATIC.0);
+
 impl Family {
     /// Edge distance ([`super::distance`]).
     pub const EDGES: Family = Family(0);

@@ -204,6 +204,56 @@ impl Layout {
         }
     }
 
+    /// How far `threads` threads sharing the large colours (of [`super::PARALLEL_MIN`] elements
+    /// or more, each thread a contiguous share of the batches) keep to their own particles, over
+    /// one sweep of the colours in `order` (empty: the layout's) after another: of the cache
+    /// lines of particles (four 16-byte particles to a 64-byte line) that each share touches,
+    /// how many another thread wrote since. Small colours are projected by thread 0. Returns
+    /// (lines from another thread, lines), over the second sweep; (0, 0) for one thread.
+    ///
+    /// A line another core wrote is loaded from that core's cache, which costs tens of
+    /// nanoseconds more than one from this core's own (docs/performance.md, "Two threads").
+    pub fn lines_from_other_threads(&self, order: &[u32], threads: usize) -> (usize, usize) {
+        const NONE: u8 = u8::MAX;
+        if threads < 2 {
+            return (0, 0);
+        }
+        let threads = threads.min(super::team::MAX_THREADS);
+        let mut last_writer = vec![NONE; self.particle_count.div_ceil(4)];
+        let mut touched = Vec::new();
+        let (mut other, mut lines) = (0, 0);
+        for sweep in 0..2 {
+            for k in 0..self.colours.len() {
+                let colour = &self.colours[order.get(k).map_or(k, |&c| c as usize)];
+                let batches = colour.batches.clone();
+                let shared = colour.elements >= super::PARALLEL_MIN;
+                for thread in 0..if shared { threads } else { 1 } {
+                    let share = if shared {
+                        super::team::share(batches.len(), thread, threads)
+                    } else {
+                        0..batches.len()
+                    };
+                    touched.clear();
+                    for b in share.start + batches.start..share.end + batches.start {
+                        let rows = &self.particles[b * self.arity..(b + 1) * self.arity];
+                        touched.extend(rows.iter().flatten().map(|&i| i as usize / 4));
+                    }
+                    touched.sort_unstable();
+                    touched.dedup();
+                    for &line in &touched {
+                        let writer = last_writer[line];
+                        if sweep == 1 {
+                            lines += 1;
+                            other += usize::from(writer != NONE && usize::from(writer) != thread);
+                        }
+                        last_writer[line] = thread as u8;
+                    }
+                }
+            }
+        }
+        (other, lines)
+    }
+
     /// Writes each particle's inverse mass into every lane that holds it (padding lanes keep
     /// 0): after a pin, a grab or a release. Allocates nothing.
     pub(crate) fn set_weights(&mut self, inverse_masses: &[f32]) {

@@ -7,6 +7,7 @@
 
 use super::batches::{Batches, Layout, RestRows, Typed};
 use super::particles::Particles;
+use super::share_timers;
 use super::team::{Disjoint, SharedSkips, Team};
 use crate::constraints::{Constraint, Evaluation, GROUP};
 use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
@@ -208,22 +209,25 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
             rest.batches(range.clone()),
             &mut lambda[range],
         );
-        let skipped = match team.filter(|_| colour.elements >= PARALLEL_MIN) {
+        let large = colour.elements >= PARALLEL_MIN;
+        let mut project = || match team.filter(|_| large) {
             Some(team) => {
                 let lambda = Disjoint::new([lambda], team.threads());
                 let totals = SharedSkips::default();
                 team.run(&|worker| {
                     let ([lambda], share) = lambda.take(worker);
-                    totals.add(project_batches::<N, C>(
-                        constraint,
-                        &particles[share.clone()],
-                        &weights[share.clone()],
-                        (&size[share.clone()], reach),
-                        rest.batches(share),
-                        lambda,
-                        access,
-                        rule,
-                    ));
+                    totals.add(share_timers::share(worker, || {
+                        project_batches::<N, C>(
+                            constraint,
+                            &particles[share.clone()],
+                            &weights[share.clone()],
+                            (&size[share.clone()], reach),
+                            rest.batches(share),
+                            lambda,
+                            access,
+                            rule,
+                        )
+                    }));
                 });
                 totals.get()
             }
@@ -237,6 +241,11 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
                 access,
                 rule,
             ),
+        };
+        let skipped = if large {
+            share_timers::colour(project)
+        } else {
+            project()
         };
         skips = skips + skipped;
         count += colour.elements;
@@ -377,21 +386,24 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         let size = &size[range.clone()];
         let rest = (rest_a.batches(range.clone()), rest_b.batches(range.clone()));
         let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
-        let skipped = match team.filter(|_| colour.elements >= PARALLEL_MIN) {
+        let large = colour.elements >= PARALLEL_MIN;
+        let mut project = || match team.filter(|_| large) {
             Some(team) => {
                 let lambdas = Disjoint::new([lambda_a, lambda_b], team.threads());
                 let totals = [SharedSkips::default(), SharedSkips::default()];
                 team.run(&|worker| {
                     let ([lambda_a, lambda_b], share) = lambdas.take(worker);
-                    let skipped = project_pair_batches::<N, A, M, B>(
-                        constraints,
-                        &particles[share.clone()],
-                        (&weights[share.clone()], &size[share.clone()], reach),
-                        (rest.0.batches(share.clone()), rest.1.batches(share)),
-                        (lambda_a, lambda_b),
-                        access,
-                        rules,
-                    );
+                    let skipped = share_timers::share(worker, || {
+                        project_pair_batches::<N, A, M, B>(
+                            constraints,
+                            &particles[share.clone()],
+                            (&weights[share.clone()], &size[share.clone()], reach),
+                            (rest.0.batches(share.clone()), rest.1.batches(share)),
+                            (lambda_a, lambda_b),
+                            access,
+                            rules,
+                        )
+                    });
                     totals[0].add(skipped[0]);
                     totals[1].add(skipped[1]);
                 });
@@ -406,6 +418,11 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
                 access,
                 rules,
             ),
+        };
+        let skipped = if large {
+            share_timers::colour(project)
+        } else {
+            project()
         };
         skips = add(skips, skipped);
         count += colour.elements;

@@ -28,6 +28,7 @@ pub mod batches;
 mod kernel;
 mod morton;
 mod particles;
+mod share_timers;
 mod team;
 
 pub use batches::{Batches, Colour, Layout};
@@ -526,6 +527,14 @@ impl FastSimulation {
         }
     }
 
+    /// How far `threads` threads would keep to their own particles on `family`'s colours:
+    /// (lines from another thread, lines) over one sweep ([`Layout::lines_from_other_threads`]).
+    pub fn lines_from_other_threads(&self, family: Family, threads: usize) -> (usize, usize) {
+        self.layouts
+            .of(self.families.binding(family))
+            .lines_from_other_threads(&self.colour_orders[family], threads)
+    }
+
     /// Projects in `order` from now on (Gauss–Seidel unless set).
     pub fn set_order(&mut self, order: Order) {
         self.jacobi = match order {
@@ -759,6 +768,14 @@ impl FastSimulation {
     /// Starts the timings afresh.
     pub fn reset_timings(&mut self) {
         self.timings = Timings::default();
+        share_timers::reset();
+    }
+
+    /// With the feature `share-timers`, the mean time of a colour large enough to share and of
+    /// each thread's share of one, since [`FastSimulation::reset_timings`] (process-wide: one
+    /// simulation at a time); `None` without it.
+    pub fn share_timings(&self) -> Option<String> {
+        share_timers::report()
     }
 
     /// Advances one frame: `substeps` substeps of predict, sweeps, velocities. With several
