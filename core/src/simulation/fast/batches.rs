@@ -224,7 +224,7 @@ impl Layout {
         let (mut other, mut lines) = (0, 0);
         for sweep in 0..2 {
             for k in 0..self.colours.len() {
-                let colour = &self.colours[order.get(k).map_or(k, |&c| c as usize)];
+                let colour = &self.colours[super::kernel::in_order(order, k)];
                 let batches = colour.batches.clone();
                 let shared = colour.elements >= super::PARALLEL_MIN;
                 for thread in 0..if shared { threads } else { 1 } {

@@ -160,7 +160,7 @@ fn gather_group<'a, const N: usize>(
 
 /// The colour projected `k`-th: `order[k]`, or `k` when `order` is empty (the layout's order).
 #[inline]
-fn in_order(order: &[u32], k: usize) -> usize {
+pub(super) fn in_order(order: &[u32], k: usize) -> usize {
     order.get(k).map_or(k, |&c| c as usize)
 }
 
@@ -210,7 +210,7 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
             &mut lambda[range],
         );
         let large = colour.elements >= PARALLEL_MIN;
-        let mut project = || match team.filter(|_| large) {
+        let project = || match team.filter(|_| large) {
             Some(team) => {
                 let lambda = Disjoint::new([lambda], team.threads());
                 let totals = SharedSkips::default();
@@ -242,11 +242,7 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
                 rule,
             ),
         };
-        let skipped = if large {
-            share_timers::colour(project)
-        } else {
-            project()
-        };
+        let skipped = share_timers::colour(large, project);
         skips = skips + skipped;
         count += colour.elements;
     }
@@ -387,7 +383,7 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         let rest = (rest_a.batches(range.clone()), rest_b.batches(range.clone()));
         let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
         let large = colour.elements >= PARALLEL_MIN;
-        let mut project = || match team.filter(|_| large) {
+        let project = || match team.filter(|_| large) {
             Some(team) => {
                 let lambdas = Disjoint::new([lambda_a, lambda_b], team.threads());
                 let totals = [SharedSkips::default(), SharedSkips::default()];
@@ -419,11 +415,7 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
                 rules,
             ),
         };
-        let skipped = if large {
-            share_timers::colour(project)
-        } else {
-            project()
-        };
+        let skipped = share_timers::colour(large, project);
         skips = add(skips, skipped);
         count += colour.elements;
     }

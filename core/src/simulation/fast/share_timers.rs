@@ -31,8 +31,12 @@ mod enabled {
         result
     }
 
-    pub(crate) fn colour<R>(f: impl FnOnce() -> R) -> R {
-        timed(&COLOUR_NS, &COLOURS, f)
+    pub(crate) fn colour<R>(large: bool, f: impl FnOnce() -> R) -> R {
+        if large {
+            timed(&COLOUR_NS, &COLOURS, f)
+        } else {
+            f()
+        }
     }
 
     pub(crate) fn share<R>(worker: usize, f: impl FnOnce() -> R) -> R {
@@ -69,10 +73,10 @@ mod enabled {
 #[cfg(feature = "share-timers")]
 pub(crate) use enabled::{colour, report, reset, share};
 
-/// Runs `f`, a large colour (timed with the feature `share-timers`).
+/// Runs `f`, a colour (timed with the feature `share-timers` when `large`).
 #[cfg(not(feature = "share-timers"))]
 #[inline(always)]
-pub(crate) fn colour<R>(f: impl FnOnce() -> R) -> R {
+pub(crate) fn colour<R>(_large: bool, f: impl FnOnce() -> R) -> R {
     f()
 }
 
