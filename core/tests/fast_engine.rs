@@ -78,13 +78,29 @@ fn edges_alone_leave_a_mirrored_cube_inverted_on_the_fast_path_too() {
     );
 }
 
-/// Large colours are shared by the threads of a team, each taking a contiguous share: two and
-/// three threads (shares of unequal sizes) give the bits of one, in either order.
+/// The threads share out a level's groups of regions and the last level's large colours, each
+/// taking a contiguous part: two and three threads (parts of unequal sizes) give the bits of one,
+/// in either order.
 #[cfg(feature = "parallel")]
 #[test]
 fn two_and_three_threads_give_the_same_bits_as_one() {
-    let mut reference = cube(16, PerFamily::builtin_list("edges,volume").unwrap());
-    reference.perturb(Perturbation::Scramble(4));
+    // Cubes of 4,913 and 17,576 particles: 2 and 8 regions, so one level of groups and three
+    // before the last (three threads share two groups, and eight unevenly).
+    for (resolution, regions) in [(16, 2), (25, 8)] {
+        let mut reference = cube(resolution, PerFamily::builtin_list("edges,volume").unwrap());
+        reference.set_settings(Settings {
+            substeps: 10,
+            ..*reference.settings()
+        });
+        reference.perturb(Perturbation::Scramble(4));
+        let fast = FastSimulation::new(reference.fast_start(), 1);
+        assert_eq!(fast.batches(Family::VOLUME).regions(), regions);
+        the_same_bits_on_any_number_of_threads(&reference);
+    }
+}
+
+#[cfg(feature = "parallel")]
+fn the_same_bits_on_any_number_of_threads(reference: &Simulation) {
     for order in [Order::GaussSeidel, Order::Jacobi { relaxation: 1.5 }] {
         let mut one = FastSimulation::new(reference.fast_start(), 1);
         one.set_order(order);
@@ -95,12 +111,10 @@ fn two_and_three_threads_give_the_same_bits_as_one() {
             let mut many = FastSimulation::new(reference.fast_start(), threads);
             many.set_order(order);
             assert_eq!(many.threads(), threads);
+            let volume = many.batches(Family::VOLUME);
             assert!(
-                many.batches(Family::VOLUME)
-                    .colours()
-                    .iter()
-                    .any(|c| c.elements >= PARALLEL_MIN),
-                "some colour is large enough to be shared"
+                volume.regions() > 1 || volume.colours().iter().any(|c| c.elements >= PARALLEL_MIN),
+                "the threads share groups, or some colour is large enough to be shared"
             );
             for _ in 0..5 {
                 many.step();
@@ -115,12 +129,13 @@ fn two_and_three_threads_give_the_same_bits_as_one() {
 }
 
 #[test]
-fn the_threads_shares_of_a_colour_keep_mostly_to_their_own_particles() {
-    // Each thread takes a contiguous share of a colour's batches, and a colour's elements are
-    // sorted by their lowest particle in Morton order: a share is a region of the body, the same
-    // one colour after colour, and only the lines of particles at its border were written by
-    // another thread since this one last touched them. (Shares dealt batch by batch in turn
-    // would find about half their lines written by another thread.)
+fn the_threads_keep_mostly_to_their_own_particles() {
+    // Each thread projects its own regions through all their colours, then a large colour of the
+    // last level is shared in contiguous parts (a colour's elements are sorted by their lowest
+    // particle in Morton order, so a part is a region of the body): only the lines of particles
+    // at the cut between the regions were written by another thread since this one last touched
+    // them. (Shares dealt batch by batch in turn would find about half their lines written by
+    // another thread.)
     let simulation = cube(15, PerFamily::builtin_list("edges,volume").unwrap());
     let fast = FastSimulation::new(simulation.fast_start(), 1);
     for family in [Family::EDGES, Family::VOLUME] {

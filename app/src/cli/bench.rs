@@ -92,10 +92,15 @@ struct Report {
     /// mean time (a diagnostic of the threads; docs/performance.md).
     #[serde(skip_serializing_if = "Option::is_none")]
     share_timings: Option<String>,
-    /// With two threads or more, per family: of the particles' cache lines each thread's share
-    /// of a large colour touches, the fraction another thread wrote since (fast engine).
+    /// How many regions the fast solver cuts the body into (docs/performance.md, "Two threads").
     #[serde(skip_serializing_if = "Option::is_none")]
-    lines_from_other_threads: Option<Named<f64>>,
+    regions: Option<usize>,
+    /// With two threads or more, per family, over one sweep: of the particles' cache lines the
+    /// threads touch (each line counted once per thread and step: a level of groups, or a
+    /// thread's part of a shared colour), how many another thread wrote since (fast engine):
+    /// [from another thread, lines].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lines_from_other_threads: Option<Named<[usize; 2]>>,
     /// After the run, per active family: √(mean (C / rest value)²).
     #[serde(serialize_with = "active_only")]
     relative_error: Option<Named<Option<f64>>>,
@@ -219,7 +224,7 @@ fn time_fast(
         }
     };
     let by_family = families.named(&families.per_family(|f| if active[f] { per(f) } else { 0.0 }));
-    let colours = families.named(&families.per_family(|f| fast.batches(f).colours().len()));
+    let colours = families.named(&families.per_family(|f| fast.batches(f).colour_count()));
     let solver = if args.jacobi {
         "fast (f32), Jacobi"
     } else {
@@ -240,13 +245,17 @@ fn time_fast(
     );
     report.lanes = Some(format!("{LANES} f32 per batch, in {REGISTERS}"));
     report.share_timings = fast.share_timings();
+    report.regions = families
+        .all()
+        .find(|&f| active[f])
+        .map(|f| fast.batches(f).regions());
     if fast.threads() > 1 {
-        let fraction = |family| {
+        let lines = |family| {
             let (other, lines) = fast.lines_from_other_threads(family, fast.threads());
-            other as f64 / lines.max(1) as f64
+            [other, lines]
         };
         report.lines_from_other_threads = Some(
-            families.named(&families.per_family(|f| if active[f] { fraction(f) } else { 0.0 })),
+            families.named(&families.per_family(|f| if active[f] { lines(f) } else { [0, 0] })),
         );
     }
     let relative_error = fast.relative_error();
@@ -322,6 +331,7 @@ fn report(
         colours,
         lanes: None,
         share_timings: None,
+        regions: None,
         lines_from_other_threads: None,
         relative_error: None,
     }
@@ -381,15 +391,18 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
     if let Some(lanes) = &r.lanes {
         writeln!(out, "SIMD lanes             {lanes}")?;
     }
+    if let Some(regions) = r.regions {
+        writeln!(out, "regions                {regions}")?;
+    }
     if let Some(lines) = &r.lines_from_other_threads {
         let each = of_active(
             lines
                 .0
                 .iter()
-                .map(|(n, v)| (n, format!("{:.1} %", 100.0 * v)))
+                .map(|(n, [other, all])| (n, format!("{other} of {all}")))
                 .collect(),
         );
-        writeln!(out, "other thread's lines   {each}")?;
+        writeln!(out, "other thread's lines   {each} a sweep")?;
     }
     if let Some(timings) = &r.share_timings {
         writeln!(out, "shared colours         {timings}")?;

@@ -10,6 +10,30 @@
 //! neo-Hookean pair, a constraint file's tet family all share the tets'), and keeps only its own
 //! rest values and multipliers ([`Batches`]).
 //!
+//! # Regions
+//!
+//! A large body's particles are cut into [`Layout::regions`] regions R (a power of two),
+//! contiguous runs of the Morton order, so parts of space. Regions pair up into groups level by
+//! level: at level l a group is 2^l regions in a row, and the last level's one group is the whole
+//! body. An element belongs to the smallest group that holds all its particles: most to their own
+//! region (level 0), those across a cut to the level of that cut. A family is projected level
+//! by level, each group through all its colours:
+//!
+//! ```text
+//! level 0:  (region 0, every colour) (region 1, every colour) …   ← groups at once, one thread each
+//! level 1:  (regions 0–1, every colour) (regions 2–3, …) …
+//! …
+//! last:     (the whole body, colour 0) (…, colour 1) …           ← a large colour shared by the threads
+//! ```
+//!
+//! The groups of a level share no particle, so threads project them at once with no barrier
+//! between colours, and a thread that projected regions 0–3 at level 0 projects their groups at
+//! the levels after: no cache line of particles passes between cores but at the levels where
+//! groups are fewer than threads (docs/performance.md, "Two threads"). The order depends on the
+//! body alone, never on the number of threads: the bits are the same for any. A body of fewer
+//! than 2 × [`PARTICLES_PER_REGION`] particles has one region and one level: colour after colour,
+//! as a Gauss–Seidel sweep by colours is.
+//!
 //! The four heights of a tet are four elements, coloured apart (they share their particles), not
 //! one element projected four times in a row: projected back to back, they snap each inverted tet
 //! to its own rest shape before its neighbours move, and a mirrored cube recovered in a third of
@@ -20,6 +44,59 @@
 use crate::numbers::lanes::{F32x8, LANES};
 use crate::numbers::vector::Real;
 use std::ops::Range;
+
+/// The fewest particles a region has: a body is cut into as many regions as this allows, a power
+/// of two up to [`MAX_REGIONS`].
+pub const PARTICLES_PER_REGION: usize = 2048;
+
+/// The most regions a body is cut into.
+pub const MAX_REGIONS: usize = 8;
+
+/// Particles a region boundary is a multiple of: four 16-byte particles fill a 64-byte cache line,
+/// so that no line holds particles of two regions. (16 for lines of 128 bytes, or 256 elsewhere.)
+const REGION_ALIGN: usize = 16;
+
+/// How many regions a body of `particles` particles is cut into (see the module).
+///
+/// ```
+/// use tetlab_core::simulation::fast::batches::regions_for;
+/// assert_eq!(regions_for(333), 1); // the bunny: one region, colour after colour
+/// assert_eq!(regions_for(4096), 2);
+/// assert_eq!(regions_for(1_000_000), 8);
+/// ```
+pub fn regions_for(particles: usize) -> usize {
+    let most = (particles / PARTICLES_PER_REGION).clamp(1, MAX_REGIONS);
+    1 << most.ilog2()
+}
+
+/// The region of particle `i` of `particles`, among `regions` (see the module): runs of the
+/// particle numbers as even as [`REGION_ALIGN`] allows.
+#[inline]
+fn region_of(i: usize, particles: usize, regions: usize) -> usize {
+    let blocks = particles.div_ceil(REGION_ALIGN).max(1);
+    (i / REGION_ALIGN) * regions / blocks
+}
+
+/// The level and group (see the module) of an element whose particles lie in regions `lo` to
+/// `hi`: the level is the highest bit in which the two differ, plus one (0 when they are the
+/// same region), and the group the regions' number above it.
+///
+/// ```
+/// use tetlab_core::simulation::fast::batches::level_and_group;
+/// assert_eq!(level_and_group(5, 5), (0, 5)); // inside region 5
+/// assert_eq!(level_and_group(4, 5), (1, 2)); // across the cut of regions 4–5
+/// assert_eq!(level_and_group(1, 2), (2, 0)); // regions 0–3 hold it
+/// ```
+pub fn level_and_group(lo: usize, hi: usize) -> (usize, usize) {
+    let level = (usize::BITS - (lo ^ hi).leading_zeros()) as usize;
+    (level, lo >> level)
+}
+
+/// Where group `group` of level `level` is among the groups of a body of `regions` regions:
+/// the R regions first, then level 1's R / 2 groups, and so on.
+pub fn group_index(regions: usize, level: usize, group: usize) -> usize {
+    2 * regions - 2 * (regions >> level) + group
+}
 
 /// One colour of a layout: the batches `batches`, holding `elements` elements. The lanes after
 /// them in the last batch are padding: copies of an element of the batch with zero weights,
@@ -43,8 +120,14 @@ pub struct Layout {
     /// Per batch, the size of each lane's element (its longest rest edge), what the reach of
     /// its projections is measured in ([`crate::simulation::Settings::reach`]).
     size: Vec<F32x8>,
-    /// Elements of one colour share no particle; colours are projected in order.
+    /// Elements of one entry share no particle. Entry s·C + c (C = [`Layout::colour_count`]) is
+    /// colour c of group s: the R regions (level 0), the R / 2 groups of level 1, …, the one group
+    /// of the last level ([`Layout::group`]). An entry may be empty.
     pub colours: Vec<Colour>,
+    /// How many regions: R, a power of two (see the module).
+    regions: usize,
+    /// How many colours each segment has: C.
+    colour_count: usize,
     /// Every particle index above is below this.
     particle_count: usize,
 }
@@ -150,14 +233,32 @@ impl Layout {
             remaining = waiting;
             base += 64;
         }
+        let particle_count = inverse_masses.len();
+        let regions = regions_for(particle_count);
+        let segment_of = |e: usize| {
+            let region = |&i: &u32| region_of(i as usize, particle_count, regions);
+            let lo = elements[e].iter().map(region).min().unwrap_or(0);
+            let hi = elements[e].iter().map(region).max().unwrap_or(0);
+            let (level, group) = level_and_group(lo, hi);
+            group_index(regions, level, group)
+        };
+        let segments = 2 * regions - 1;
+        let colour_count = colour_of.iter().map(|&c| c + 1).max().unwrap_or(0);
+        let key = |e: usize| (segment_of(e), colour_of[e]);
         let mut order: Vec<usize> = (0..elements.len()).collect();
-        order.sort_by_key(|&e| (colour_of[e], elements[e].iter().min().copied()));
+        order.sort_by_key(|&e| (key(e), elements[e].iter().min().copied()));
         let mut layout = Layout {
             arity: N,
-            particle_count: inverse_masses.len(),
+            particle_count,
+            regions,
+            colour_count,
             ..Layout::default()
         };
-        for colour in order.chunk_by(|&a, &b| colour_of[a] == colour_of[b]) {
+        let mut rest = &order[..];
+        for entry in (0..segments).flat_map(|s| (0..colour_count).map(move |c| (s, c))) {
+            let len = rest.iter().take_while(|&&e| key(e) == entry).count();
+            let colour;
+            (colour, rest) = rest.split_at(len);
             let start = layout.elements.len();
             for lanes in colour.chunks(LANES) {
                 let element = |k: usize| lanes[k.min(lanes.len() - 1)];
@@ -186,7 +287,53 @@ impl Layout {
                 elements: colour.len(),
             });
         }
+        debug_assert!(rest.is_empty(), "every element has its entry");
         layout
+    }
+
+    /// How many regions the particles are cut into: R (see the module).
+    pub fn regions(&self) -> usize {
+        // An empty layout (`Layout::default`) is one region.
+        self.regions.max(1)
+    }
+
+    /// How many levels of groups: log₂ R + 1 (see the module).
+    pub fn levels(&self) -> usize {
+        self.regions().ilog2() as usize + 1
+    }
+
+    /// How many groups level `level` has: R / 2^level.
+    pub fn groups(&self, level: usize) -> usize {
+        self.regions() >> level
+    }
+
+    /// How many colours: C, the same in every group (some entries may be empty).
+    pub fn colour_count(&self) -> usize {
+        self.colour_count
+    }
+
+    /// The entry of group `group` projected `k`-th ([`group_index`]), the colours in `order`
+    /// (empty: the layout's).
+    #[inline]
+    pub(crate) fn entry(&self, group: usize, k: usize, order: &[u32]) -> &Colour {
+        &self.colours[group * self.colour_count + super::kernel::in_order(order, k)]
+    }
+
+    /// The batches of groups `groups` of level `level`, which lie together: a group's entries
+    /// are stored one after the other, before the next group's, and a level's groups before the
+    /// next level's.
+    pub(crate) fn group_batches(&self, level: usize, groups: Range<usize>) -> Range<usize> {
+        let c = self.colour_count;
+        let first = group_index(self.regions(), level, groups.start);
+        let start = self
+            .colours
+            .get(first * c)
+            .map_or(self.elements.len(), |e| e.batches.start);
+        if groups.is_empty() || c == 0 {
+            return start..start;
+        }
+        let last = group_index(self.regions(), level, groups.end - 1);
+        start..self.colours[last * c + c - 1].batches.end
     }
 
     /// The layout with its arity `N` known.
@@ -204,16 +351,19 @@ impl Layout {
         }
     }
 
-    /// How far `threads` threads sharing the large colours (of [`super::PARALLEL_MIN`] elements
-    /// or more, each thread a contiguous share of the batches) keep to their own particles, over
-    /// one sweep of the colours in `order` (empty: the layout's) after another: of the cache
-    /// lines of particles (four 16-byte particles to a 64-byte line) that each share touches,
-    /// how many another thread wrote since. Small colours are projected by thread 0. Returns
-    /// (lines from another thread, lines), over the second sweep; (0, 0) for one thread.
+    /// How far `threads` threads keep to their own particles over one sweep (as
+    /// `schedule::sweep` shares it out: level by level, a contiguous run of the level's groups
+    /// per thread, then the last level's colours in `order` (empty: the layout's), a large one (of
+    /// [`super::PARALLEL_MIN`] elements or more) shared in contiguous parts of its batches and a
+    /// small one projected by thread 0), after another: of the cache lines of particles (four
+    /// 16-byte particles to a 64-byte line) that each thread touches in each step, how many
+    /// another thread wrote since. Returns (lines from another thread, lines), over the second
+    /// sweep; (0, 0) for one thread.
     ///
     /// A line another core wrote is loaded from that core's cache, which costs tens of
     /// nanoseconds more than one from this core's own (docs/performance.md, "Two threads").
     pub fn lines_from_other_threads(&self, order: &[u32], threads: usize) -> (usize, usize) {
+        use super::team::share;
         const NONE: u8 = u8::MAX;
         if threads < 2 {
             return (0, 0);
@@ -222,32 +372,47 @@ impl Layout {
         let mut last_writer = vec![NONE; self.particle_count.div_ceil(4)];
         let mut touched = Vec::new();
         let (mut other, mut lines) = (0, 0);
+        // Thread `thread` projects `batches` (in the second sweep, `count` says so).
+        let mut step = |thread: usize, batches: Range<usize>, count: bool| {
+            touched.clear();
+            for b in batches {
+                let rows = &self.particles[b * self.arity..(b + 1) * self.arity];
+                touched.extend(rows.iter().flatten().map(|&i| i as usize / 4));
+            }
+            touched.sort_unstable();
+            touched.dedup();
+            for &line in &touched {
+                let writer = last_writer[line];
+                if count {
+                    lines += 1;
+                    other += usize::from(writer != NONE && usize::from(writer) != thread);
+                }
+                last_writer[line] = thread as u8;
+            }
+        };
         for sweep in 0..2 {
-            for k in 0..self.colours.len() {
-                let colour = &self.colours[super::kernel::in_order(order, k)];
+            let count = sweep == 1;
+            let last = self.levels() - 1;
+            for level in 0..last {
+                for thread in 0..threads {
+                    let groups = share(self.groups(level), thread, threads);
+                    step(thread, self.group_batches(level, groups), count);
+                }
+            }
+            for k in 0..self.colour_count {
+                let colour = self.entry(group_index(self.regions(), last, 0), k, order);
                 let batches = colour.batches.clone();
-                let shared = colour.elements >= super::PARALLEL_MIN;
-                for thread in 0..if shared { threads } else { 1 } {
-                    let share = if shared {
-                        super::team::share(batches.len(), thread, threads)
-                    } else {
-                        0..batches.len()
-                    };
-                    touched.clear();
-                    for b in share.start + batches.start..share.end + batches.start {
-                        let rows = &self.particles[b * self.arity..(b + 1) * self.arity];
-                        touched.extend(rows.iter().flatten().map(|&i| i as usize / 4));
+                if colour.elements >= super::PARALLEL_MIN {
+                    for thread in 0..threads {
+                        let part = share(batches.len(), thread, threads);
+                        step(
+                            thread,
+                            batches.start + part.start..batches.start + part.end,
+                            count,
+                        );
                     }
-                    touched.sort_unstable();
-                    touched.dedup();
-                    for &line in &touched {
-                        let writer = last_writer[line];
-                        if sweep == 1 {
-                            lines += 1;
-                            other += usize::from(writer != NONE && usize::from(writer) != thread);
-                        }
-                        last_writer[line] = thread as u8;
-                    }
+                } else {
+                    step(0, batches, count);
                 }
             }
         }
@@ -302,7 +467,9 @@ impl Layout {
         })
     }
 
-    /// Whether every colour really shares no particle (padding, which moves nothing, aside).
+    /// Whether every colour really shares no particle (padding, which moves nothing, aside), and
+    /// every group's elements have their particles in the group's regions only (see the module),
+    /// which is what lets threads project a level's groups at once.
     pub fn colouring_is_valid(&self, particle_count: usize) -> bool {
         let mut seen = vec![usize::MAX; particle_count];
         let mut colour_at = vec![0; self.elements.len()];
@@ -311,12 +478,22 @@ impl Layout {
                 colour_at[b] = k;
             }
         }
+        // The regions each group holds, by group index.
+        let mut regions = vec![0..0; 2 * self.regions() - 1];
+        for level in 0..self.levels() {
+            for group in 0..self.groups(level) {
+                regions[group_index(self.regions(), level, group)] =
+                    group << level..(group + 1) << level;
+            }
+        }
+        let c = self.colour_count.max(1);
         self.elements().all(|(_, particles, (b, _))| {
             let k = colour_at[b];
             particles[..self.arity].iter().all(|&i| {
                 let fresh = seen[i as usize] != k;
                 seen[i as usize] = k;
-                fresh
+                let region = region_of(i as usize, self.particle_count, self.regions());
+                fresh && regions[k / c].contains(&region)
             })
         })
     }

@@ -7,8 +7,8 @@
 
 use super::batches::{Batches, Layout, RestRows, Typed};
 use super::particles::Particles;
-use super::share_timers;
-use super::team::{Disjoint, SharedSkips, Team};
+use super::schedule::sweep;
+use super::team::Team;
 use crate::constraints::{Constraint, Evaluation, GROUP};
 use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
 use crate::numbers::vector::{Real, Vector3};
@@ -197,56 +197,19 @@ pub(crate) fn project_family<const N: usize, C: Constraint<N>>(
         rest_shape: Particles::new(rest_positions, particle_count),
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
-    let mut count = 0;
-    let mut skips = SkipCounts::default();
-    for k in 0..colours.len() {
-        let colour = &colours[in_order(order, k)];
-        let range = colour.batches.clone();
-        let (particles, weights, size, rest, lambda) = (
+    let [skips] = sweep(layout, order, team, [lambda], |range, [lambda]| {
+        [project_batches::<N, C>(
+            constraint,
             &particles[range.clone()],
             &weights[range.clone()],
-            &size[range.clone()],
-            rest.batches(range.clone()),
-            &mut lambda[range],
-        );
-        let large = colour.elements >= PARALLEL_MIN;
-        let project = || match team.filter(|_| large) {
-            Some(team) => {
-                let lambda = Disjoint::new([lambda], team.threads());
-                let totals = SharedSkips::default();
-                team.run(&|worker| {
-                    let ([lambda], share) = lambda.take(worker);
-                    totals.add(share_timers::share(worker, || {
-                        project_batches::<N, C>(
-                            constraint,
-                            &particles[share.clone()],
-                            &weights[share.clone()],
-                            (&size[share.clone()], reach),
-                            rest.batches(share),
-                            lambda,
-                            access,
-                            rule,
-                        )
-                    }));
-                });
-                totals.get()
-            }
-            None => project_batches::<N, C>(
-                constraint,
-                particles,
-                weights,
-                (size, reach),
-                rest,
-                lambda,
-                access,
-                rule,
-            ),
-        };
-        let skipped = share_timers::colour(large, project);
-        skips = skips + skipped;
-        count += colour.elements;
-    }
-    (count, skips)
+            (&size[range.clone()], reach),
+            rest.batches(range),
+            lambda,
+            access,
+            rule,
+        )]
+    });
+    (colours.iter().map(|c| c.elements).sum(), skips)
 }
 
 /// [`project_batches`] for two families projected together ([`pair_correction_lanes`]): one
@@ -372,52 +335,22 @@ pub(crate) fn project_pair<const N: usize, A: Constraint<N>, const M: usize, B: 
         rest_shape: Particles::new(rest_positions, particle_count),
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
-    let mut count = 0;
-    let mut skips = [SkipCounts::default(); 2];
-    let add = |a: [SkipCounts; 2], b: [SkipCounts; 2]| [a[0] + b[0], a[1] + b[1]];
-    for k in 0..colours.len() {
-        let colour = &colours[in_order(order, k)];
-        let range = colour.batches.clone();
-        let (particles, weights) = (&particles[range.clone()], &weights[range.clone()]);
-        let size = &size[range.clone()];
-        let rest = (rest_a.batches(range.clone()), rest_b.batches(range.clone()));
-        let (lambda_a, lambda_b) = (&mut lambda_a[range.clone()], &mut lambda_b[range]);
-        let large = colour.elements >= PARALLEL_MIN;
-        let project = || match team.filter(|_| large) {
-            Some(team) => {
-                let lambdas = Disjoint::new([lambda_a, lambda_b], team.threads());
-                let totals = [SharedSkips::default(), SharedSkips::default()];
-                team.run(&|worker| {
-                    let ([lambda_a, lambda_b], share) = lambdas.take(worker);
-                    let skipped = share_timers::share(worker, || {
-                        project_pair_batches::<N, A, M, B>(
-                            constraints,
-                            &particles[share.clone()],
-                            (&weights[share.clone()], &size[share.clone()], reach),
-                            (rest.0.batches(share.clone()), rest.1.batches(share)),
-                            (lambda_a, lambda_b),
-                            access,
-                            rules,
-                        )
-                    });
-                    totals[0].add(skipped[0]);
-                    totals[1].add(skipped[1]);
-                });
-                [totals[0].get(), totals[1].get()]
-            }
-            None => project_pair_batches::<N, A, M, B>(
+    let skips = sweep(
+        layout,
+        order,
+        team,
+        [lambda_a, lambda_b],
+        |range, [lambda_a, lambda_b]| {
+            project_pair_batches::<N, A, M, B>(
                 constraints,
-                particles,
-                (weights, size, reach),
-                rest,
+                &particles[range.clone()],
+                (&weights[range.clone()], &size[range.clone()], reach),
+                (rest_a.batches(range.clone()), rest_b.batches(range)),
                 (lambda_a, lambda_b),
                 access,
                 rules,
-            ),
-        };
-        let skipped = share_timers::colour(large, project);
-        skips = add(skips, skipped);
-        count += colour.elements;
-    }
-    (count, skips)
+            )
+        },
+    );
+    (colours.iter().map(|c| c.elements).sum(), skips)
 }

@@ -14,7 +14,9 @@
 //! - each family's constraints are coloured so that no two of one colour share a particle, and
 //!   projected colour by colour (Gauss–Seidel across colours) ([`batches`]). Within a colour the
 //!   order does not matter, so several threads can share a colour and the result is the same bits
-//!   whatever the thread count;
+//!   whatever the thread count. A large body is first cut into regions of space, each projected
+//!   through all its colours before the elements across the cuts ([`batches`], "Regions";
+//!   `schedule`), so that threads take whole regions and meet at the cuts only;
 //! - within a colour, [`crate::numbers::lanes::LANES`] constraints are projected at once ([`kernel`]): the formulas run
 //!   on [`crate::numbers::lanes::Vec3x8`], eight x, eight y and eight z in SIMD registers; a batch's
 //!   particles are loaded as padded 3-vectors and transposed, its inverse masses, rest values and
@@ -22,12 +24,14 @@
 //!   ([`particles`], one of the two `unsafe` modules, with [`team`]);
 //! - f32 instead of f64;
 //! - optionally the [`Order::Jacobi`] order, for comparison;
-//! - large colours shared by a [`Team`] of threads kept for the simulation's life.
+//! - regions, large colours and the per-particle passes of a large body shared by a [`Team`] of
+//!   threads kept for the simulation's life.
 
 pub mod batches;
 mod kernel;
 mod morton;
 mod particles;
+mod schedule;
 mod share_timers;
 mod team;
 
@@ -186,13 +190,29 @@ pub struct FamilyBatches<'a> {
 }
 
 impl<'a> FamilyBatches<'a> {
-    /// The colours of the family's layout (none for a family that is not active).
+    /// The entries of the family's layout: its colours, segment by segment (the regions, then
+    /// the border: [`Layout::colours`]; none for a family that is not active).
     pub fn colours(&self) -> &'a [Colour] {
         if self.batches.is_empty() {
             &[]
         } else {
             &self.layout.colours
         }
+    }
+
+    /// How many colours each segment of the layout has (none for a family that is not active):
+    /// what [`FastSimulation::colour_order`] permutes ([`Layout::colour_count`]).
+    pub fn colour_count(&self) -> usize {
+        if self.batches.is_empty() {
+            0
+        } else {
+            self.layout.colour_count()
+        }
+    }
+
+    /// The layout's regions ([`Layout::regions`]).
+    pub fn regions(&self) -> usize {
+        self.layout.regions()
     }
 
     /// The number of constraints, padding not counted.
@@ -504,10 +524,10 @@ impl FastSimulation {
         self.settings = settings;
     }
 
-    /// The order `family`'s colours are projected in, as indices into
-    /// [`FamilyBatches::colours`].
+    /// The order `family`'s colours are projected in, in each segment of its layout: colour
+    /// numbers, below [`FamilyBatches::colour_count`].
     pub fn colour_order(&self, family: Family) -> Vec<usize> {
-        let colours = self.batches(family).colours().len();
+        let colours = self.batches(family).colour_count();
         let order = &self.colour_orders[family];
         (0..colours)
             .map(|k| order.get(k).map_or(k, |&c| c as usize))
@@ -820,23 +840,32 @@ impl FastSimulation {
         if keep {
             self.corrections.frame.fill(Vec3A::ZERO);
         }
+        let motion = integrate::Substep {
+            gravity: settings.gravity,
+            h,
+            ground,
+            plane_strain: self.plane_strain,
+        };
         for substep in 0..substeps {
-            integrate::predict(
-                &mut self.positions,
-                &mut self.previous,
-                &mut self.velocities,
-                &self.inverse_masses,
-                &self.forces,
-                integrate::Substep {
-                    gravity: settings.gravity,
-                    h,
-                    ground,
-                    plane_strain: self.plane_strain,
+            let (arrays, inverse_masses, forces) = self.particle_arrays();
+            schedule::by_particles(
+                team,
+                arrays,
+                |range, [positions, previous, velocities, now, before]| {
+                    let forces = forces.get(range.clone()).unwrap_or_default();
+                    integrate::predict(
+                        positions,
+                        previous,
+                        velocities,
+                        &inverse_masses[range],
+                        forces,
+                        motion,
+                        Some(integrate::Residuals {
+                            now,
+                            previous: before,
+                        }),
+                    );
                 },
-                Some(integrate::Residuals {
-                    now: &mut self.residuals,
-                    previous: &mut self.previous_residuals,
-                }),
             );
             if let Some((i, target, compliance)) = grab
                 && compliance <= 0.0
@@ -868,19 +897,43 @@ impl FastSimulation {
                     *sum += *last;
                 }
             }
-            integrate::update_velocities(
-                &self.positions,
-                &self.previous,
-                &mut self.velocities,
-                h,
-                settings.damping,
-                inputs.settling,
-                Some(&integrate::Residuals {
-                    now: &mut self.residuals,
-                    previous: &mut self.previous_residuals,
-                }),
+            schedule::by_particles(
+                team,
+                self.particle_arrays().0,
+                |_, [positions, previous, velocities, now, before]| {
+                    integrate::update_velocities(
+                        positions,
+                        previous,
+                        velocities,
+                        h,
+                        settings.damping,
+                        inputs.settling,
+                        Some(&integrate::Residuals {
+                            now,
+                            previous: before,
+                        }),
+                    );
+                },
             );
         }
+    }
+
+    /// What the per-particle passes write (positions, their values at the start of the substep,
+    /// velocities, residuals and theirs at the start of the substep) and read (inverse masses,
+    /// forces).
+    #[allow(clippy::type_complexity)]
+    fn particle_arrays(&mut self) -> ([&mut [Vec3A]; 5], &[f32], &[Vec3A]) {
+        (
+            [
+                &mut self.positions,
+                &mut self.previous,
+                &mut self.velocities,
+                &mut self.residuals,
+                &mut self.previous_residuals,
+            ],
+            &self.inverse_masses,
+            &self.forces,
+        )
     }
 
     /// In Jacobi order, moves each particle by its share of the corrections `family`'s
@@ -1044,11 +1097,17 @@ impl FastSimulation {
                 self.positions[i] += c.delta_x[0];
             }
         }
-        if let Some(ground) = self.ground() {
-            integrate::project_ground(&mut self.positions, &self.inverse_masses, ground);
-        }
-        if self.plane_strain {
-            integrate::hold_plane(&mut self.positions, &self.previous);
+        let (ground, plane_strain) = (self.ground(), self.plane_strain);
+        if ground.is_some() || plane_strain {
+            let (inverse_masses, previous) = (&self.inverse_masses[..], &self.previous[..]);
+            schedule::by_particles(team, [&mut self.positions], |range, [positions]| {
+                if let Some(ground) = ground {
+                    integrate::project_ground(positions, &inverse_masses[range.clone()], ground);
+                }
+                if plane_strain {
+                    integrate::hold_plane(positions, &previous[range]);
+                }
+            });
         }
     }
 }
@@ -1064,7 +1123,7 @@ fn colour_orders(
         if !settings.active[family] {
             return Vec::new();
         }
-        let colours = layouts.of(families.binding(family)).colours.len();
+        let colours = layouts.of(families.binding(family)).colour_count();
         settings
             .projection_order(family, colours)
             .unwrap_or_default()

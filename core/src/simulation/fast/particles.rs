@@ -6,7 +6,7 @@
 //! fields are private), and a [`Particles`] is only made for a family whose `particle_count` is
 //! the positions' length (checked in [`Particles::new`]). Threads sharing a colour never write
 //! the same particle, nor read one another's writes: the constraints of a colour share none
-//! ([`super::batches::Batches::colouring_is_valid`]), and a padding lane repeats a particle of
+//! ([`super::batches::Layout::colouring_is_valid`]), and a padding lane repeats a particle of
 //! its own batch, which one thread projects. (With the Jacobi order, the threads only read the
 //! positions and write the sums.)
 #![allow(unsafe_code)]

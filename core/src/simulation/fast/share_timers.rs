@@ -9,8 +9,9 @@
 //!
 //! A colour counts when it is large enough to be shared ([`super::PARALLEL_MIN`] elements or
 //! more), whether a team shares it or one thread projects it all, so that one thread's figures
-//! and two threads' compare colour for colour. The sums are process-wide: one simulation at a
-//! time.
+//! and two threads' compare colour for colour. On a body cut into regions only the last level is
+//! projected colour by colour, so only its colours are timed ([`super::batches`], "Regions").
+//! The sums are process-wide: one simulation at a time.
 
 #[cfg(feature = "share-timers")]
 mod enabled {

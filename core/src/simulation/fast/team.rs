@@ -224,10 +224,12 @@ pub(crate) fn share(len: usize, worker: usize, workers: usize) -> std::ops::Rang
 }
 
 /// `K` slices of one length that the workers of one job write in disjoint parts: worker w's
-/// [`share`] of each, handed out once ([`Disjoint::take`]).
+/// [`share`] of each, or the parts given by [`Disjoint::cut`], handed out once
+/// ([`Disjoint::take`]).
 pub(crate) struct Disjoint<'a, T, const K: usize> {
     starts: [*mut T; K],
-    len: usize,
+    /// Worker w's part is cuts[w]..cuts[w + 1].
+    cuts: [usize; MAX_THREADS + 1],
     workers: usize,
     /// Bit w: worker w's part was handed out.
     taken: std::sync::atomic::AtomicU64,
@@ -242,18 +244,38 @@ impl<'a, T, const K: usize> Disjoint<'a, T, K> {
     /// `slices` (all of one length), to be written in `workers` parts (at most [`MAX_THREADS`]).
     pub(crate) fn new(slices: [&'a mut [T]; K], workers: usize) -> Self {
         let len = slices.first().map_or(0, |s| s.len());
+        Self::cut(slices, workers, |w| share(len, w, workers).start)
+    }
+
+    /// `slices` (all of one length), worker w's part starting at `cut(w)`: `cut(0)` must be 0,
+    /// `cut(workers)` their length, and the cuts in order.
+    pub(crate) fn cut(
+        slices: [&'a mut [T]; K],
+        workers: usize,
+        cut: impl Fn(usize) -> usize,
+    ) -> Self {
+        let len = slices.first().map_or(0, |s| s.len());
         assert!(slices.iter().all(|s| s.len() == len));
         assert!((1..=MAX_THREADS).contains(&workers));
+        let mut cuts = [0; MAX_THREADS + 1];
+        for (w, at) in cuts.iter_mut().enumerate().take(workers + 1) {
+            *at = cut(w);
+        }
+        assert!(
+            cuts[0] == 0 && cuts[workers] == len,
+            "the parts cover the slices"
+        );
+        assert!(cuts[..=workers].is_sorted(), "the parts are in order");
         Disjoint {
             starts: slices.map(|s| s.as_mut_ptr()),
-            len,
+            cuts,
             workers,
             taken: std::sync::atomic::AtomicU64::new(0),
             _slices: std::marker::PhantomData,
         }
     }
 
-    /// Worker `worker`'s part of each slice ([`share`]) and where it lies. Panics when that part
+    /// Worker `worker`'s part of each slice and where it lies. Panics when that part
     /// was handed out before.
     #[allow(clippy::mut_from_ref)] // each part once: the bit of `taken`
     pub(crate) fn take(&self, worker: usize) -> ([&mut [T]; K], std::ops::Range<usize>) {
@@ -263,9 +285,9 @@ impl<'a, T, const K: usize> Disjoint<'a, T, K> {
             before & (1 << worker) == 0,
             "worker {worker}'s part is taken"
         );
-        let range = share(self.len, worker, self.workers);
-        // Safety: in bounds (a share of len), disjoint from every other worker's share, and
-        // handed out once (the bit above).
+        let range = self.cuts[worker]..self.cuts[worker + 1];
+        // Safety: in bounds and disjoint from every other worker's part (the cuts cover the
+        // slices, in order: checked in `cut`), and handed out once (the bit above).
         let parts = self
             .starts
             .map(|p| unsafe { std::slice::from_raw_parts_mut(p.add(range.start), range.len()) });
@@ -347,6 +369,24 @@ mod tests {
                 b[k]
             );
         }
+    }
+
+    #[test]
+    fn parts_cut_where_asked_must_cover_the_slices_in_order() {
+        let mut a = [0u8; 10];
+        let parts = Disjoint::cut([&mut a[..]], 3, |w| [0, 4, 4, 10][w]);
+        assert_eq!(parts.take(1).1, 4..4, "a worker may have nothing");
+        assert_eq!(parts.take(2).1, 4..10);
+        let backwards = std::panic::catch_unwind(|| {
+            let mut a = [0u8; 10];
+            Disjoint::cut([&mut a[..]], 2, |w| [0, 6, 4][w]).take(0).1
+        });
+        assert!(backwards.is_err(), "parts out of order would overlap");
+        let short = std::panic::catch_unwind(|| {
+            let mut a = [0u8; 10];
+            Disjoint::cut([&mut a[..]], 2, |w| [0, 4, 8][w]).take(0).1
+        });
+        assert!(short.is_err(), "parts must cover the slices");
     }
 
     #[test]
