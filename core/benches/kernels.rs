@@ -168,12 +168,7 @@ fn file_in_lanes(c: &mut Criterion) {
     let file = ConstraintFile::load(&folder.join("volume.toml")).expect("the example file");
     group.bench_function("volume, file", |b| {
         b.iter(|| {
-            FileConstraint::<4, false>(&file).evaluate_batches(
-                black_box(&p),
-                rest,
-                &shape,
-                [&[]; GROUP],
-            )
+            FileConstraint::<4>(&file).evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP])
         })
     });
     group.bench_function("neo-Hookean pair, built-in", |b| {
@@ -197,7 +192,7 @@ fn file_in_lanes(c: &mut Criterion) {
         .collect();
     group.bench_function("neo-Hookean deviatoric alone, file", |b| {
         b.iter(|| {
-            FileConstraint::<4, true>(&files[0]).evaluate_batches(
+            FileConstraint::<4>(&files[0]).evaluate_batches(
                 black_box(&p),
                 rest,
                 &shape,
@@ -207,7 +202,7 @@ fn file_in_lanes(c: &mut Criterion) {
     });
     group.bench_function("neo-Hookean pair, file", |b| {
         b.iter(|| {
-            let [a, b] = [0, 1].map(|i| FileConstraint::<4, true>(&files[i]));
+            let [a, b] = [0, 1].map(|i| FileConstraint::<4>(&files[i]));
             (
                 a.evaluate_batches(black_box(&p), rest, &shape, [&stored[0]; GROUP]),
                 b.evaluate_batches(black_box(&p), rest, &shape, [&stored[1]; GROUP]),

@@ -28,8 +28,8 @@ fn bits<const N: usize>(e: &Evaluation<Vec3x8, N>) -> Vec<u32> {
 }
 
 /// The grouped evaluation of `file` against each batch alone, over 50 random groups.
-fn same_bits<const N: usize, const SHAPE: bool>(file: &ConstraintFile) -> usize {
-    let constraint = FileConstraint::<N, SHAPE>(file);
+fn same_bits<const N: usize>(file: &ConstraintFile) -> usize {
+    let constraint = FileConstraint::<N>(file);
     let mut random = SplitMix64::new(7);
     let mut checked = 0;
     for round in 0..50 {
@@ -86,14 +86,11 @@ fn a_file_family_evaluated_in_groups_gives_each_batch_its_own_bits() {
     paths.sort();
     for path in paths {
         for file in ConstraintFile::load_all(&path).unwrap() {
-            let checked = match (file.arity(), file.reads_rest_shape()) {
-                (2, false) => same_bits::<2, false>(&file),
-                (2, true) => same_bits::<2, true>(&file),
-                (3, false) => same_bits::<3, false>(&file),
-                (3, true) => same_bits::<3, true>(&file),
-                (4, false) => same_bits::<4, false>(&file),
-                (4, true) => same_bits::<4, true>(&file),
-                (arity, _) => panic!("{}: arity {arity}", file.name),
+            let checked = match file.arity() {
+                2 => same_bits::<2>(&file),
+                3 => same_bits::<3>(&file),
+                4 => same_bits::<4>(&file),
+                arity => panic!("{}: arity {arity}", file.name),
             };
             assert_eq!(checked, 50 * GROUP);
             families += 1;

@@ -467,13 +467,10 @@ impl Families {
             Kind::Hydrostatic => visitor.visit(family, &Hydrostatic),
             Kind::File => {
                 let file = self.file(family).expect("a family of kind File has a file");
-                match (file.arity(), file.reads_rest_shape()) {
-                    (2, false) => visitor.visit(family, &FileConstraint::<2, false>(file)),
-                    (2, true) => visitor.visit(family, &FileConstraint::<2, true>(file)),
-                    (3, false) => visitor.visit(family, &FileConstraint::<3, false>(file)),
-                    (3, true) => visitor.visit(family, &FileConstraint::<3, true>(file)),
-                    (_, false) => visitor.visit(family, &FileConstraint::<4, false>(file)),
-                    (_, true) => visitor.visit(family, &FileConstraint::<4, true>(file)),
+                match file.arity() {
+                    2 => visitor.visit(family, &FileConstraint::<2>(file)),
+                    3 => visitor.visit(family, &FileConstraint::<3>(file)),
+                    _ => visitor.visit(family, &FileConstraint::<4>(file)),
                 }
             }
         }
@@ -570,13 +567,13 @@ impl Families {
         self.visit(family, At(points, rest, rest_shape))
     }
 
-    /// Whether `family`'s formula reads the rest shape ([`Constraint::USES_REST_SHAPE`]).
+    /// Whether `family`'s formula reads the rest shape ([`Constraint::uses_rest_shape`]).
     pub fn uses_rest_shape(&self, family: Family) -> bool {
         struct Uses;
         impl Visit for Uses {
             type Output = bool;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, _: &C) -> bool {
-                C::USES_REST_SHAPE
+            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> bool {
+                c.uses_rest_shape()
             }
         }
         self.visit(family, Uses)

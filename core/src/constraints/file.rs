@@ -13,12 +13,11 @@ use glam::DVec3;
 
 /// A constraint file's family as a [`Constraint`] on N particles: C and ∇C from the file's
 /// compiled tape ([`ConstraintFile::evaluate_vectors`]), the rest value as the file defines it.
-/// `SHAPE` says whether it reads the rest shape ([`ConstraintFile::reads_rest_shape`]), so that
-/// the solvers gather the rest positions only for one that does.
-pub struct FileConstraint<'a, const N: usize, const SHAPE: bool>(pub &'a ConstraintFile);
+/// Whether it reads the rest shape is the file's ([`ConstraintFile::reads_rest_shape`]), asked at
+/// run time, so that the solvers' code for files is compiled once per arity.
+pub struct FileConstraint<'a, const N: usize>(pub &'a ConstraintFile);
 
-impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, SHAPE> {
-    const USES_REST_SHAPE: bool = SHAPE;
+impl<const N: usize> Constraint<N> for FileConstraint<'_, N> {
     // What a file's tapes read of the rest shape at each projection is stored.
     const STORED_USES_REST_SHAPE: bool = false;
     // μ and λ may appear in what an element stores and in its rest value.
@@ -27,6 +26,10 @@ impl<const N: usize, const SHAPE: bool> Constraint<N> for FileConstraint<'_, N, 
     const GROUPED: bool = true;
     // A file's `pair`.
     const PAIR_GROUP: PairGroup = PairGroup::File;
+
+    fn uses_rest_shape(&self) -> bool {
+        self.0.reads_rest_shape()
+    }
 
     /// C and ∇C with what the element stores worked out here from `rest_shape` and the default
     /// material: for the checkers and readers that hold no stored values (the solvers call

@@ -95,14 +95,11 @@ pub const fn pairs<const N: usize, A: Constraint<N>, const M: usize, B: Constrai
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or
 /// eight constraints at once in SIMD lanes).
 pub trait Constraint<const N: usize>: Sync {
-    /// Whether [`Constraint::evaluate`] reads `rest_shape`. When it does not, callers may pass
-    /// the current positions there, and the solvers save themselves the loads.
-    const USES_REST_SHAPE: bool = false;
-
     /// Whether [`Constraint::evaluate_stored`], what the solvers call, reads `rest_shape`: a
     /// family that stores what it needs of its rest shape ([`Constraint::store`]) does not, and
-    /// the solvers then gather no rest positions for it.
-    const STORED_USES_REST_SHAPE: bool = Self::USES_REST_SHAPE;
+    /// the solvers then gather no rest positions for it. A constant of the type, since the
+    /// solvers' loops are compiled with it.
+    const STORED_USES_REST_SHAPE: bool = false;
 
     /// Whether [`Constraint::rest_value`] depends on the material, so that the rest values are
     /// measured again when it changes.
@@ -121,6 +118,16 @@ pub trait Constraint<const N: usize>: Sync {
         rest: V::Real,
         rest_shape: &[V; N],
     ) -> Evaluation<V, N>;
+
+    /// Whether [`Constraint::evaluate`] reads `rest_shape`. When it does not, callers may pass
+    /// the current positions there (the gradient check and `tetlab gradient` then ask for no
+    /// rest shape). A method rather than a constant, so that a constraint file's family is one
+    /// type whether its formula reads the rest shape or not: the solvers' code for files is
+    /// compiled once per arity. By default, what the solvers' [`Constraint::evaluate_stored`]
+    /// reads.
+    fn uses_rest_shape(&self) -> bool {
+        Self::STORED_USES_REST_SHAPE
+    }
 
     /// The rest value of a constraint whose particles are at rest at `rest_shape`: unless the
     /// family says otherwise, C there with rest value 0 (the rest length d, the rest volume V),

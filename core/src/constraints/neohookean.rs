@@ -179,7 +179,7 @@ fn scale(rest_shape: &[DVec3; 4]) -> f64 {
 pub struct Deviatoric;
 
 impl Constraint<4> for Deviatoric {
-    const USES_REST_SHAPE: bool = true;
+    const STORED_USES_REST_SHAPE: bool = true;
     const PAIR_GROUP: PairGroup = PairGroup::NeoHookeanDeviatoric;
 
     #[inline(always)]
@@ -201,7 +201,7 @@ impl Constraint<4> for Deviatoric {
 pub struct Hydrostatic;
 
 impl Constraint<4> for Hydrostatic {
-    const USES_REST_SHAPE: bool = true;
+    const STORED_USES_REST_SHAPE: bool = true;
     const REST_USES_MATERIAL: bool = true;
     const PAIR_GROUP: PairGroup = PairGroup::NeoHookeanHydrostatic;
 
