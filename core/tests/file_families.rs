@@ -289,6 +289,31 @@ fn a_file_family_has_a_name_of_its_own() {
     assert!(Families::builtin().parse("my-volume").is_err());
 }
 
+/// Whether a file's family reads the rest shape is the file's own answer, asked at run time (one
+/// type per arity, `FileConstraint<N>`): the example files hold families of both kinds.
+#[test]
+fn a_file_family_reads_the_rest_shape_as_its_file_says() {
+    let mut seen = [false; 2];
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(asset(""))
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let files = ConstraintFile::load_all(&path).unwrap();
+        let reads: Vec<bool> = files.iter().map(ConstraintFile::reads_rest_shape).collect();
+        // A table of its own per file: a table holds a few files at most.
+        let mut table = Families::builtin();
+        let registered = table.register_all(files).unwrap();
+        for (family, reads) in registered.into_iter().zip(reads) {
+            assert_eq!(table.uses_rest_shape(family), reads, "{}", path.display());
+            seen[usize::from(reads)] = true;
+        }
+    }
+    assert_eq!(seen, [true, true], "files of both kinds");
+}
+
 /// The editor redefines a family as the user types: every simulation that uses it rebuilds its
 /// constraints, even when the binding (and so the number of constraints) changes.
 #[test]

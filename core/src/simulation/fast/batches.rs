@@ -49,6 +49,10 @@ use std::ops::Range;
 /// of two up to [`MAX_REGIONS`].
 pub const PARTICLES_PER_REGION: usize = 2048;
 
+/// Colours with fewer elements than this are projected on one thread even when several are
+/// available: below it, handing out the work costs more than it saves.
+pub const PARALLEL_MIN: usize = 256;
+
 /// The most regions a body is cut into.
 pub const MAX_REGIONS: usize = 8;
 
@@ -316,7 +320,7 @@ impl Layout {
     /// (empty: the layout's).
     #[inline]
     pub(crate) fn entry(&self, group: usize, k: usize, order: &[u32]) -> &Colour {
-        &self.colours[group * self.colour_count + super::kernel::in_order(order, k)]
+        &self.colours[group * self.colour_count + in_order(order, k)]
     }
 
     /// The batches of groups `groups` of level `level`, which lie together: a group's entries
@@ -402,7 +406,7 @@ impl Layout {
             for k in 0..self.colour_count {
                 let colour = self.entry(group_index(self.regions(), last, 0), k, order);
                 let batches = colour.batches.clone();
-                if colour.elements >= super::PARALLEL_MIN {
+                if colour.elements >= PARALLEL_MIN {
                     for thread in 0..threads {
                         let part = share(batches.len(), thread, threads);
                         step(
@@ -576,4 +580,10 @@ impl Batches {
         (self.rest.capacity() + self.lambda.capacity() + self.stored.capacity())
             * size_of::<F32x8>()
     }
+}
+
+/// The colour projected `k`-th: `order[k]`, or `k` when `order` is empty (the layout's order).
+#[inline]
+fn in_order(order: &[u32], k: usize) -> usize {
+    order.get(k).map_or(k, |&c| c as usize)
 }

@@ -15,10 +15,6 @@ use crate::numbers::vector::{Real, Vector3};
 use crate::simulation::projection::{Rule, SkipCounts, correction_lanes, pair_correction_lanes};
 use glam::Vec3A;
 
-/// Colours with fewer elements than this are projected on one thread even when several are
-/// available: below it, handing out the work costs more than it saves.
-pub const PARALLEL_MIN: usize = 256;
-
 /// The particles `indices` (one per lane) as eight x, eight y and eight z.
 #[inline(always)]
 fn gather(positions: Particles, indices: [u32; LANES]) -> Vec3x8 {
@@ -156,12 +152,6 @@ fn gather_group<'a, const N: usize>(
         (rows[j], stored[j]) = rest.of(b + j);
     }
     (p, shape, (rows, stored))
-}
-
-/// The colour projected `k`-th: `order[k]`, or `k` when `order` is empty (the layout's order).
-#[inline]
-pub(super) fn in_order(order: &[u32], k: usize) -> usize {
-    order.get(k).map_or(k, |&c| c as usize)
 }
 
 /// Projects every constraint of a family (`batches`, on `layout`), colour by colour in `order`

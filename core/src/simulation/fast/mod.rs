@@ -35,8 +35,7 @@ mod schedule;
 mod share_timers;
 mod team;
 
-pub use batches::{Batches, Colour, Layout};
-pub use kernel::PARALLEL_MIN;
+pub use batches::{Batches, Colour, Layout, PARALLEL_MIN};
 pub use team::Team;
 
 use super::constraint_set::ConstraintSet;

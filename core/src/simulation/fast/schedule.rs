@@ -16,8 +16,7 @@
 //! shared. The result is the same to the bit for any number of threads: the groups of a level
 //! share no particle, nor do a colour's batches.
 
-use super::batches::{Colour, Layout, group_index};
-use super::kernel::PARALLEL_MIN;
+use super::batches::{Colour, Layout, PARALLEL_MIN, group_index};
 use super::share_timers;
 use super::team::{Disjoint, SharedSkips, Team, share};
 use crate::numbers::lanes::F32x8;
