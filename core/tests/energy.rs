@@ -4,8 +4,10 @@
 //! its zero eigenvalues where that number is known; and the neo-Hookean energy's analytic
 //! eigensystem against a numeric one at HOBAK's configurations and inverted ones.
 
+#[path = "support/example_files.rs"]
+mod example_files;
+use example_files::example_files;
 use glam::{DMat3, DQuat, DVec3};
-use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::material::Material;
 use tetlab_core::constraints::{Families, PerFamily};
@@ -29,17 +31,6 @@ const REST: [DVec3; 4] = [
     DVec3::new(0.1, 0.2, 1.1),
 ];
 
-fn examples() -> Vec<std::path::PathBuf> {
-    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints");
-    let mut files: Vec<_> = std::fs::read_dir(folder)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    files
-}
-
 /// Every built-in group and every example file, as (name, table, active families).
 fn every_energy() -> Vec<(String, Families, PerFamily<bool>)> {
     let builtin = Families::builtin();
@@ -50,7 +41,7 @@ fn every_energy() -> Vec<(String, Families, PerFamily<bool>)> {
             (name.to_string(), builtin.clone(), active)
         })
         .collect();
-    for path in examples() {
+    for path in example_files() {
         let mut families = Families::builtin();
         let files = ConstraintFile::load_all(&path).unwrap_or_else(|e| panic!("{e}"));
         let added = families.register_all(files).unwrap();

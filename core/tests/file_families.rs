@@ -5,6 +5,9 @@
 //! The families this binary uses are in one table, made once ([`families`]); a test that
 //! changes a table changes its own copy.
 
+#[path = "support/example_files.rs"]
+mod example_files;
+use example_files::example_files;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
@@ -294,13 +297,7 @@ fn a_file_family_has_a_name_of_its_own() {
 #[test]
 fn a_file_family_reads_the_rest_shape_as_its_file_says() {
     let mut seen = [false; 2];
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(asset(""))
-        .unwrap()
-        .map(|entry| entry.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    paths.sort();
-    for path in paths {
+    for path in example_files() {
         let files = ConstraintFile::load_all(&path).unwrap();
         let reads: Vec<bool> = files.iter().map(ConstraintFile::reads_rest_shape).collect();
         // A table of its own per file: a table holds a few files at most.

@@ -4,7 +4,9 @@
 //! grouping changes no result: checked for every example file, at random configurations with a
 //! degenerate lane among them.
 
-use std::path::Path;
+#[path = "support/example_files.rs"]
+mod example_files;
+use example_files::example_files;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::file::FileConstraint;
 use tetlab_core::constraints::{Constraint, Evaluation, GROUP};
@@ -76,15 +78,8 @@ fn same_bits<const N: usize>(file: &ConstraintFile) -> usize {
 
 #[test]
 fn a_file_family_evaluated_in_groups_gives_each_batch_its_own_bits() {
-    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/constraints");
     let mut families = 0;
-    let mut paths: Vec<_> = std::fs::read_dir(&folder)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    paths.sort();
-    for path in paths {
+    for path in example_files() {
         for file in ConstraintFile::load_all(&path).unwrap() {
             let checked = match file.arity() {
                 2 => same_bits::<2>(&file),
