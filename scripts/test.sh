@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Everything a fresh machine needs, then every check and test of tetlab:
-# rustfmt and clippy (warnings are errors), the workbench built as a web page and opened in
+# rustfmt, clippy and rustdoc (warnings are errors), the workbench built as a web page and opened in
 # headless Chromium, Rerun's own checker on a recording tetlab writes, all tests of the workspace
 # (unit, doc, end to end, the abuse runs), then every fuzz target briefly. Exits non-zero on the
 # first failure.
@@ -28,6 +28,8 @@ cargo fmt --all --check
 (cd fuzz && cargo fmt --check)
 echo "== cargo clippy --all-targets -- -D warnings"
 cargo clippy --workspace --all-targets --locked -- -D warnings
+echo "== cargo doc --no-deps (warnings are errors: every link in the docs resolves)"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
 # The workbench as a web page, built and opened in headless Chromium (installs what it needs).
 echo "== the web page (scripts/web-test.sh)"
 scripts/web-test.sh

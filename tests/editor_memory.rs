@@ -28,7 +28,7 @@ fn a_hundred_definitions_in_the_editor_leave_live_memory_flat() {
     preferences.scene.builtin = "cube".into();
     preferences.scene.resolution = 2;
     let mut app = TetlabApp::with_preferences(preferences);
-    app.compare(Some(app.bench.simulation.settings().active));
+    app.compare(Some(*app.bench.simulation.active()));
     for k in 0..10 {
         app.define_constraint(typed(k));
         app.bench.step_frame();
@@ -40,7 +40,7 @@ fn a_hundred_definitions_in_the_editor_leave_live_memory_flat() {
     }
     let grown = live() - before;
     let family = app.editor.family.expect("defined");
-    assert!(app.bench.simulation.settings().active[family]);
+    assert!(app.bench.simulation.active()[family]);
     // One definition holds about a kilobyte; a leak of one per definition would be 100 kB.
     assert!(
         grown.abs() < 16 * 1024,

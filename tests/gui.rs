@@ -262,10 +262,10 @@ fn the_neo_hookean_family_is_switched_on_with_its_material() {
     assert_eq!(harness.state().bench.metrics.inverted_tets, 0, "recovered");
     // Steel in ten substeps: the readouts say how many it needs.
     let mut steel = settings;
-    steel.set_material(tetlab_core::constraints::material::Material {
+    steel.material = tetlab_core::constraints::material::Material {
         young: 2e11,
         poisson: 0.3,
-    });
+    };
     harness.state_mut().set_settings(steel);
     harness.run_steps(1);
     harness.get_by_label_contains("needs at least");
@@ -545,7 +545,7 @@ fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
     harness.run_steps(2);
     let families = |harness: &Harness<'static, TetlabApp>| {
         let comparison = harness.state().comparison.as_ref().expect("comparing");
-        Families::builtin().describe(&comparison.bench.simulation.settings().active)
+        Families::builtin().describe(comparison.bench.simulation.active())
     };
     assert_eq!(families(&harness), "height+volume");
     harness.get_by_label("height+volume");

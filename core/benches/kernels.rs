@@ -166,10 +166,9 @@ fn file_in_lanes(c: &mut Criterion) {
         b.iter(|| volume::Volume.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]))
     });
     let file = ConstraintFile::load(&folder.join("volume.toml")).expect("the example file");
+    let file = FileConstraint::<4>(std::sync::Arc::new(file));
     group.bench_function("volume, file", |b| {
-        b.iter(|| {
-            FileConstraint::<4>(&file).evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP])
-        })
+        b.iter(|| file.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]))
     });
     group.bench_function("neo-Hookean pair, built-in", |b| {
         b.iter(|| {
@@ -190,19 +189,16 @@ fn file_in_lanes(c: &mut Criterion) {
                 .collect()
         })
         .collect();
+    let files: Vec<FileConstraint<4>> = files
+        .into_iter()
+        .map(|file| FileConstraint(std::sync::Arc::new(file)))
+        .collect();
     group.bench_function("neo-Hookean deviatoric alone, file", |b| {
-        b.iter(|| {
-            FileConstraint::<4>(&files[0]).evaluate_batches(
-                black_box(&p),
-                rest,
-                &shape,
-                [&stored[0]; GROUP],
-            )
-        })
+        b.iter(|| files[0].evaluate_batches(black_box(&p), rest, &shape, [&stored[0]; GROUP]))
     });
     group.bench_function("neo-Hookean pair, file", |b| {
         b.iter(|| {
-            let [a, b] = [0, 1].map(|i| FileConstraint::<4>(&files[i]));
+            let [a, b] = [&files[0], &files[1]];
             (
                 a.evaluate_batches(black_box(&p), rest, &shape, [&stored[0]; GROUP]),
                 b.evaluate_batches(black_box(&p), rest, &shape, [&stored[1]; GROUP]),
@@ -236,7 +232,7 @@ fn frame(c: &mut Criterion) {
         (Order::GaussSeidel, "Gauss-Seidel"),
         (Order::Jacobi { relaxation: 1.0 }, "Jacobi"),
     ] {
-        let mut fast = FastSimulation::new(simulation.fast_start(), 1);
+        let mut fast = FastSimulation::new(simulation.start());
         fast.set_order(order);
         group.bench_function(format!("{name}, fast, {label}"), |b| b.iter(|| fast.step()));
     }
@@ -244,7 +240,7 @@ fn frame(c: &mut Criterion) {
     // frame runs them (every batch of eight of each family, padding included, every substep),
     // on particles already in registers. The frame's time over this one is what moving the
     // particles (gathering, transposing, writing back) and the rest of the frame cost on top.
-    let fast = FastSimulation::new(simulation.fast_start(), 1);
+    let fast = FastSimulation::new(simulation.start());
     let batches = |family| -> usize {
         let batches = fast.batches(family);
         batches.colours().iter().map(|c| c.batches.len()).sum()

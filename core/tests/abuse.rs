@@ -30,7 +30,8 @@ use tetlab_core::input::limits::{self, Bounds};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::numbers::random::SplitMix64;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
-use tetlab_core::simulation::{DENSITY, Engine, Method, Settings, Simulation};
+use tetlab_core::simulation::fast::FastSimulation;
+use tetlab_core::simulation::{DENSITY, EngineChoice, Method, Settings, Simulation};
 
 /// Frames per engine.
 const FRAMES: usize = 10_000;
@@ -91,7 +92,9 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
     };
     settings.set_gravity(gravity);
     settings.ground = settings.ground && !rng.next_u64().is_multiple_of(4);
-    for family in Family::builtins().filter(|f| f.compliance_from_material().is_none()) {
+    for family in
+        Family::builtins().filter(|f| f.builtin_row().unwrap().compliance_from_material.is_none())
+    {
         settings
             .active
             .set(family, !rng.next_u64().is_multiple_of(3));
@@ -106,7 +109,9 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
     // The families a material describes: on or off together, as the command line and the
     // workbench have them, with any material in range.
     let on = !rng.next_u64().is_multiple_of(3);
-    for family in Family::builtins().filter(|f| f.compliance_from_material().is_some()) {
+    for family in
+        Family::builtins().filter(|f| f.builtin_row().unwrap().compliance_from_material.is_some())
+    {
         settings.active.set(family, on);
     }
     // Within the material's documented stable range (Material::substeps_needed) on the
@@ -123,10 +128,10 @@ fn random_settings(rng: &mut SplitMix64) -> Settings {
         max: stiffest.clamp(material::YOUNG.min, material::YOUNG.max),
         ..material::YOUNG
     };
-    settings.set_material(Material {
+    settings.material = Material {
         young: log_uniform(rng, &bounds, bounds.min),
         poisson,
-    });
+    };
     settings.check().expect("drawn within the limits");
     settings
 }
@@ -369,12 +374,12 @@ fn motion_of(simulation: &Simulation) -> Motion {
     )
 }
 
-/// 10⁴ frames of stretches on `engine` ([`Engine::Fast`] or the reference one), drawn from
+/// 10⁴ frames of stretches on `engine` ([`EngineChoice::Fast`] or the reference one), drawn from
 /// `seed`, through the [`Simulation`] the product drives: edits and grabs on the simulation's
 /// arrays (the fast solver takes them up before its next frame, on one or two threads). On the
 /// fast engine a launch may carry particles past its 10⁹ m (docs/reliability.md): the stretch then
 /// ends, is counted, and must have been one the speed put in allows.
-fn survives_random_edits_grabs_and_settings(engine: Engine, seed: u64, name: &str) {
+fn survives_random_edits_grabs_and_settings(engine: EngineChoice, seed: u64, name: &str) {
     let scene = cube();
     let arena = Arena::new(&scene.mesh.positions);
     let mut rng = SplitMix64::new(seed);
@@ -387,7 +392,7 @@ fn survives_random_edits_grabs_and_settings(engine: Engine, seed: u64, name: &st
             engine,
             ..random_settings(&mut rng)
         });
-        if engine == Engine::Fast {
+        if engine == EngineChoice::Fast {
             simulation.set_threads(1 + (rng.next_u64() % 2) as usize);
         }
         let before = motion_of(&simulation);
@@ -420,7 +425,10 @@ fn survives_random_edits_grabs_and_settings(engine: Engine, seed: u64, name: &st
             );
             let what = format!("frame {}", watch.frames);
             if let Err(divergence) = Metrics::measure_sound(&simulation) {
-                assert!(engine == Engine::Fast, "{what}: {divergence}; {settings:?}");
+                assert!(
+                    engine == EngineChoice::Fast,
+                    "{what}: {divergence}; {settings:?}"
+                );
                 // Past f32's range only with the speed put in (a launch): start afresh.
                 let what = format!("{what}: {divergence}");
                 watch.check(&motion_of(&simulation), &settings, &what);
@@ -429,8 +437,11 @@ fn survives_random_edits_grabs_and_settings(engine: Engine, seed: u64, name: &st
             }
             watch.check(&motion_of(&simulation), &settings, &what);
         }
-        if engine == Engine::Fast && simulation.is_sound() {
-            let relative = simulation.fast_solver().relative_error();
+        if engine == EngineChoice::Fast && simulation.is_sound() {
+            let relative = simulation
+                .engine_as::<FastSimulation>()
+                .expect("the fast engine")
+                .relative_error();
             assert!(
                 Family::builtins().all(|f| relative.get(f).is_none_or(f64::is_finite)),
                 "{relative:?}"
@@ -442,10 +453,10 @@ fn survives_random_edits_grabs_and_settings(engine: Engine, seed: u64, name: &st
 
 #[test]
 fn the_reference_engine_survives_random_edits_and_settings() {
-    survives_random_edits_grabs_and_settings(Engine::Reference, seed(13), "reference engine");
+    survives_random_edits_grabs_and_settings(EngineChoice::Reference, seed(13), "reference engine");
 }
 
 #[test]
 fn the_fast_engine_survives_random_edits_grabs_and_settings() {
-    survives_random_edits_grabs_and_settings(Engine::Fast, seed(31), "fast engine");
+    survives_random_edits_grabs_and_settings(EngineChoice::Fast, seed(31), "fast engine");
 }

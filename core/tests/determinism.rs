@@ -6,12 +6,13 @@
 
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
+use tetlab_core::simulation::fast::FastSimulation;
 use tetlab_core::simulation::fast::PARALLEL_MIN;
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
 /// A scrambled 16³ cube (24 576 tets: its colours are large enough to be shared between
 /// threads), on `engine` with `threads` threads.
-fn simulation(engine: Engine, threads: usize) -> Simulation {
+fn simulation(engine: EngineChoice, threads: usize) -> Simulation {
     let scene = Scene::builtin(Builtin::Cube, 16).unwrap();
     let mut simulation = Simulation::new(
         &scene,
@@ -28,7 +29,7 @@ fn simulation(engine: Engine, threads: usize) -> Simulation {
 }
 
 /// FNV-1a over the bits of every coordinate of [`simulation`] after two frames.
-fn bits_of_a_run(engine: Engine, threads: usize) -> u64 {
+fn bits_of_a_run(engine: EngineChoice, threads: usize) -> u64 {
     let mut simulation = simulation(engine, threads);
     for _ in 0..2 {
         simulation.step();
@@ -49,7 +50,10 @@ fn bits_of_a_run(engine: Engine, threads: usize) -> u64 {
 fn print_the_bits_of_a_run() {
     let asked = std::env::var("TETLAB_BITS_OF").expect("run by its parent");
     let (engine, threads) = asked.split_once(',').unwrap();
-    let bits = bits_of_a_run(Engine::parse(engine).unwrap(), threads.parse().unwrap());
+    let bits = bits_of_a_run(
+        EngineChoice::parse(engine).unwrap(),
+        threads.parse().unwrap(),
+    );
     println!("bits {bits:016x}");
 }
 
@@ -76,18 +80,19 @@ fn bits_in_a_child(engine: &str, threads: usize) -> u64 {
 
 #[test]
 fn the_same_bits_in_other_processes_and_on_any_thread_count() {
-    let reference = bits_of_a_run(Engine::Reference, 1);
+    let reference = bits_of_a_run(EngineChoice::Reference, 1);
     assert_eq!(bits_in_a_child("reference", 1), reference);
     assert_eq!(bits_in_a_child("reference", 1), reference);
-    let fast = bits_of_a_run(Engine::Fast, 1);
+    let fast = bits_of_a_run(EngineChoice::Fast, 1);
     assert_ne!(
         fast, reference,
         "f32 is not f64: the two runs are told apart"
     );
     let threads = if cfg!(feature = "parallel") { 2 } else { 1 };
-    let mut shared = simulation(Engine::Fast, threads);
+    let mut shared = simulation(EngineChoice::Fast, threads);
     let colours = shared
-        .fast_solver()
+        .engine_as::<FastSimulation>()
+        .expect("the fast engine")
         .batches(Family::VOLUME)
         .colours()
         .to_vec();
@@ -97,5 +102,5 @@ fn the_same_bits_in_other_processes_and_on_any_thread_count() {
     );
     assert_eq!(bits_in_a_child("fast", 1), fast);
     assert_eq!(bits_in_a_child("fast", threads), fast);
-    assert_eq!(bits_of_a_run(Engine::Fast, threads), fast);
+    assert_eq!(bits_of_a_run(EngineChoice::Fast, threads), fast);
 }

@@ -1,6 +1,10 @@
 //! The engine matrix: every scene a claim of tetlab's rests on, run on the reference engine
 //! (f64) and on the fast one (f32, one and two threads), must come to the same outcome: both
-//! recover (no tet inverted at the end) or both do not, and neither is thrown.
+//! recover (no tet inverted at the end) or both do not, and neither is thrown. A third engine
+//! that no file of the library knows (`support/reversed_engine.rs`: the reference engine's
+//! stages with every sweep walked backwards) runs beside them through the engine interface, and
+//! must reach the same outcome wherever the claim does not hang on the order of the
+//! projections: the seam takes a new engine without a change to edits, inspection or metrics.
 //!
 //! - **Bits across threads.** The fast engine on two threads gives the bits of one thread, at
 //!   every frame (compared for the first frames of every claim, then at the end of one).
@@ -18,14 +22,18 @@
 //! on both engines in `core/tests/lessons.rs`. The scenes on `../shared/meshes` skip without it
 //! (and fail under CI).
 
+#[path = "support/reversed_engine.rs"]
+mod reversed_engine;
+
 use glam::DVec3;
+use reversed_engine::Reversed;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::input::shared_meshes;
 use tetlab_core::measures::ensemble::Ensemble;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
 /// One claim: a scene, how it is run, and what the docs say it comes to.
 struct Claim {
@@ -191,7 +199,7 @@ impl Claim {
     }
 
     /// The command line's settings for the claim: edits settle unless --no-settle-edits.
-    fn settings(&self, engine: Engine) -> Settings {
+    fn settings(&self, engine: EngineChoice) -> Settings {
         let mut settings = Settings {
             active: PerFamily::builtin_list(self.families).unwrap(),
             engine,
@@ -202,10 +210,20 @@ impl Claim {
         settings
     }
 
-    fn simulation(&self, scene: &Scene, engine: Engine, threads: usize) -> Simulation {
+    fn simulation(&self, scene: &Scene, engine: EngineChoice, threads: usize) -> Simulation {
         let mut simulation = Simulation::new(scene, self.settings(engine));
         assert_eq!(simulation.engine(), engine);
         simulation.set_threads(threads);
+        if let Some(perturbation) = self.perturbation {
+            simulation.perturb(perturbation);
+        }
+        simulation
+    }
+
+    /// The claim's simulation on the test's own engine ([`Reversed`]).
+    fn reversed(&self, scene: &Scene) -> Simulation {
+        let mut simulation = Simulation::new(scene, self.settings(EngineChoice::Reference));
+        simulation.use_engine(Reversed::build, "reversed");
         if let Some(perturbation) = self.perturbation {
             simulation.perturb(perturbation);
         }
@@ -270,7 +288,7 @@ fn nudged(positions: &[DVec3]) -> Vec<DVec3> {
 }
 
 #[test]
-fn every_claim_scene_gives_one_answer_on_both_engines() {
+fn every_claim_scene_gives_one_answer_on_every_engine() {
     let mut failures = Vec::new();
     for claim in CLAIMS {
         let Some(scene) = claim.scene() else { continue };
@@ -278,10 +296,11 @@ fn every_claim_scene_gives_one_answer_on_both_engines() {
             failures.extend(compare_orderings(claim, &scene));
             continue;
         }
-        let mut reference = claim.simulation(&scene, Engine::Reference, 1);
-        let mut one = claim.simulation(&scene, Engine::Fast, 1);
-        let mut two = claim.simulation(&scene, Engine::Fast, 2);
-        let mut nudge = claim.simulation(&scene, Engine::Reference, 1);
+        let mut reference = claim.simulation(&scene, EngineChoice::Reference, 1);
+        let mut one = claim.simulation(&scene, EngineChoice::Fast, 1);
+        let mut two = claim.simulation(&scene, EngineChoice::Fast, 2);
+        let mut reversed = claim.reversed(&scene);
+        let mut nudge = claim.simulation(&scene, EngineChoice::Reference, 1);
         let moved = nudged(nudge.positions());
         nudge.set_positions(&moved);
         nudge.step();
@@ -289,10 +308,12 @@ fn every_claim_scene_gives_one_answer_on_both_engines() {
         let mut outcomes = [
             Outcome::start(&reference, &start),
             Outcome::start(&one, &start),
+            Outcome::start(&reversed, &start),
         ];
         for frame in 1..=claim.frames {
             reference.step();
             one.step();
+            reversed.step();
             if frame <= 3 {
                 two.step();
                 assert_eq!(
@@ -302,18 +323,18 @@ fn every_claim_scene_gives_one_answer_on_both_engines() {
                     claim.source
                 );
             }
-            for (outcome, simulation) in outcomes.iter_mut().zip([&reference, &one]) {
+            for (outcome, simulation) in outcomes.iter_mut().zip([&reference, &one, &reversed]) {
                 let metrics = Metrics::measure_sound(simulation)
                     .unwrap_or_else(|d| panic!("{}: {d}", claim.source));
                 outcome.observe(simulation, &metrics);
             }
             if frame == 1 {
-                failures.extend(compare_frame_one(
-                    claim, &reference, &one, &nudge, &outcomes,
-                ));
+                let engines = [outcomes[0], outcomes[1]];
+                failures.extend(compare_frame_one(claim, &reference, &one, &nudge, &engines));
             }
         }
-        for (engine, outcome) in ["reference", "fast"].iter().zip(&outcomes) {
+        assert_eq!(reversed.describe_engine(), "reversed (f64, a test's)");
+        for (engine, outcome) in ["reference", "fast", "reversed"].iter().zip(&outcomes) {
             println!("{}: {engine}: {}", claim.source, outcome.describe());
             // A body that stays tangled may walk (its inverted slivers push it about); one that
             // recovers must do so where it lies.
@@ -392,13 +413,13 @@ fn compare_frame_one(
 fn compare_orderings(claim: &Claim, scene: &Scene) -> Option<String> {
     let ensemble = Ensemble {
         scene,
-        settings: claim.settings(Engine::Reference),
+        settings: claim.settings(EngineChoice::Reference),
         perturbation: claim.perturbation,
         frames: claim.frames,
     };
     let seeds: Vec<u64> = (1..=claim.orderings).collect();
-    let members = ensemble.run(&[Engine::Reference, Engine::Fast], &seeds, 2);
-    let recovered = |engine: Engine| {
+    let members = ensemble.run(&[EngineChoice::Reference, EngineChoice::Fast], &seeds, 2);
+    let recovered = |engine: EngineChoice| {
         members
             .iter()
             .filter(|m| m.engine == engine)
@@ -409,7 +430,10 @@ fn compare_orderings(claim: &Claim, scene: &Scene) -> Option<String> {
             })
             .count()
     };
-    let (reference, fast) = (recovered(Engine::Reference), recovered(Engine::Fast));
+    let (reference, fast) = (
+        recovered(EngineChoice::Reference),
+        recovered(EngineChoice::Fast),
+    );
     let n = claim.orderings;
     println!(
         "{}: recovers in {reference} of {n} orderings on the reference engine, {fast} of {n} on the fast one",
@@ -434,7 +458,7 @@ fn compare_orderings(claim: &Claim, scene: &Scene) -> Option<String> {
 #[test]
 fn a_body_in_free_fall_falls_as_far_on_both_engines() {
     let scene = Scene::builtin(Builtin::Ball, 4).unwrap();
-    for (engine, tolerance) in [(Engine::Reference, 1e-10), (Engine::Fast, 1e-3)] {
+    for (engine, tolerance) in [(EngineChoice::Reference, 1e-10), (EngineChoice::Fast, 1e-3)] {
         let settings = Settings {
             engine,
             ground: false,

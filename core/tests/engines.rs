@@ -6,10 +6,15 @@ use glam::DVec3;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 use tetlab_core::teaching::stepper::StepByStep;
 
-fn simulation(builtin: Builtin, resolution: u32, families: &str, engine: Engine) -> Simulation {
+fn simulation(
+    builtin: Builtin,
+    resolution: u32,
+    families: &str,
+    engine: EngineChoice,
+) -> Simulation {
     let scene = Scene::builtin(builtin, resolution).unwrap();
     let settings = Settings {
         active: PerFamily::builtin_list(families).unwrap(),
@@ -35,7 +40,7 @@ fn run(simulation: &mut Simulation, frames: usize) -> Metrics {
 /// and recovers under edges + heights and under edges + volume; heights alone un-invert a tet.
 #[test]
 fn the_source_notes_claims_hold_on_both_engines() {
-    for engine in [Engine::Reference, Engine::Fast] {
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
         for (families, inverted_at_the_end) in [
             ("edges", 162),
             ("edges,height", 0),
@@ -63,7 +68,7 @@ fn the_source_notes_claims_hold_on_both_engines() {
 /// keeps the target's speed when let go.
 #[test]
 fn edits_reach_the_fast_engine() {
-    let mut cube = simulation(Builtin::Cube, 2, "edges,volume", Engine::Fast);
+    let mut cube = simulation(Builtin::Cube, 2, "edges,volume", EngineChoice::Fast);
     let mut settings = *cube.settings();
     settings.gravity = 9.81;
     settings.ground = true;
@@ -122,7 +127,7 @@ fn edits_reach_the_fast_engine() {
 #[test]
 fn edits_settle_on_the_fast_engine() {
     let highest = |settle: bool| {
-        let mut cube = simulation(Builtin::Cube, 4, "edges,volume", Engine::Fast);
+        let mut cube = simulation(Builtin::Cube, 4, "edges,volume", EngineChoice::Fast);
         let mut settings = *cube.settings();
         settings.settle_edits = settle;
         settings.substeps = 100;
@@ -154,7 +159,7 @@ fn edits_settle_on_the_fast_engine() {
 /// makes are the reference solver's, and the fast frames go on from where it left off.
 #[test]
 fn step_by_step_carries_the_state_across_the_engines() {
-    let mut cube = simulation(Builtin::Cube, 2, "edges,volume", Engine::Fast);
+    let mut cube = simulation(Builtin::Cube, 2, "edges,volume", EngineChoice::Fast);
     cube.perturb(Perturbation::Mirror);
     run(&mut cube, 2);
     let before = cube.positions().to_vec();
@@ -190,14 +195,19 @@ fn step_by_step_carries_the_state_across_the_engines() {
 /// one that does not (the same qualitative result), and the settings reach the fast engine.
 #[test]
 fn switching_engines_between_frames_keeps_the_state() {
-    let mut cube = simulation(Builtin::Cube, 3, "edges,height,volume", Engine::Reference);
+    let mut cube = simulation(
+        Builtin::Cube,
+        3,
+        "edges,height,volume",
+        EngineChoice::Reference,
+    );
     cube.perturb(Perturbation::Mirror);
     run(&mut cube, 3);
     let inverted = Metrics::measure(&cube).inverted_tets;
     let mut settings = *cube.settings();
-    settings.engine = Engine::Fast;
+    settings.engine = EngineChoice::Fast;
     cube.set_settings(settings);
-    assert_eq!(cube.engine(), Engine::Fast);
+    assert_eq!(cube.engine(), EngineChoice::Fast);
     assert_eq!(
         Metrics::measure(&cube).inverted_tets,
         inverted,
@@ -207,12 +217,12 @@ fn switching_engines_between_frames_keeps_the_state() {
     settings.active[Family::HEIGHT] = false;
     cube.set_settings(settings);
     assert_eq!(run(&mut cube, 120).inverted_tets, 0);
-    settings.engine = Engine::Reference;
+    settings.engine = EngineChoice::Reference;
     cube.set_settings(settings);
     assert_eq!(run(&mut cube, 10).inverted_tets, 0);
 }
 
-/// [`Engine::Auto`] puts big scenes on the fast engine and the teaching scenes on the
+/// [`EngineChoice::Auto`] puts big scenes on the fast engine and the teaching scenes on the
 /// reference one; every front end says which.
 #[test]
 fn auto_picks_by_size_and_says_which() {
@@ -220,13 +230,18 @@ fn auto_picks_by_size_and_says_which() {
         &Scene::builtin(Builtin::Cube, 3).unwrap(),
         Settings::default(),
     );
-    assert_eq!(small.engine(), Engine::Reference);
+    assert_eq!(small.engine(), EngineChoice::Reference);
     assert_eq!(small.describe_engine(), "reference (f64)");
     let mut big = Simulation::new(
         &Scene::builtin(Builtin::Cube, 6).unwrap(),
         Settings::default(),
     );
-    assert_eq!(big.engine(), Engine::Fast, "{} tets", big.tets().len());
+    assert_eq!(
+        big.engine(),
+        EngineChoice::Fast,
+        "{} tets",
+        big.tets().len()
+    );
     big.set_threads(2);
     let expected = if cfg!(feature = "parallel") {
         "fast (f32, 2 threads)"

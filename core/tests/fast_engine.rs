@@ -23,7 +23,7 @@ fn cube(resolution: u32, active: PerFamily<bool>) -> Simulation {
 #[test]
 fn colours_share_no_particle_and_cover_every_constraint_once() {
     let simulation = cube(4, PerFamily::splat(true));
-    let fast = FastSimulation::new(simulation.fast_start(), 1);
+    let fast = FastSimulation::new(simulation.start());
     let n = simulation.positions().len();
     for family in Family::builtins() {
         assert!(fast.batches(family).colouring_is_valid(n), "{family}");
@@ -51,7 +51,7 @@ fn a_mirrored_cube_recovers_on_the_fast_path_as_on_the_reference() {
         ..*reference.settings()
     });
     reference.perturb(Perturbation::Mirror);
-    let mut fast = FastSimulation::new(reference.fast_start(), 1);
+    let mut fast = FastSimulation::new(reference.start());
     for _ in 0..60 {
         reference.step();
         fast.step();
@@ -66,7 +66,7 @@ fn a_mirrored_cube_recovers_on_the_fast_path_as_on_the_reference() {
 fn edges_alone_leave_a_mirrored_cube_inverted_on_the_fast_path_too() {
     let mut reference = cube(3, PerFamily::builtin_list("edges").unwrap());
     reference.perturb(Perturbation::Mirror);
-    let mut fast = FastSimulation::new(reference.fast_start(), 1);
+    let mut fast = FastSimulation::new(reference.start());
     for _ in 0..60 {
         fast.step();
     }
@@ -93,7 +93,7 @@ fn two_and_three_threads_give_the_same_bits_as_one() {
             ..*reference.settings()
         });
         reference.perturb(Perturbation::Scramble(4));
-        let fast = FastSimulation::new(reference.fast_start(), 1);
+        let fast = FastSimulation::new(reference.start());
         assert_eq!(fast.batches(Family::VOLUME).regions(), regions);
         the_same_bits_on_any_number_of_threads(&reference);
     }
@@ -102,13 +102,16 @@ fn two_and_three_threads_give_the_same_bits_as_one() {
 #[cfg(feature = "parallel")]
 fn the_same_bits_on_any_number_of_threads(reference: &Simulation) {
     for order in [Order::GaussSeidel, Order::Jacobi { relaxation: 1.5 }] {
-        let mut one = FastSimulation::new(reference.fast_start(), 1);
+        let mut one = FastSimulation::new(reference.start());
         one.set_order(order);
         for _ in 0..5 {
             one.step();
         }
         for threads in [2, 3] {
-            let mut many = FastSimulation::new(reference.fast_start(), threads);
+            let mut many = FastSimulation::new(tetlab_core::simulation::Start {
+                threads,
+                ..reference.start()
+            });
             many.set_order(order);
             assert_eq!(many.threads(), threads);
             let volume = many.batches(Family::VOLUME);
@@ -137,7 +140,7 @@ fn the_threads_keep_mostly_to_their_own_particles() {
     // them. (Shares dealt batch by batch in turn would find about half their lines written by
     // another thread.)
     let simulation = cube(15, PerFamily::builtin_list("edges,volume").unwrap());
-    let fast = FastSimulation::new(simulation.fast_start(), 1);
+    let fast = FastSimulation::new(simulation.start());
     for family in [Family::EDGES, Family::VOLUME] {
         assert_eq!(fast.lines_from_other_threads(family, 1), (0, 0), "{family}");
         let fraction = |threads| {
@@ -158,7 +161,7 @@ fn the_threads_keep_mostly_to_their_own_particles() {
 fn a_mirrored_cube_recovers_in_jacobi_order_too() {
     let mut reference = cube(3, PerFamily::splat(true));
     reference.perturb(Perturbation::Mirror);
-    let mut fast = FastSimulation::new(reference.fast_start(), 1);
+    let mut fast = FastSimulation::new(reference.start());
     fast.set_order(Order::Jacobi { relaxation: 1.0 });
     assert_eq!(fast.order(), Order::Jacobi { relaxation: 1.0 });
     for _ in 0..60 {
@@ -176,7 +179,7 @@ fn a_mirrored_cube_recovers_in_jacobi_order_too() {
 fn the_jacobi_order_holds_the_constraints_less_tightly_than_gauss_seidel() {
     let simulation = cube(4, PerFamily::builtin_list("edges,volume").unwrap());
     let error = |order| {
-        let mut fast = FastSimulation::new(simulation.fast_start(), 1);
+        let mut fast = FastSimulation::new(simulation.start());
         fast.set_order(order);
         for _ in 0..60 {
             fast.step();
@@ -196,7 +199,7 @@ fn the_jacobi_order_holds_the_constraints_less_tightly_than_gauss_seidel() {
 #[test]
 fn projections_and_memory_are_counted() {
     let simulation = cube(4, PerFamily::builtin_list("edges,volume").unwrap());
-    let mut fast = FastSimulation::new(simulation.fast_start(), 1);
+    let mut fast = FastSimulation::new(simulation.start());
     let count = |f| simulation.constraint_count(f) as u64;
     let substeps = simulation.settings().substeps as u64;
     let per_frame = (count(Family::EDGES) + count(Family::VOLUME)) * substeps;

@@ -23,7 +23,7 @@ use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
 use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
 fn asset(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -96,7 +96,9 @@ fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2],
             .map(|&i| mesh.positions[i as usize])
             .collect();
         let points: Vec<DVec3> = constraint.iter().map(|&i| positions[i as usize]).collect();
-        let rest = table.rest_value(family, &shape, &Material::default());
+        let rest = table
+            .constraint(family)
+            .rest_value(&shape, &Material::default());
         let at = |f: Family| {
             table.visit(
                 f,
@@ -141,7 +143,7 @@ fn differences(route: &Route, mesh: &TetMesh, positions: &[DVec3]) -> ([f64; 2],
 fn states(scene: &Scene, perturbation: Perturbation, frames: &[u64]) -> Vec<Vec<DVec3>> {
     let settings = Settings {
         active: PerFamily::builtin_list("edges,height,volume").unwrap(),
-        engine: Engine::Reference,
+        engine: EngineChoice::Reference,
         settle_edits: true,
         ..Settings::default()
     };
@@ -216,7 +218,7 @@ fn a_file_recovers_where_the_built_in_does_on_both_engines() {
         } else {
             vec![None]
         };
-        for engine in [Engine::Reference, Engine::Fast] {
+        for engine in [EngineChoice::Reference, EngineChoice::Fast] {
             let mut recovered = Vec::new();
             for pick in [
                 |r: &Route| r.builtin,

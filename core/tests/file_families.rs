@@ -213,7 +213,7 @@ fn the_fast_solver_projects_a_file_family_in_lanes() {
     let f = families();
     let mut reference = cube(with(&[Family::EDGES, f.height]), 10);
     reference.perturb(Perturbation::Mirror);
-    let mut fast = FastSimulation::new(reference.fast_start(), 1);
+    let mut fast = FastSimulation::new(reference.start());
     assert_eq!(fast.batches(f.height).len(), 4 * reference.tets().len());
     for _ in 0..120 {
         fast.step();
@@ -304,7 +304,12 @@ fn a_file_family_reads_the_rest_shape_as_its_file_says() {
         let mut table = Families::builtin();
         let registered = table.register_all(files).unwrap();
         for (family, reads) in registered.into_iter().zip(reads) {
-            assert_eq!(table.uses_rest_shape(family), reads, "{}", path.display());
+            assert_eq!(
+                table.row(family).reads_rest_shape,
+                reads,
+                "{}",
+                path.display()
+            );
             seen[usize::from(reads)] = true;
         }
     }

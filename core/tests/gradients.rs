@@ -46,7 +46,10 @@ fn every_built_in_family_passes_every_check_of_the_harness() {
         (Family::NEOHOOKEAN_DEVIATORIC, Reflection::Unchanged),
         (Family::NEOHOOKEAN_HYDROSTATIC, Reflection::Negated),
     ];
-    for (family, reflection) in expected {
+    for family in Family::builtins() {
+        let reflection = (expected.iter().find(|(f, _)| *f == family))
+            .unwrap_or_else(|| panic!("{family}: say above what a reflection does to it"))
+            .1;
         let source = TableFamily {
             families: &families,
             family,

@@ -31,7 +31,7 @@ fn bits<const N: usize>(e: &Evaluation<Vec3x8, N>) -> Vec<u32> {
 
 /// The grouped evaluation of `file` against each batch alone, over 50 random groups.
 fn same_bits<const N: usize>(file: &ConstraintFile) -> usize {
-    let constraint = FileConstraint::<N>(file);
+    let constraint = FileConstraint::<N>(std::sync::Arc::new(file.clone()));
     let mut random = SplitMix64::new(7);
     let mut checked = 0;
     for round in 0..50 {

@@ -6,7 +6,7 @@ use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::input::shared_meshes;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
 /// The bunny's metrics after `perturbation` and 300 frames; `None` when `../shared/meshes` is
 /// absent (the test then skips).
@@ -23,7 +23,7 @@ fn bunny_after(perturbation: Perturbation, active: &str, edge_compliance: f64) -
         substeps: 10,
         // The tables were measured on the reference engine (`--engine reference`): the fast
         // one projects in another order, and these recoveries depend on it (docs/experiments.md).
-        engine: Engine::Reference,
+        engine: EngineChoice::Reference,
         ..Settings::default()
     };
     settings.compliance[Family::EDGES] = edge_compliance;

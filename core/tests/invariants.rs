@@ -35,7 +35,7 @@ fn gradients_sum_to_zero() {
     for family in Family::builtins() {
         for _ in 0..TRIALS {
             let p = well_conditioned_points(&mut rng, family);
-            let e = builtin().evaluate(family, &p, 0.3, &p);
+            let e = builtin().constraint(family).evaluate(&p, 0.3, &p);
             let sum: DVec3 = e.gradients.iter().sum();
             assert!(
                 sum.length() <= 1e-12 * max_gradient(&e.gradients),
@@ -56,16 +56,16 @@ fn value_is_invariant_under_rigid_motion_and_gradients_rotate_with_the_body() {
             let moved: Vec<DVec3> = p.iter().map(|&x| rotation * x + shift).collect();
             // A family that reads the rest shape (the neo-Hookean pair) keeps its own: a body
             // moved rigidly away from rest is as deformed as before.
-            let (before, after) = if builtin().uses_rest_shape(family) {
+            let (before, after) = if builtin().row(family).reads_rest_shape {
                 let rest = well_conditioned_points(&mut rng, family);
                 (
-                    builtin().evaluate(family, &p, 0.2, &rest),
-                    builtin().evaluate(family, &moved, 0.2, &rest),
+                    builtin().constraint(family).evaluate(&p, 0.2, &rest),
+                    builtin().constraint(family).evaluate(&moved, 0.2, &rest),
                 )
             } else {
                 (
-                    builtin().evaluate(family, &p, 0.2, &p),
-                    builtin().evaluate(family, &moved, 0.2, &moved),
+                    builtin().constraint(family).evaluate(&p, 0.2, &p),
+                    builtin().constraint(family).evaluate(&moved, 0.2, &moved),
                 )
             };
             assert!(
@@ -175,8 +175,7 @@ fn coincident_points_and_zero_area_faces_are_flagged_with_finite_values() {
 
     // All four coincident.
     for family in Family::builtins() {
-        let e = builtin().evaluate(
-            family,
+        let e = builtin().constraint(family).evaluate(
             &vec![p; builtin().arity(family)],
             0.1,
             &vec![p; builtin().arity(family)],
@@ -203,7 +202,7 @@ fn near_degenerate_configurations_stay_finite() {
             let offset = (q[b] - q[a]).normalize().any_orthonormal_vector() * 1e-6;
             q[v] = along + offset;
             for family in [Family::HEIGHT, Family::VOLUME] {
-                let e = builtin().evaluate(family, &q, 0.1, &q);
+                let e = builtin().constraint(family).evaluate(&q, 0.1, &q);
                 assert!(e.value.is_finite(), "{family:?} value at {q:?}");
                 assert!(
                     e.gradients.iter().all(|g| g.is_finite()),
@@ -211,7 +210,9 @@ fn near_degenerate_configurations_stay_finite() {
                 );
             }
             let pair = [q[v], q[v] + offset];
-            let d = builtin().evaluate(Family::EDGES, &pair, 0.1, &pair);
+            let d = builtin()
+                .constraint(Family::EDGES)
+                .evaluate(&pair, 0.1, &pair);
             assert!(d.value.is_finite() && d.gradients.iter().all(|g| g.is_finite()));
         }
     }

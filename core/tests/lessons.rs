@@ -4,7 +4,7 @@
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::input::shared_meshes;
-use tetlab_core::simulation::Engine;
+use tetlab_core::simulation::EngineChoice;
 use tetlab_core::teaching::lesson::{BUILTIN, Expectation, Lesson, LessonRun};
 
 /// The built-in lessons are the files of `assets/lessons`, every one, in file-name order and as
@@ -65,7 +65,7 @@ fn every_lesson_observes_what_it_says() {
         }
         let mut lesson = Lesson::builtin(number).unwrap_or_else(|e| panic!("{e}"));
         let engines = match lesson.settings.engine {
-            Engine::Auto => vec![Engine::Reference, Engine::Fast],
+            EngineChoice::Auto => vec![EngineChoice::Reference, EngineChoice::Fast],
             named => vec![named],
         };
         for engine in engines {

@@ -22,7 +22,7 @@ use tetlab_core::constraints::{Families, Family, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
 /// The built-in table with the file's two families, and those families (deviatoric, then
 /// hydrostatic).
@@ -40,7 +40,7 @@ fn table() -> (Families, [Family; 2]) {
     (families, [added[0], added[1]])
 }
 
-fn settings(active: PerFamily<bool>, engine: Engine, order_seed: Option<u64>) -> Settings {
+fn settings(active: PerFamily<bool>, engine: EngineChoice, order_seed: Option<u64>) -> Settings {
     Settings {
         active,
         engine,
@@ -57,7 +57,7 @@ fn every_projection_of_the_file_is_the_built_ins() {
     let both = table.per_family(|f| f == file[0] || f == file[1]);
     let mut simulation = Simulation::with_families(
         &scene,
-        settings(both, Engine::Reference, None),
+        settings(both, EngineChoice::Reference, None),
         table.clone(),
     );
     simulation.perturb(Perturbation::Mirror);
@@ -79,7 +79,7 @@ fn every_projection_of_the_file_is_the_built_ins() {
                         .collect();
                     let points: Vec<DVec3> = tet.iter().map(|&i| positions[i as usize]).collect();
                     let material = Material::default();
-                    let rest = table.rest_value(builtin, &shape, &material);
+                    let rest = table.constraint(builtin).rest_value(&shape, &material);
                     assert!(
                         (set.rest()[c] - rest).abs() <= 1e-15 * rest.abs().max(1.0),
                         "the rest values: {} against {rest}",
@@ -140,7 +140,7 @@ fn a_run_of_the_file_follows_the_built_in_on_both_engines() {
     let run = |active: PerFamily<bool>, frames: usize| {
         let mut simulation = Simulation::with_families(
             &scene,
-            settings(active, Engine::Reference, None),
+            settings(active, EngineChoice::Reference, None),
             table.clone(),
         );
         simulation.perturb(Perturbation::Mirror);
@@ -158,7 +158,7 @@ fn a_run_of_the_file_follows_the_built_in_on_both_engines() {
     println!("after 30 frames the positions differ by at most {gap:.1e} m");
     assert!(gap < 1e-8, "{gap}");
     // Outcome by outcome, both engines, four orders.
-    for engine in [Engine::Reference, Engine::Fast] {
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
         for order_seed in [None, Some(1), Some(2), Some(3)] {
             let outcomes: Vec<String> = [builtin, ours]
                 .into_iter()

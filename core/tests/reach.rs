@@ -8,7 +8,7 @@ use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::{Families, Family, PerFamily};
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
 use tetlab_core::simulation::projection::SkipCounts;
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
 /// A tet squeezed to 10⁻⁴ of its size under its volume constraint alone: ∇V (its face areas)
 /// all but vanishes while V − V₀ does not, so a projection would move its corners by about
@@ -17,7 +17,7 @@ use tetlab_core::simulation::{Engine, Settings, Simulation};
 /// stays where it is.
 #[test]
 fn a_step_beyond_the_reach_is_skipped_and_counted_on_both_engines() {
-    for engine in [Engine::Reference, Engine::Fast] {
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
         let far = |reach: f64| {
             let scene = Scene::builtin(Builtin::Tet, 1).unwrap();
             let mut settings = Settings {
@@ -68,7 +68,7 @@ fn a_correct_constraint_with_a_vanishing_gradient_does_not_diverge() {
     let family = families
         .register(ConstraintFile::load(&path).unwrap())
         .unwrap();
-    for engine in [Engine::Reference, Engine::Fast] {
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
         let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
         let mut active = PerFamily::builtin_list("edges,volume").unwrap();
         active.set(family, true);
@@ -111,9 +111,9 @@ fn the_reach_leaves_the_built_in_families_alone() {
         ] {
             for families in ["edges,volume", "edges,height,volume", "edges,neohookean"] {
                 for (engine, settle_edits) in [
-                    (Engine::Reference, true),
-                    (Engine::Fast, true),
-                    (Engine::Reference, false),
+                    (EngineChoice::Reference, true),
+                    (EngineChoice::Fast, true),
+                    (EngineChoice::Reference, false),
                 ] {
                     let scene = Scene::builtin(builtin, 2).unwrap();
                     let settings = Settings {

@@ -7,7 +7,9 @@ use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
-use tetlab_core::simulation::{DEFAULT_SUBSTEPS, DENSITY, Engine, Method, Settings, Simulation};
+use tetlab_core::simulation::{
+    DEFAULT_SUBSTEPS, DENSITY, EngineChoice, Method, Settings, Simulation,
+};
 
 // Counts each thread's allocations; the allocator needs `unsafe impl GlobalAlloc`.
 #[allow(unsafe_code)]
@@ -146,7 +148,7 @@ fn a_mirrored_cube_recovers_under_edges_and_volume() {
 /// and its writing back included.
 #[test]
 fn a_step_allocates_nothing() {
-    for engine in [Engine::Reference, Engine::Fast] {
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
         for method in [Method::Xpbd, Method::Pbd] {
             let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
             let mut simulation = Simulation::new(
@@ -170,7 +172,7 @@ fn a_step_allocates_nothing() {
             simulation.place(5, DVec3::ONE);
             simulation.step();
             assert_eq!(allocations(), before, "{engine:?}, {method:?}");
-            assert!(simulation.is_settling() || engine == Engine::Reference);
+            assert!(simulation.is_settling() || engine == EngineChoice::Reference);
         }
     }
 }
@@ -558,7 +560,7 @@ fn a_constraint_its_free_particles_can_barely_change_is_skipped() {
     let mut positions = simulation.positions().to_vec();
     positions[0] = DVec3::new(0.0, 1e-3, 1.0);
     simulation.set_positions(&positions);
-    let fast = tetlab_core::simulation::fast::FastSimulation::new(simulation.fast_start(), 1);
+    let fast = tetlab_core::simulation::fast::FastSimulation::new(simulation.start());
     simulation.step();
     let moved = simulation.positions()[0].distance(positions[0]);
     assert!(moved < 2.0, "the free corner was flung {moved} m");

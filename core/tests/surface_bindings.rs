@@ -9,7 +9,7 @@ use tetlab_core::constraints::{Binding, Families, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::scene::{Builtin, Scene};
-use tetlab_core::simulation::{Engine, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
 fn example(name: &str) -> ConstraintFile {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -89,7 +89,7 @@ fn a_non_manifold_edge_makes_no_hinge() {
 }
 
 /// The beam of lesson 10: soft edges alone, then with bending; on `engine`.
-fn beam(engine: Engine, bending: bool) -> Metrics {
+fn beam(engine: EngineChoice, bending: bool) -> Metrics {
     let mut families = Families::builtin();
     let family = families.register(example("bending.toml")).unwrap();
     let mut active = PerFamily::builtin_list("edges").unwrap();
@@ -112,7 +112,7 @@ fn beam(engine: Engine, bending: bool) -> Metrics {
 
 #[test]
 fn bending_on_the_hinges_holds_a_soft_beam_on_both_engines() {
-    for engine in [Engine::Reference, Engine::Fast] {
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
         let (soft, bent) = (beam(engine, false), beam(engine, true));
         println!(
             "{engine:?}: edges alone sag {:.3} m ({} inverted), with bending {:.4} m ({} inverted)",
@@ -128,7 +128,7 @@ fn the_surface_area_of_a_flattened_cube_comes_back_on_both_engines() {
     let mut families = Families::builtin();
     let area = families.register(example("surface-area.toml")).unwrap();
     let scene = Scene::builtin(Builtin::Cube, 3).unwrap();
-    for engine in [Engine::Reference, Engine::Fast] {
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
         let mut active = PerFamily::builtin_list("edges,volume").unwrap();
         active.set(area, true);
         let settings = Settings {

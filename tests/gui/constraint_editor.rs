@@ -128,7 +128,7 @@ fn a_wrong_gradient_is_named_by_the_check_and_drawn_beside_ads() {
     harness.run_steps(2);
     let family = harness.state().editor.family.unwrap();
     assert_eq!(families(&harness).name(family), "height-wrong-sign");
-    let active = harness.state().bench.simulation.settings().active;
+    let active = *harness.state().bench.simulation.active();
     assert!(active[family] && !active[families(&harness).parse("my-height").unwrap()]);
     harness.get_by_label("Check my gradient").click();
     harness.run_steps(2);
@@ -168,7 +168,7 @@ fn a_dropped_constraint_file_opens_in_the_editor() {
     let family = harness.state().editor.family.expect("dropped and defined");
     assert_eq!(families(&harness).name(family), "my-volume");
     assert!(harness.state().editor.open);
-    assert!(harness.state().bench.simulation.settings().active[family]);
+    assert!(harness.state().bench.simulation.active()[family]);
 
     let dir = std::env::temp_dir().join(format!("tetlab-editor-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -211,10 +211,13 @@ fn a_file_of_two_constraints_defines_both_from_the_editor() {
     let table = families(&harness);
     let deviatoric = table.parse("my-neohookean-deviatoric").unwrap();
     let hydrostatic = table.parse("my-neohookean-hydrostatic").unwrap();
-    let active = harness.state().bench.simulation.settings().active;
+    let active = *harness.state().bench.simulation.active();
     assert!(active[deviatoric] && active[hydrostatic]);
     assert!(!active[table.parse("my-height").unwrap()]);
-    assert_eq!(table.partner_in(deviatoric, &active), Some(hydrostatic));
+    assert_eq!(
+        table.unit_of(deviatoric, &active).partner,
+        Some(hydrostatic)
+    );
     assert_eq!(harness.state().editor.family, Some(deviatoric));
     // The solver panel shows the pair as one group, with the material's E and ν (its stiffness
     // is μ and λ): switched off and on together.
@@ -225,7 +228,7 @@ fn a_file_of_two_constraints_defines_both_from_the_editor() {
         .expect("the solver panel's checkbox")
         .click();
     harness.run_steps(2);
-    let active = harness.state().bench.simulation.settings().active;
+    let active = *harness.state().bench.simulation.active();
     assert!(!active[deviatoric] && !active[hydrostatic]);
     // The solver panel's (the compare panel below has one of the same name).
     harness
@@ -234,7 +237,7 @@ fn a_file_of_two_constraints_defines_both_from_the_editor() {
         .expect("the solver panel's checkbox")
         .click();
     harness.run_steps(2);
-    let active = harness.state().bench.simulation.settings().active;
+    let active = *harness.state().bench.simulation.active();
     assert!(active[deviatoric] && active[hydrostatic]);
     // Played from a mirror, the pair brings the cube back, as the built-in does.
     harness.key_press(egui::Key::M);

@@ -27,7 +27,7 @@ fn the_modes_window_shows_the_selected_tets_eigenvalues_and_draws_a_mode() {
             .bench
             .simulation
             .families()
-            .describe(&harness.state().bench.simulation.settings().active),
+            .describe(harness.state().bench.simulation.active()),
         "edges+volume"
     );
     harness.get_by_label_contains("Tet 0: E = ");
@@ -43,9 +43,7 @@ fn the_modes_window_shows_the_selected_tets_eigenvalues_and_draws_a_mode() {
     harness.run_steps(2);
     let simulation = harness.state().bench.simulation.clone();
     assert_eq!(
-        simulation
-            .families()
-            .describe(&simulation.settings().active),
+        simulation.families().describe(simulation.active()),
         "volume"
     );
     let modes = Modes::of_tet(&simulation, 0).unwrap();

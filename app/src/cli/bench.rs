@@ -12,8 +12,8 @@ use tetlab_core::input::limits;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::numbers::lanes::{LANES, REGISTERS};
 use tetlab_core::scene::Scene;
-use tetlab_core::simulation::fast::Order;
-use tetlab_core::simulation::{Engine, Simulation};
+use tetlab_core::simulation::fast::{FastSimulation, Order};
+use tetlab_core::simulation::{EngineChoice, Simulation};
 
 /// Options of `tetlab bench`.
 #[derive(Debug, clap::Args)]
@@ -152,11 +152,11 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             .map_err(UsageError::stdout);
     }
     settings.engine = match (args.reference, args.solver.engine) {
-        (true, _) => Engine::Reference,
+        (true, _) => EngineChoice::Reference,
         (false, Some(engine)) => engine.resolve(scene.mesh.tets.len()),
-        (false, None) => Engine::Fast,
+        (false, None) => EngineChoice::Fast,
     };
-    if args.jacobi && settings.engine != Engine::Fast {
+    if args.jacobi && settings.engine != EngineChoice::Fast {
         return Err(UsageError(
             "--jacobi: only the fast engine projects in Jacobi order".into(),
         ));
@@ -165,7 +165,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     simulation.set_threads(args.solver.threads.unwrap_or(1) as usize);
     super::simulation_args::warn_if_unstable(&simulation);
     let report = match settings.engine {
-        Engine::Fast => time_fast(args, &scene, &mut simulation)?,
+        EngineChoice::Fast => time_fast(args, &scene, &mut simulation)?,
         _ => time_reference(args, &scene, &mut simulation)?,
     };
     write_report(&report, args.json, out).map_err(UsageError::stdout)
@@ -183,7 +183,7 @@ fn time_reference(
         args,
         scene,
         simulation.families(),
-        simulation.settings().active,
+        *simulation.active(),
         "reference (f64)",
         1,
         projections,
@@ -194,27 +194,33 @@ fn time_reference(
     ))
 }
 
+/// The fast engine `simulation` steps on (its settings choose it).
+fn fast_engine(simulation: &mut Simulation) -> &mut FastSimulation {
+    (simulation.engine_as::<FastSimulation>())
+        .expect("bench runs the fast engine when asked for it")
+}
+
 fn time_fast(
     args: &Args,
     scene: &Scene,
     simulation: &mut Simulation,
 ) -> Result<Report, UsageError> {
     if args.jacobi {
-        simulation.fast_solver().set_order(Order::Jacobi {
+        fast_engine(simulation).set_order(Order::Jacobi {
             relaxation: args.relaxation,
         });
     }
     let elapsed = time(args, simulation, Simulation::step, |s| {
-        s.fast_solver().reset_timings();
+        fast_engine(s).reset_timings();
     });
     Metrics::measure_sound(simulation).map_err(|d| UsageError(d.to_string()))?;
     let families = simulation.families().clone();
-    let fast = simulation.fast_solver();
+    let fast = fast_engine(simulation);
     // The fast solver's own arrays (the simulation it steps keeps its f64 state beside them).
     let heap_bytes = fast.heap_bytes();
     fast.check().map_err(|d| UsageError(d.to_string()))?;
     let timings = fast.timings();
-    let active = fast.settings().active;
+    let active = fast.resolved().active;
     let per = |f: Family| {
         let n = timings.projections[f];
         if n == 0 {

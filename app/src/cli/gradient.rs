@@ -70,13 +70,15 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     }
     let rest_shape = rest_shape(
         args,
-        families.uses_rest_shape(family),
+        families.row(family).reads_rest_shape,
         &format!(
             "the {} constraint does not read a rest shape",
             families.name(family)
         ),
     )?;
-    let evaluation = families.evaluate(family, &args.points, args.rest, rest_shape);
+    let evaluation = families
+        .constraint(family)
+        .evaluate(&args.points, args.rest, rest_shape);
     let (analytic, numeric) =
         analytic_and_numeric(&families, family, &args.points, args.rest, rest_shape);
     let output = Output {

@@ -9,7 +9,7 @@ use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use tetlab_core::constraint_file::ConstraintFile;
-use tetlab_core::simulation::Engine;
+use tetlab_core::simulation::EngineChoice;
 use tetlab_core::teaching::lesson::{Action, BUILTIN, Lesson, LessonRun};
 
 /// Options of `tetlab lesson`.
@@ -33,8 +33,8 @@ pub struct Args {
     #[arg(long = "constraint-file", value_name = "FILE", conflicts_with = "list")]
     constraint_files: Vec<PathBuf>,
     /// The engine instead of the lesson's: auto, reference or fast, as for `tetlab run`.
-    #[arg(long, value_parser = Engine::parse, conflicts_with = "list")]
-    engine: Option<Engine>,
+    #[arg(long, value_parser = EngineChoice::parse, conflicts_with = "list")]
+    engine: Option<EngineChoice>,
     /// Threads for the fast engine (1..=256) [default: every core].
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256), conflicts_with = "list")]
     threads: Option<u64>,
@@ -98,7 +98,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     let spec = args.lesson.as_deref().expect("clap requires a lesson");
     let mut lesson = Lesson::find(spec).map_err(|e| UsageError(e.to_string()))?;
     if let Some(material) = args.material {
-        lesson.settings.set_material(material);
+        lesson.settings.material = material;
     }
     // A file named after one of the lesson's is an answer to its exercise, taken up at the
     // exercise; any other joins the active families now.
@@ -184,7 +184,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
         "engine {}{}{}",
         run.simulation.describe_engine(),
         super::simulation_args::describe_order(run.simulation.settings()),
-        super::simulation_args::describe_settling(run.simulation.settings())
+        super::simulation_args::describe_settling(run.simulation.resolved())
     );
     writeln!(out, "\n{engine}").map_err(UsageError::stdout)?;
     let mut all_observed = true;

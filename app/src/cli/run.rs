@@ -12,7 +12,7 @@ use tetlab_core::input::limits;
 use tetlab_core::measures::ensemble::{Ensemble, Member, Tally};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
-use tetlab_core::simulation::{Engine, Simulation};
+use tetlab_core::simulation::{EngineChoice, Simulation};
 
 /// Options of `tetlab run`.
 #[derive(Debug, clap::Args)]
@@ -79,7 +79,7 @@ impl FrameRecord {
     /// settings that decide the order and the settling. `start` is the centre of mass at frame 0.
     pub fn new(simulation: &Simulation, metrics: &Metrics, start: glam::DVec3) -> Self {
         let first = simulation.frame() == 0;
-        let settings = simulation.settings();
+        let (settings, active) = (simulation.resolved(), simulation.active());
         let families = simulation.families();
         let moved = metrics.centre_of_mass - start;
         FrameRecord {
@@ -95,12 +95,12 @@ impl FrameRecord {
             centre_of_mass_horizontal_displacement: moved.x.hypot(moved.z),
             residuals: families
                 .values(&metrics.residual)
-                .filter(|&(family, _)| settings.active[family])
+                .filter(|&(family, _)| active[family])
                 .map(|(family, value)| (format!("residual_{}", families.name(family)), value))
                 .collect(),
             skipped: families
                 .values(simulation.skipped())
-                .filter(|&(family, _)| settings.active[family])
+                .filter(|&(family, _)| active[family])
                 .flat_map(|(family, counts)| {
                     let name = families.name(family);
                     [
@@ -114,7 +114,7 @@ impl FrameRecord {
             edges: first.then(|| simulation.constraint_count(Family::EDGES)),
             engine: first.then(|| simulation.engine().name()),
             threads: first.then(|| simulation.threads()),
-            order_seed: first.then_some(settings.order_seed),
+            order_seed: first.then_some(settings.settings.order_seed),
             edits_settle: first.then(|| settings.edits_settle()),
         }
     }
@@ -189,7 +189,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             writeln!(out, "{line}").map_err(io)?;
         }
         if let Some(warning) = outcome.thrown_warning() {
-            let advice = if simulation.settings().edits_settle() {
+            let advice = if simulation.resolved().edits_settle() {
                 ""
             } else if simulation.settings().settle_edits {
                 " (edits do not settle while a material is active)"
@@ -208,8 +208,8 @@ fn run_ensemble(args: &Args, n: u64, out: &mut impl Write) -> Result<(), UsageEr
     let io = UsageError::stdout;
     let (scene, simulation) = args.simulation.build()?;
     let engines = match args.simulation.solver.engine {
-        Some(engine @ (Engine::Reference | Engine::Fast)) => vec![engine],
-        _ => vec![Engine::Reference, Engine::Fast],
+        Some(engine) if engine != EngineChoice::Auto => vec![engine],
+        _ => EngineChoice::engines().collect(),
     };
     let ensemble = Ensemble {
         scene: &scene,

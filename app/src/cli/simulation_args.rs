@@ -9,7 +9,7 @@ use tetlab_core::constraints::{Families, Family};
 use tetlab_core::input::limits::{self, Number};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Perturbation, Scene};
-use tetlab_core::simulation::{Engine, Method, Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Method, Resolved, Settings, Simulation};
 
 /// Scene and solver options.
 #[derive(Debug, Clone, clap::Args)]
@@ -85,7 +85,7 @@ impl FamilyArgs {
             settings.active.set(family, true);
         }
         if let Some(material) = self.material {
-            settings.set_material(material);
+            settings.material = material;
         }
         for NamedValue { name, value } in &self.compliance {
             let family = tetlab_core::simulation::settable_family(&families, name)
@@ -110,8 +110,8 @@ pub struct SolverArgs {
     /// Which solver steps the simulation: reference (f64, one constraint at a time), fast (f32,
     /// coloured, in SIMD lanes, on threads) or auto (reference below 1000 tets, fast from there)
     /// [default: auto; bench: fast].
-    #[arg(long, value_parser = Engine::parse)]
-    pub engine: Option<Engine>,
+    #[arg(long, value_parser = EngineChoice::parse)]
+    pub engine: Option<EngineChoice>,
     /// Threads for the fast engine (1..=256; the results are the same for any count) [default:
     /// every core; bench: 1].
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
@@ -211,7 +211,7 @@ impl SolverArgs {
             "engine {}, {}, {}, {} substeps x {} iteration{}, dt {:.6} s, gravity {}",
             simulation.describe_engine(),
             s.method.name(),
-            families.describe(&s.active),
+            families.describe(simulation.active()),
             s.substeps,
             s.iterations,
             if s.iterations == 1 { "" } else { "s" },
@@ -224,7 +224,7 @@ impl SolverArgs {
         for NamedValue { name, value } in &self.stiffness {
             text += &format!(", stiffness {name}={value}");
         }
-        let uses_material = s.active.families().any(|f| s.from_material[f]);
+        let uses_material = simulation.resolved().material_family().is_some();
         if uses_material || self.families.material.is_some() {
             text += &format!(", material {}", s.material.describe());
         }
@@ -232,7 +232,7 @@ impl SolverArgs {
         if s.reach != Settings::default().reach {
             text += &format!(", reach {} rest edges", s.reach.show());
         }
-        for family in s.active.families() {
+        for family in simulation.active().families() {
             if let Some(file) = families.file(family) {
                 let gradient = if file.use_gradient {
                     "its own gradient"
@@ -284,7 +284,7 @@ impl SimulationArgs {
 
     /// What [`SolverArgs::describe`] says of `simulation`'s settings, and whether edits settle.
     pub fn describe(&self, simulation: &Simulation) -> String {
-        self.solver.describe(simulation) + &describe_settling(simulation.settings())
+        self.solver.describe(simulation) + &describe_settling(simulation.resolved())
     }
 }
 
@@ -297,9 +297,9 @@ pub fn describe_order(settings: &Settings) -> String {
 }
 
 /// ", edits settle", ", edits do not settle (--no-settle-edits)", or why they do not settle
-/// although asked to ([`Settings::edits_settle`]: a material is active).
-pub fn describe_settling(settings: &Settings) -> String {
-    match (settings.settle_edits, settings.edits_settle()) {
+/// although asked to ([`Resolved::edits_settle`]: a material is active).
+pub fn describe_settling(resolved: &Resolved) -> String {
+    match (resolved.settings.settle_edits, resolved.edits_settle()) {
         (_, true) => ", edits settle".to_owned(),
         (false, false) => ", edits do not settle (--no-settle-edits)".to_owned(),
         (true, false) => ", edits do not settle while neohookean is active (a material carries \

@@ -11,7 +11,7 @@ use std::time::Instant;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::validation::{self, Case, Check, Trial, Unwatched, Watch};
 use tetlab_core::scene::Scene;
-use tetlab_core::simulation::{Engine, Simulation};
+use tetlab_core::simulation::{EngineChoice, Simulation};
 
 /// Options of `tetlab validate`.
 #[derive(Debug, clap::Args)]
@@ -73,14 +73,16 @@ pub fn main(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
             .collect(),
     };
     let engines = match args.engine.as_str() {
-        "both" => vec![Engine::Reference, Engine::Fast],
-        other => match Engine::parse(other) {
-            Ok(Engine::Auto) | Err(_) => {
+        "both" => EngineChoice::engines().collect(),
+        other => match EngineChoice::parse(other) {
+            Ok(engine) if engine != EngineChoice::Auto => vec![engine],
+            _ => {
+                let names: Vec<&str> = EngineChoice::engines().map(|e| e.name()).collect();
                 return Err(UsageError(format!(
-                    "--engine: '{other}' is not an engine to validate: expected both, reference or fast"
+                    "--engine: '{other}' is not an engine to validate: expected both, {}",
+                    names.join(", ")
                 )));
             }
-            Ok(engine) => vec![engine],
         },
     };
     if let Some(path) = &args.json {
@@ -152,7 +154,7 @@ pub fn main(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
 /// Every case on every engine: the checks, or `None` when Ctrl-C stopped the suite.
 fn run(
     cases: &[&'static Case],
-    engines: &[Engine],
+    engines: &[EngineChoice],
     threads: usize,
     full: bool,
     watch: &mut dyn Watch,

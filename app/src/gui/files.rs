@@ -23,7 +23,7 @@ pub enum Opened {
 }
 
 /// Opens a mesh or lesson file by path. A TetGen mesh is read from its two files (`.node` and
-/// `.ele`); anything else is read here and opened by [`open_bytes`], as in a browser.
+/// `.ele`); anything else is read here and opened by `open_bytes`, as in a browser.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn open_path(path: &str) -> Result<Opened, String> {
     let path = std::path::Path::new(path);

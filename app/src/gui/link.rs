@@ -18,7 +18,7 @@ use std::fmt;
 use tetlab_core::constraints::Families;
 use tetlab_core::constraints::material::Material;
 use tetlab_core::scene::{Builtin, Perturbation};
-use tetlab_core::simulation::{Engine, Method, Settings};
+use tetlab_core::simulation::{EngineChoice, Method, Settings};
 
 /// The address the desktop workbench puts before a fragment: where `scripts/web.sh` says to serve
 /// the page. `TETLAB_PAGE_URL` replaces it (e.g. the address a class uses).
@@ -149,7 +149,7 @@ impl Link {
         }
         for family in families.all() {
             // The material gives these; `material` carries them.
-            if families.compliance_from_material(family).is_some() {
+            if families.row(family).compliance_from_material.is_some() {
                 continue;
             }
             if s.compliance[family] != defaults.compliance[family] {
@@ -237,7 +237,7 @@ impl Link {
                         .map_err(wrong)?
                 }
                 "method" => s.method = Method::parse(&value).map_err(wrong)?,
-                "engine" => s.engine = Engine::parse(&value).map_err(wrong)?,
+                "engine" => s.engine = EngineChoice::parse(&value).map_err(wrong)?,
                 "substeps" => s.substeps = count(&value)?,
                 "iterations" => s.iterations = count(&value)?,
                 "dt" => s.dt = number(&value)?,
@@ -246,7 +246,7 @@ impl Link {
                 "grab" => s.grab_compliance = number(&value)?,
                 "ground" => s.ground = switch(&value)?,
                 "settle" => s.settle_edits = switch(&value)?,
-                "material" => s.set_material(Material::parse(&value).map_err(wrong)?),
+                "material" => s.material = Material::parse(&value).map_err(wrong)?,
                 "lesson" => lesson = Some(count(&value)? as usize),
                 "step" => step = Some(count(&value)? as usize),
                 "camera" => {
@@ -380,7 +380,7 @@ mod tests {
         let mut settings = crate::gui::Preferences::default().settings;
         settings.active = PerFamily::builtin_list("edges,height,neohookean").unwrap();
         settings.method = Method::Pbd;
-        settings.engine = Engine::Fast;
+        settings.engine = EngineChoice::Fast;
         settings.substeps = 37;
         settings.dt = 1.0 / 30.0;
         settings.gravity = 0.0;
@@ -388,7 +388,7 @@ mod tests {
         settings.settle_edits = false;
         settings.compliance[Family::EDGES] = 1e-4;
         settings.stiffness[Family::HEIGHT] = 0.5;
-        settings.set_material(Material::parse("E=2e5,nu=0.45").unwrap());
+        settings.material = Material::parse("E=2e5,nu=0.45").unwrap();
         let link = Link {
             scene: Some((Builtin::Ball, 2)),
             settings,

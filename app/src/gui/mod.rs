@@ -1,7 +1,7 @@
 //! The interactive workbench: an eframe app on wgpu. The 3D view is in [`viewport`] (drawing in
 //! [`render`], what to draw in [`geometry`]), the state in [`workbench`], and each panel in a
-//! file of its own under [`panels`], all with one signature: they draw and add [`Request`]s,
-//! which [`TetlabApp::ui`] carries out in one loop once every panel is drawn.
+//! file of its own under [`panels`], all with one signature: they draw and add [`request::Request`]s,
+//! which the app (`app/frame.rs`) carries out in one loop once every panel is drawn.
 
 pub mod app;
 #[cfg(not(target_arch = "wasm32"))]

@@ -1,5 +1,5 @@
 //! Where the workbench runs, as the workbench sees it: the few things a browser page gives that a
-//! desktop window does not. The GUI calls this interface; the page ([`crate::web`]) implements it
+//! desktop window does not. The GUI calls this interface; the page (`web.rs`) implements it
 //! and starts the GUI, so the GUI never imports the page.
 
 use super::report::Report;

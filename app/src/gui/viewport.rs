@@ -1,5 +1,5 @@
 //! The 3D view as a widget: camera input, picking and dragging particles, and the paint
-//! callback that draws [`geometry::build`]'s output with the [`render`] renderer.
+//! callback that draws [`geometry::build`]'s output with the [`super::render`] renderer.
 //!
 //! Left-drag on a particle moves it (through the grab constraint while playing, directly while
 //! paused); left-drag elsewhere orbits, right- or middle-drag pans, the wheel zooms, a click
@@ -246,7 +246,7 @@ fn legend(ui: &egui::Ui, rect: Rect, bench: &Workbench, options: &ViewOptions) {
     if stepping {
         entry(geometry::PENDING, "next projection".to_owned());
     }
-    let active = bench.simulation.settings().active;
+    let active = *bench.simulation.active();
     let families = bench.simulation.families();
     for family in families.all().filter(|&f| options.arrows && active.get(f)) {
         for quantity in visual::Quantity::of_family(families, family) {

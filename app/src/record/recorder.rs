@@ -84,7 +84,7 @@ impl<'a> Recorder<'a> {
         // The constraint files of the families in use, as written: what the arrows of
         // `world/gradients/<name>` are the gradient of.
         let families = simulation.families();
-        for family in simulation.settings().active.families() {
+        for family in simulation.active().families() {
             if let Some(file) = families.file(family) {
                 let text = format!(
                     "# {}\n\n{}\n\n```toml\n{}\n```",
@@ -234,7 +234,7 @@ impl<'a> Recorder<'a> {
             Some(1.0),
             &mut self.arrow_scratch,
         );
-        let active = simulation.settings().active;
+        let active = *simulation.active();
         let families = simulation.families();
         let quantities = families
             .all()

@@ -49,7 +49,7 @@ impl Summary {
 
     /// Decodes a whole recording from `reader`. A damaged recording is an error, never a panic
     /// and never an allocation larger than the recording: its framing is checked first
-    /// ([`check_message_lengths`]), and a panic inside Rerun's decoder (which some damaged
+    /// (`check_message_lengths`), and a panic inside Rerun's decoder (which some damaged
     /// files cause, in arrow's schema conversion) is caught and reported as damage.
     pub fn decode<R: Read + Seek>(mut reader: R) -> Result<Summary, String> {
         check_message_lengths(&mut reader)?;

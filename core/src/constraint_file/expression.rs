@@ -2,11 +2,11 @@
 //! is `expression.pest` (the pest crate): numbers, names, calls `f(a, b)`, components `v.x`,
 //! unary −, `+ − * /` with the usual precedence, left to right, and comparisons `< <= > >=` as
 //! the condition of `if(…)`. An expression may span lines. Types are checked later, when the
-//! tree is compiled ([`super::program`]).
+//! tree is compiled (`super::program`).
 //!
 //! # Nothing the parser reads can crash it
 //! The parser and the compiler recurse into the tree, so a tree must be shallow enough for any
-//! stack, the browser's 1 MB included. Before pest sees the text, [`check_depth`] measures how
+//! stack, the browser's 1 MB included. Before pest sees the text, `check_depth` measures how
 //! deep its tree would be (one level per open parenthesis, unary −, and operator of a chain,
 //! which builds a left-leaning tree) in one pass that does not recurse, and refuses a text that
 //! would be deeper than [`MAX_DEPTH`] or longer than [`MAX_LENGTH`], at the byte where it
@@ -22,7 +22,7 @@ mod grammar {
     #![allow(missing_docs)]
     #[derive(pest_derive::Parser)]
     #[grammar = "constraint_file/expression.pest"]
-    pub struct Grammar;
+    pub(super) struct Grammar;
 }
 use grammar::{Grammar, Rule};
 
@@ -156,7 +156,7 @@ static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
 pub const MAX_DEPTH: usize = 100;
 
 /// The longest text an expression (or the whole of `define`) may be, in bytes: a formula that
-/// fits in [`super::program::MAX_REGISTERS`] operations is a few kilobytes at most.
+/// fits in `super::program::MAX_REGISTERS` operations is a few kilobytes at most.
 pub const MAX_LENGTH: usize = 64 * 1024;
 
 /// Refuses a text whose tree would be deeper than [`MAX_DEPTH`] or that is longer than
@@ -166,16 +166,7 @@ pub const MAX_LENGTH: usize = 64 * 1024;
 /// The depth counted is an upper bound of the tree's: each open parenthesis adds a level for
 /// what is inside it, and within a parenthesis (or a call's argument, or a definition) each
 /// unary − and each binary operator adds one, since `a + b + c` is `(a + b) + c`.
-///
-/// ```
-/// use tetlab_core::constraint_file::expression::{check_depth, MAX_DEPTH};
-/// assert!(check_depth("-(1 + 2) * sqrt(3)").is_ok());
-/// let deep = format!("{}1{}", "(".repeat(MAX_DEPTH + 1), ")".repeat(MAX_DEPTH + 1));
-/// let e = check_depth(&deep).unwrap_err();
-/// assert_eq!(e.offset, MAX_DEPTH);
-/// assert!(e.message.contains("too deeply"));
-/// ```
-pub fn check_depth(text: &str) -> Result<(), SyntaxError> {
+pub(crate) fn check_depth(text: &str) -> Result<(), SyntaxError> {
     // The depth of the enclosing parentheses, and within the innermost one the operators so far.
     let mut open: Vec<(usize, usize)> = Vec::new();
     let (mut level, mut chain) = (0usize, 0usize);
@@ -236,15 +227,7 @@ pub fn check_depth(text: &str) -> Result<(), SyntaxError> {
 }
 
 /// Parses one expression.
-///
-/// ```
-/// use tetlab_core::constraint_file::expression::{parse_expression, Expr};
-/// // Precedence: 1 + 2 * 3 is 1 + (2 * 3).
-/// let Expr::Binary(op, _, right, _) = parse_expression("1 + 2 * 3").unwrap() else { panic!() };
-/// assert_eq!(op.symbol(), "+");
-/// assert!(matches!(*right, Expr::Binary(..)));
-/// ```
-pub fn parse_expression(text: &str) -> Result<Expr, SyntaxError> {
+pub(crate) fn parse_expression(text: &str) -> Result<Expr, SyntaxError> {
     check_depth(text)?;
     let mut pairs = Grammar::parse(Rule::expression, text).map_err(|e| syntax_error(text, e))?;
     let expression = pairs.next().expect("the grammar's root");
@@ -256,7 +239,7 @@ pub fn parse_expression(text: &str) -> Result<Expr, SyntaxError> {
 }
 
 /// Parses `define`: one `name = expression` per line, in order.
-pub fn parse_definitions(text: &str) -> Result<Vec<(String, Span, Expr)>, SyntaxError> {
+pub(crate) fn parse_definitions(text: &str) -> Result<Vec<(String, Span, Expr)>, SyntaxError> {
     check_depth(text)?;
     let mut pairs = Grammar::parse(Rule::definitions, text).map_err(|e| syntax_error(text, e))?;
     let root = pairs.next().expect("the grammar's root");
@@ -373,4 +356,37 @@ fn argument(pair: Pair<'_, Rule>) -> Expr {
     };
     let right = build(inner.next().expect("a comparison has two sides"));
     Expr::Compare(op, Box::new(left), Box::new(right), span)
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `parse_expression`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn parse_expression_example() {
+        use crate::constraint_file::expression::{Expr, parse_expression};
+        // Precedence: 1 + 2 * 3 is 1 + (2 * 3).
+        let Expr::Binary(op, _, right, _) = parse_expression("1 + 2 * 3").unwrap() else {
+            panic!()
+        };
+        assert_eq!(op.symbol(), "+");
+        assert!(matches!(*right, Expr::Binary(..)));
+    }
+
+    /// The example of `check_depth`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn check_depth_example() {
+        use crate::constraint_file::expression::{MAX_DEPTH, check_depth};
+        assert!(check_depth("-(1 + 2) * sqrt(3)").is_ok());
+        let deep = format!(
+            "{}1{}",
+            "(".repeat(MAX_DEPTH + 1),
+            ")".repeat(MAX_DEPTH + 1)
+        );
+        let e = check_depth(&deep).unwrap_err();
+        assert_eq!(e.offset, MAX_DEPTH);
+        assert!(e.message.contains("too deeply"));
+    }
 }

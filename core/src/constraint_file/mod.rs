@@ -18,7 +18,7 @@
 //! p1 = "n"
 //! ```
 //! `rest` is `value` with rest = 0 on the rest configuration, unless `rest = "…"` gives it.
-//! Expressions ([`expression`], [`program`]) over scalars, 3-vectors and 3×3 matrices, over several
+//! Expressions ([`expression`], `program`) over scalars, 3-vectors and 3×3 matrices, over several
 //! lines if need be: `+ − * /`, components (`v.x`, `M.xy`), the functions `dot cross length
 //! normalize det vec3 mat3 outer transpose inverse trace norm sqrt cbrt pow exp log sin cos tan
 //! asin acos atan2 abs sign min max clamp if`, the rest shape (`q0`…, `Dm`, `Ds`, `F`, `V0`) and
@@ -33,7 +33,7 @@ pub mod check;
 pub mod expression;
 pub mod grade;
 mod parse;
-pub mod program;
+mod program;
 
 use crate::constraints::Binding;
 use crate::constraints::material::Material;
@@ -353,7 +353,7 @@ impl ConstraintFile {
     }
 
     /// [`ConstraintFile::store`] in any precision.
-    pub fn store_in<T: Real>(
+    pub(crate) fn store_in<T: Real>(
         &self,
         rest_shape: &[[T; 3]],
         material: &Material,
@@ -414,7 +414,7 @@ impl ConstraintFile {
     /// The Hessian blocks the file gives (`[hessian]`), ∂²C/∂pᵢ∂pⱼ at `points` with rest value
     /// `rest`: each (i, j) and the 3 × 3 block, entry (r, c) = ∂²C/∂pᵢ[r]∂pⱼ[c]. Empty when the
     /// file gives none.
-    pub fn your_hessian(
+    pub(crate) fn your_hessian(
         &self,
         points: &[DVec3],
         rest: f64,
@@ -453,10 +453,10 @@ impl ConstraintFile {
 
     /// C and ∇C at `p` with rest value `rest`, in the precision of `V` (f64, f32, the fast
     /// solver's lanes), as a simulation uses them: ∇C by reverse-mode AD
-    /// ([`program::Tape::gradient`]) or, with `use_gradient`, the file's own (a particle it gives
+    /// (the gradient tape `Program::differentiate` compiles) or, with `use_gradient`, the file's own (a particle it gives
     /// none for gets AD's). Where C or ∇C is not finite, the evaluation is degenerate: C is 0
     /// there and ∇C zero. Allocates nothing: the registers are on the stack
-    /// ([`program::MAX_REGISTERS`]).
+    /// (`program::MAX_REGISTERS`).
     ///
     /// # Panics
     /// When `N` is not the file's arity.
@@ -507,7 +507,7 @@ impl ConstraintFile {
     /// # Panics
     /// When `N` is not the file's arity.
     #[inline(always)]
-    pub fn value_and_gradient<T: Real, const N: usize>(
+    pub(crate) fn value_and_gradient<T: Real, const N: usize>(
         &self,
         points: &[[T; 3]; N],
         rest: T,
@@ -528,7 +528,7 @@ impl ConstraintFile {
 
     /// How many numbers the registers of the tape of C and ∇C are ([`program::Tape::slots`]):
     /// what [`ConstraintFile::gradient_placed`]'s registers must hold.
-    pub fn gradient_slots(&self, own: bool) -> usize {
+    pub(crate) fn gradient_slots(&self, own: bool) -> usize {
         if own { &self.yours } else { &self.gradient }.slots()
     }
 
@@ -541,7 +541,7 @@ impl ConstraintFile {
     /// # Panics
     /// When `registers` is too short.
     #[inline(always)]
-    pub fn gradient_placed<T: Real, R>(
+    pub(crate) fn gradient_placed<T: Real, R>(
         &self,
         (own, registers): (bool, &mut [T]),
         place: impl FnOnce(&mut [T], &[u8]),
@@ -551,7 +551,7 @@ impl ConstraintFile {
         tape.run_placed(registers, place, read)
     }
 
-    /// ∇C in f64 as [`ConstraintFile::evaluate_by`] gives it (the file's own with `own`, else
+    /// ∇C in f64 as `ConstraintFile::evaluate_by` gives it (the file's own with `own`, else
     /// AD's), for `points` given as a slice of the file's arity, padded to four.
     pub fn gradients_of(
         &self,
@@ -668,12 +668,6 @@ impl ConstraintFile {
     /// Line and column of byte `offset` of the expression whose TOML value starts at `base`.
     fn place(&self, base: usize, offset: usize) -> (usize, usize) {
         position(&self.source, file_offset(&self.source, base, offset))
-    }
-
-    /// The instructions of C's tape and of the tape of C and ∇C by AD, for the record of what an
-    /// evaluation costs.
-    pub fn tape_lengths(&self) -> (usize, usize) {
-        (self.value.len(), self.gradient.len())
     }
 
     fn coordinates(&self, points: &[DVec3]) -> ArrayVec<[f64; 3], 4> {

@@ -1,7 +1,7 @@
 //! A constraint file's family as a [`Constraint`]: its compiled tape gives C and ∇C. The file
 //! joins the table of families in [`super::Families`].
 
-use super::{Constraint, Evaluation, PairGroup};
+use super::{Constraint, Evaluation};
 use super::{GROUP, MAX_STORED, Stored};
 use crate::constraint_file::{ConstraintFile, sound};
 use crate::constraints::material::Material;
@@ -10,26 +10,20 @@ use crate::numbers::lanes::{F32x8, Vec3x8};
 use crate::numbers::vector::{Real, Vector3};
 use arrayvec::ArrayVec;
 use glam::DVec3;
+use std::sync::Arc;
 
 /// A constraint file's family as a [`Constraint`] on N particles: C and ∇C from the file's
 /// compiled tape ([`ConstraintFile::evaluate_vectors`]), the rest value as the file defines it.
-/// Whether it reads the rest shape is the file's ([`ConstraintFile::reads_rest_shape`]), asked at
-/// run time, so that the solvers' code for files is compiled once per arity.
-pub struct FileConstraint<'a, const N: usize>(pub &'a ConstraintFile);
+/// Whether it reads the rest shape is the file's ([`ConstraintFile::reads_rest_shape`], its row's
+/// [`super::Row::reads_rest_shape`]), so that the solvers' code for files is compiled once per
+/// arity.
+pub struct FileConstraint<const N: usize>(pub Arc<ConstraintFile>);
 
-impl<const N: usize> Constraint<N> for FileConstraint<'_, N> {
+impl<const N: usize> Constraint<N> for FileConstraint<N> {
     // What a file's tapes read of the rest shape at each projection is stored.
     const STORED_USES_REST_SHAPE: bool = false;
-    // μ and λ may appear in what an element stores and in its rest value.
-    const REST_USES_MATERIAL: bool = true;
     // The tape's dispatch on each instruction, paid once for GROUP batches.
     const GROUPED: bool = true;
-    // A file's `pair`.
-    const PAIR_GROUP: PairGroup = PairGroup::File;
-
-    fn uses_rest_shape(&self) -> bool {
-        self.0.reads_rest_shape()
-    }
 
     /// C and ∇C with what the element stores worked out here from `rest_shape` and the default
     /// material: for the checkers and readers that hold no stored values (the solvers call
@@ -58,7 +52,7 @@ impl<const N: usize> Constraint<N> for FileConstraint<'_, N> {
         self.0.evaluate_vectors(p, rest, stored)
     }
 
-    /// The GROUP batches as one [`Block`] of lanes through the tape, then each batch's lanes
+    /// The GROUP batches as one `Block` of lanes through the tape, then each batch's lanes
     /// taken out: each lane computes what it computes in [`Constraint::evaluate_stored`].
     #[inline(always)]
     // Indexed loops: the iterator forms compiled to copies of these wide arrays.
@@ -75,12 +69,8 @@ impl<const N: usize> Constraint<N> for FileConstraint<'_, N> {
             gradients: [Vec3x8::ZERO; N],
             degenerate: F32x8::ZERO.finite(),
         }; GROUP];
-        through_tape(self.0, p, (rest, stored), &mut out);
+        through_tape(&self.0, p, (rest, stored), &mut out);
         out
-    }
-
-    fn stored_len(&self) -> usize {
-        self.0.stored_len()
     }
 
     fn store(&self, rest_shape: &[DVec3; N], material: &Material) -> Stored {

@@ -13,27 +13,40 @@
 //! | [`neohookean`] deviatoric | p0, p1, p2, p3 | √V₀ ‖F‖_F, F = Ds Dm⁻¹ |
 //! | [`neohookean`] hydrostatic | p0, p1, p2, p3 | √V₀ (det F − γ), γ = 1 + μ/λ |
 //!
-//! Each is a [`Constraint`] type; a [`Families`] value ([`families`]) is the table of families
-//! that everything else reads: the built-in ones, and those of constraint files ([`file`]). [`material`]
-//! turns Young's modulus and Poisson's ratio into the compliances of the families that take them.
+//! Each is a [`Constraint`] type, one formula generic over the number type. What a family is
+//! besides its formula (names, colour, binding, material, what it reads and stores) is data, its
+//! [`Row`] (`row`); the built-in rows are `builtin`, one entry each. A [`Families`] value
+//! (`family_table`) is the table of families that everything else reads: the built-in ones, and
+//! those of constraint files ([`mod@file`]). The solvers reach a family's type through `dispatch`;
+//! tools ask any family in f64 through `any`. [`material`] turns Young's modulus and Poisson's
+//! ratio into the compliances of the families that take them.
 //!
 //! When a gradient is undefined (coincident points, a face of zero area) the evaluation is
 //! flagged ([`Evaluation::degenerate`]), its gradients are zero and its value stays finite.
 
+mod any;
+mod binding;
+mod builtin;
+mod dispatch;
 pub mod distance;
-pub mod families;
-pub mod family;
+mod family_table;
 pub mod file;
 pub mod height;
 pub mod material;
 pub mod neohookean;
-mod table;
+mod per_family;
+mod row;
 pub mod verify;
+mod visit;
 pub mod volume;
 
-pub use families::{Families, Named};
-pub use family::{Binding, Family, MAX_FAMILIES, PerFamily, Row, TABLE, Visit, VisitPair};
-pub use table::Formula;
+pub use any::{AnyConstraint, Typed};
+pub use binding::Binding;
+pub use builtin::TABLE;
+pub use family_table::{COLOURS, Families, MAX_FILE_FAMILIES, Named};
+pub use per_family::PerFamily;
+pub use row::{Family, Formula, MAX_FAMILIES, Row};
+pub use visit::{Pair, Projected, Unit, Visit, VisitProjected};
 
 use crate::constraints::material::Material;
 use crate::numbers::lanes::{F32x8, Vec3x8};
@@ -51,47 +64,6 @@ pub const MAX_STORED: usize = 48;
 /// What an element stores ([`Constraint::store`]).
 pub type Stored = arrayvec::ArrayVec<f64, MAX_STORED>;
 
-/// The constraints that can be projected together as a pair ([`Constraint::PAIR_GROUP`]).
-///
-/// A pair is projected by the family that comes first in the table
-/// ([`Families::partner_in`](families::Families::partner_in)): the built-in neo-Hookean pair
-/// always by its deviatoric half, a pair of files by either.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PairGroup {
-    /// Never half of a pair.
-    None,
-    /// The built-in neo-Hookean energy's deviatoric half, which leads its pair.
-    NeoHookeanDeviatoric,
-    /// The built-in neo-Hookean energy's hydrostatic half, which the deviatoric one leads.
-    NeoHookeanHydrostatic,
-    /// The constraints of constraint files (a file's `pair`).
-    File,
-}
-
-/// Whether constraints of types `A` and `B` can be a pair led by `A`: the neo-Hookean
-/// deviatoric half before the hydrostatic one, or two constraint files, on the same particles
-/// (N = M). The solvers' pair code is compiled for these only.
-///
-/// ```
-/// use tetlab_core::constraints::neohookean::{Deviatoric, Hydrostatic};
-/// use tetlab_core::constraints::{pairs, volume::Volume};
-/// assert!(pairs::<4, Deviatoric, 4, Hydrostatic>());
-/// assert!(!pairs::<4, Hydrostatic, 4, Deviatoric>()); // the table puts the deviatoric half first
-/// assert!(!pairs::<4, Deviatoric, 4, Deviatoric>());
-/// assert!(!pairs::<4, Volume, 4, Hydrostatic>());
-/// assert!(!pairs::<4, Volume, 4, Volume>());
-/// ```
-pub const fn pairs<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>>() -> bool {
-    N == M
-        && matches!(
-            (A::PAIR_GROUP, B::PAIR_GROUP),
-            (
-                PairGroup::NeoHookeanDeviatoric,
-                PairGroup::NeoHookeanHydrostatic
-            ) | (PairGroup::File, PairGroup::File)
-        )
-}
-
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or
 /// eight constraints at once in SIMD lanes).
 pub trait Constraint<const N: usize>: Sync {
@@ -101,33 +73,20 @@ pub trait Constraint<const N: usize>: Sync {
     /// solvers' loops are compiled with it.
     const STORED_USES_REST_SHAPE: bool = false;
 
-    /// Whether [`Constraint::rest_value`] depends on the material, so that the rest values are
-    /// measured again when it changes.
-    const REST_USES_MATERIAL: bool = false;
-
-    /// Which constraints of another family this one may be projected together with, as a pair
-    /// ([`Row::projected_with`]): those of the same group. The solvers' pair kernels are compiled
-    /// for such two types only, not for every two families of the table ([`pairs`]).
-    const PAIR_GROUP: PairGroup = PairGroup::None;
+    /// Whether the fast engine should evaluate this family [`GROUP`] batches at a time
+    /// ([`Constraint::evaluate_batches`]) rather than one: for a family whose evaluation costs
+    /// something per call whatever the lanes (a constraint file's tape pays its dispatch on each
+    /// instruction once per call).
+    const GROUPED: bool = false;
 
     /// C and ∇C at `p`, with rest value `rest` (d, V) and the particles' rest positions
-    /// `rest_shape`.
+    /// `rest_shape`: the one formula a family must write.
     fn evaluate<V: Vector3>(
         &self,
         p: &[V; N],
         rest: V::Real,
         rest_shape: &[V; N],
     ) -> Evaluation<V, N>;
-
-    /// Whether [`Constraint::evaluate`] reads `rest_shape`. When it does not, callers may pass
-    /// the current positions there (the gradient check and `tetlab gradient` then ask for no
-    /// rest shape). A method rather than a constant, so that a constraint file's family is one
-    /// type whether its formula reads the rest shape or not: the solvers' code for files is
-    /// compiled once per arity. By default, what the solvers' [`Constraint::evaluate_stored`]
-    /// reads.
-    fn uses_rest_shape(&self) -> bool {
-        Self::STORED_USES_REST_SHAPE
-    }
 
     /// The rest value of a constraint whose particles are at rest at `rest_shape`: unless the
     /// family says otherwise, C there with rest value 0 (the rest length d, the rest volume V),
@@ -137,17 +96,11 @@ pub trait Constraint<const N: usize>: Sync {
         self.evaluate(rest_shape, 0.0, rest_shape).value
     }
 
-    /// How many numbers each constraint stores beyond its rest value: what depends only on its
-    /// rest shape and the material, worked out once per element ([`Constraint::store`]). The
-    /// built-in families store none (they work everything out at each projection); a
-    /// constraint file's stores what its prelude computes
-    /// ([`crate::constraint_file::program::Compiled`]).
-    fn stored_len(&self) -> usize {
-        0
-    }
-
-    /// What a constraint at rest at `rest_shape` stores, with `material`: [`Constraint::stored_len`]
-    /// numbers.
+    /// What a constraint at rest at `rest_shape` stores, with `material`: what depends only on
+    /// its rest shape and the material, worked out once per element ([`Row::stored_len`]
+    /// numbers). The built-in families store none (they work everything out at each
+    /// projection); a constraint file's stores what its prelude computes
+    /// (the file's compiled prelude).
     fn store(&self, rest_shape: &[DVec3; N], material: &Material) -> Stored {
         let _ = (rest_shape, material);
         Stored::new()
@@ -166,12 +119,6 @@ pub trait Constraint<const N: usize>: Sync {
         let _ = stored;
         self.evaluate(p, rest, rest_shape)
     }
-
-    /// Whether the fast engine should evaluate this family [`GROUP`] batches at a time
-    /// ([`Constraint::evaluate_batches`]) rather than one: for a family whose evaluation costs
-    /// something per call whatever the lanes (a constraint file's tape pays its dispatch on each
-    /// instruction once per call).
-    const GROUPED: bool = false;
 
     /// C and ∇C of [`GROUP`] batches of lanes of one colour at once, batch j at `p[j]` with
     /// `rest[j]`, `rest_shape[j]` and `stored[j]`. Each batch's evaluation is, to the bit, what

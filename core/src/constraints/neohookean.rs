@@ -41,7 +41,7 @@
 //! assert!(h.value < 0.0 && h.gradients[1].x > 0.0);
 //! ```
 
-use super::{Constraint, Evaluation, PairGroup, first_from_rest};
+use super::{Constraint, Evaluation, first_from_rest};
 use crate::constraints::material::Material;
 use crate::numbers::vector::{Real, Vector3};
 use glam::{DMat3, DVec3};
@@ -147,7 +147,7 @@ pub fn hydrostatic<V: Vector3>(p: &[V; 4], rest: V::Real, rest_shape: &[V; 4]) -
 
 /// F = Ds Dm⁻¹ of a tet at `p` with rest shape `rest_shape`; `None` when the rest shape has no
 /// volume.
-pub fn deformation_gradient(p: &[DVec3; 4], rest_shape: &[DVec3; 4]) -> Option<DMat3> {
+pub(crate) fn deformation_gradient(p: &[DVec3; 4], rest_shape: &[DVec3; 4]) -> Option<DMat3> {
     let columns = |q: &[DVec3; 4]| DMat3::from_cols(q[1] - q[0], q[2] - q[0], q[3] - q[0]);
     let dm = columns(rest_shape);
     (!rest_frame(rest_shape).degenerate).then(|| columns(p) * dm.inverse())
@@ -180,7 +180,6 @@ pub struct Deviatoric;
 
 impl Constraint<4> for Deviatoric {
     const STORED_USES_REST_SHAPE: bool = true;
-    const PAIR_GROUP: PairGroup = PairGroup::NeoHookeanDeviatoric;
 
     #[inline(always)]
     fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, shape: &[V; 4]) -> Evaluation<V, 4> {
@@ -202,8 +201,6 @@ pub struct Hydrostatic;
 
 impl Constraint<4> for Hydrostatic {
     const STORED_USES_REST_SHAPE: bool = true;
-    const REST_USES_MATERIAL: bool = true;
-    const PAIR_GROUP: PairGroup = PairGroup::NeoHookeanHydrostatic;
 
     #[inline(always)]
     fn evaluate<V: Vector3>(&self, p: &[V; 4], rest: V::Real, shape: &[V; 4]) -> Evaluation<V, 4> {

@@ -145,7 +145,7 @@ pub fn analytic_and_numeric(
     rest: f64,
     rest_shape: &[DVec3],
 ) -> (Vec<DVec3>, Vec<DVec3>) {
-    let evaluate = |p: &[DVec3]| families.evaluate(family, p, rest, rest_shape);
+    let evaluate = |p: &[DVec3]| families.constraint(family).evaluate(p, rest, rest_shape);
     let analytic = evaluate(points).gradients[..points.len()].to_vec();
     let numeric = central_difference(points, |p| evaluate(p).value);
     (analytic, numeric)
@@ -263,19 +263,17 @@ impl GradientSource for TableFamily<'_> {
     }
 
     fn uses_rest_shape(&self) -> bool {
-        self.families.uses_rest_shape(self.family)
+        self.families.row(self.family).reads_rest_shape
     }
 
     fn value(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> f64 {
-        self.families
-            .evaluate(self.family, points, rest, rest_shape)
-            .value
+        let constraint = self.families.constraint(self.family);
+        constraint.evaluate(points, rest, rest_shape).value
     }
 
     fn given(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Vec<Option<DVec3>> {
-        let evaluation = self
-            .families
-            .evaluate(self.family, points, rest, rest_shape);
+        let constraint = self.families.constraint(self.family);
+        let evaluation = constraint.evaluate(points, rest, rest_shape);
         evaluation.gradients[..points.len()]
             .iter()
             .map(|&g| Some(g))

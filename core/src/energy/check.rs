@@ -4,7 +4,7 @@
 //! central differences of ∇C by forward-mode AD; and a file's own `[hessian]` blocks against AD,
 //! block by block.
 
-use super::element::{constraint, store};
+use super::element::constraint;
 use crate::constraint_file::ConstraintFile;
 use crate::constraints::material::Material;
 use crate::constraints::verify::{TableFamily, draw, well_conditioned};
@@ -144,7 +144,7 @@ fn check_on<const N: usize>(
         let x: [DVec3; N] = std::array::from_fn(|k| points[k]);
         let shape: [DVec3; N] = std::array::from_fn(|k| shape[k]);
         let rest = source.natural_rest(&points, &shape);
-        let stored = store(families, family, &shape, &material);
+        let stored = families.constraint(family).store(&shape, &material);
         let at = (rest, &stored[..]);
         let h = forward(families, family, &x, at, &shape);
         let h2 = second_order(families, family, &x, at, &shape);

@@ -6,7 +6,6 @@
 //! ([`crate::constraints::Binding::particles`]): one volume, four heights, six edges; for a family
 //! of the surface, the tet's own four faces and six hinges, as if it stood alone.
 
-use crate::constraints::material::Material;
 use crate::constraints::{Constraint, Families, Family, PerFamily, Stored, Visit};
 use crate::numbers::dual::DualVec3;
 use crate::numbers::vector::{Real, Vector3};
@@ -79,7 +78,7 @@ impl ElementEnergy {
         let mut terms = Vec::new();
         let mut compliances = Vec::new();
         for family in families.all().filter(|&f| active[f]) {
-            let compliance = match families.compliance_from_material(family) {
+            let compliance = match families.row(family).compliance_from_material {
                 Some(from) => Compliance::Given(from(material)),
                 None if settings.compliance[family] > 0.0 => {
                     Compliance::Given(settings.compliance[family])
@@ -98,8 +97,8 @@ impl ElementEnergy {
                     family,
                     corners,
                     arity,
-                    rest: families.rest_value(family, &shape, material),
-                    stored: store(families, family, &shape, material),
+                    rest: families.constraint(family).rest_value(&shape, material),
+                    stored: families.constraint(family).store(&shape, material),
                     stiffness: 1.0 / compliance.alpha(),
                 });
             }
@@ -141,7 +140,7 @@ impl ElementEnergy {
     }
 
     /// Its constraints.
-    pub fn terms(&self) -> &[Term] {
+    pub(crate) fn terms(&self) -> &[Term] {
         &self.terms
     }
 
@@ -205,24 +204,6 @@ impl ElementEnergy {
         }
         sum
     }
-
-    /// Each family's share of E at `x`, in the order of [`ElementEnergy::compliances`].
-    pub fn energy_by_family(&self, x: &[DVec3; 4]) -> Vec<(Family, f64)> {
-        let x = x.map(|p| p.to_array());
-        self.compliances
-            .iter()
-            .map(|&(family, _)| {
-                let share = (0..self.terms.len())
-                    .filter(|&t| self.terms[t].family == family)
-                    .map(|t| {
-                        let c = self.evaluate(t, &x).0;
-                        0.5 * self.terms[t].stiffness * c * c
-                    })
-                    .sum();
-                (family, share)
-            })
-            .collect()
-    }
 }
 
 /// C and ∇C of one constraint of `family` at `x`, with its rest value and stored numbers `rest`
@@ -251,19 +232,6 @@ pub fn constraint<T: Real<Mask = bool>, const N: usize>(
             rest_shape,
         },
     )
-}
-
-/// What a family stores for a constraint at rest at `shape` ([`Constraint::store`]).
-pub fn store(families: &Families, family: Family, shape: &[DVec3], material: &Material) -> Stored {
-    struct Store<'a>(&'a [DVec3], &'a Material);
-    impl Visit for Store<'_> {
-        type Output = Stored;
-        fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Stored {
-            let shape: [DVec3; N] = std::array::from_fn(|k| self.0[k]);
-            c.store(&shape, self.1)
-        }
-    }
-    families.visit(family, Store(shape, material))
 }
 
 /// One constraint of a built-in family evaluated at `x`, in the number type of `x`.

@@ -126,7 +126,7 @@ impl Modes {
     ///
     /// Within a group of equal eigenvalues (the null space, above all) any orthonormal basis is
     /// as good as another: the basis is turned to the classes, the translations first, then the
-    /// rotations, twists, flips and scalings ([`Frame::candidates`]), so that a null space shows
+    /// rotations, twists, flips and scalings (`Frame::candidates`), so that a null space shows
     /// its three translations and, where ∇E = 0, its three rotations.
     pub fn of_matrix(h: Matrix12, x: &[DVec3; 4], rest: &[DVec3; 4], mass: f64) -> Modes {
         let eigen = SymmetricEigen::new(h);

@@ -61,7 +61,7 @@ impl Parameters {
 }
 
 /// Ψ(F) in any number type.
-pub fn psi<T: Real>(f: &[[T; 3]; 3], p: &Parameters) -> T {
+pub(crate) fn psi<T: Real>(f: &[[T; 3]; 3], p: &Parameters) -> T {
     // f[c][r]: column c.
     let mut norm = T::ZERO;
     for column in f {
@@ -244,7 +244,7 @@ impl FSpace {
 }
 
 /// The eigenvalues of a symmetric D × D matrix, lowest first.
-pub fn sorted_eigenvalues<const D: usize>(m: SMatrix<f64, D, D>) -> Vec<f64> {
+pub(crate) fn sorted_eigenvalues<const D: usize>(m: SMatrix<f64, D, D>) -> Vec<f64> {
     let dynamic = nalgebra::DMatrix::from_column_slice(D, D, m.as_slice());
     let mut values: Vec<f64> = SymmetricEigen::new(dynamic)
         .eigenvalues

@@ -1,6 +1,6 @@
 //! The signed singular value decomposition of a deformation gradient, F = U Σ Vᵀ with U and V
 //! rotations ([`signed_svd`]), and the split of a direction in F-space into twist, flip and scale
-//! in its frame ([`twist_flip_scale`], after Smith et al. 2019): what the modes' classes
+//! in its frame (`twist_flip_scale`, after Smith et al. 2019): what the modes' classes
 //! ([`super::modes`]) and the neo-Hookean analytic system ([`super::neohookean`]) are written in.
 //!
 //! ```
@@ -59,7 +59,7 @@ pub fn signed_svd(f: &DMat3) -> (DMat3, [f64; 3], DMat3) {
 /// How much of an F-space direction `m` is twist, flip and scale in the frame of F = U Σ Vᵀ: the
 /// squared norms of the antisymmetric off-diagonal part, the symmetric off-diagonal part and the
 /// diagonal of Uᵀ m V (they sum to ‖m‖²).
-pub fn twist_flip_scale(u: &DMat3, v: &DMat3, m: &DMat3) -> [f64; 3] {
+pub(crate) fn twist_flip_scale(u: &DMat3, v: &DMat3, m: &DMat3) -> [f64; 3] {
     let g = u.transpose() * *m * *v;
     let e = |r: usize, c: usize| g.col(c)[r];
     let (mut twist, mut flip, mut scale) = (0.0, 0.0, 0.0);

@@ -15,12 +15,12 @@ pub fn folder() -> PathBuf {
 }
 
 /// Whether the folder is there.
-pub fn present() -> bool {
+pub(crate) fn present() -> bool {
     folder().is_dir()
 }
 
 /// Whether this is a CI run (`CI=true`), where the shared meshes must be present.
-pub fn in_ci() -> bool {
+pub(crate) fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true")
 }
 

@@ -1,6 +1,6 @@
 //! A user's text file (a mesh, a lesson) read as UTF-8, with the line of the first byte that is
 //! not UTF-8 when it fails; and the byte-order mark some editors put first, which every parser
-//! skips ([`without_byte_order_mark`]) so that it is never quoted, invisibly, in an error about
+//! skips (`without_byte_order_mark`) so that it is never quoted, invisibly, in an error about
 //! the first word.
 
 use std::path::Path;
@@ -19,13 +19,7 @@ pub struct TextFileError {
 const BYTE_ORDER_MARK: &str = "\u{feff}";
 
 /// `text` without the byte-order mark it may start with.
-///
-/// ```
-/// use tetlab_core::input::text_file::without_byte_order_mark;
-/// assert_eq!(without_byte_order_mark("\u{feff}4 3 0 0\n"), "4 3 0 0\n");
-/// assert_eq!(without_byte_order_mark("4 3 0 0\n"), "4 3 0 0\n");
-/// ```
-pub fn without_byte_order_mark(text: &str) -> &str {
+pub(crate) fn without_byte_order_mark(text: &str) -> &str {
     text.strip_prefix(BYTE_ORDER_MARK).unwrap_or(text)
 }
 
@@ -73,15 +67,14 @@ pub fn read(path: &Path) -> Result<String, TextFileError> {
 static PROVIDED: std::sync::Mutex<Vec<(String, String)>> = std::sync::Mutex::new(Vec::new());
 
 /// Provides the text of a file named `name` (a file name, no folder) to [`read`] and
-/// [`available`], for paths that end in that name and cannot be read.
+/// `available`, for paths that end in that name and cannot be read.
 ///
 /// ```
 /// use std::path::Path;
-/// use tetlab_core::input::text_file::{available, provide, read};
+/// use tetlab_core::input::text_file::{provide, read};
 /// let path = Path::new("/nowhere/provided-doctest.node");
-/// assert!(!available(path) && read(path).is_err());
+/// assert!(read(path).is_err());
 /// provide("provided-doctest.node", "1 3 0 0\n0 0 0 0\n".into());
-/// assert!(available(path));
 /// assert_eq!(read(path).unwrap(), "1 3 0 0\n0 0 0 0\n");
 /// ```
 pub fn provide(name: &str, text: String) {
@@ -101,6 +94,20 @@ fn provided(path: &Path) -> Option<String> {
 }
 
 /// Whether `path` can be read: it exists, or a file of its name was [`provide`]d.
-pub fn available(path: &Path) -> bool {
+pub(crate) fn available(path: &Path) -> bool {
     path.exists() || provided(path).is_some()
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `without_byte_order_mark`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn without_byte_order_mark_example() {
+        use crate::input::text_file::without_byte_order_mark;
+        assert_eq!(without_byte_order_mark("\u{feff}4 3 0 0\n"), "4 3 0 0\n");
+        assert_eq!(without_byte_order_mark("4 3 0 0\n"), "4 3 0 0\n");
+    }
 }

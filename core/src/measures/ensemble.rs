@@ -12,7 +12,7 @@ use crate::measures::metrics::Metrics;
 use crate::measures::outcome::Outcome;
 use crate::scene::{Perturbation, Scene};
 use crate::simulation::divergence::Divergence;
-use crate::simulation::{Engine, Settings, Simulation};
+use crate::simulation::{EngineChoice, Settings, Simulation};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -32,8 +32,8 @@ pub struct Ensemble<'a> {
 /// One member of an ensemble: its engine, its order seed and what it came to.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Member {
-    /// [`Engine::Reference`] or [`Engine::Fast`].
-    pub engine: Engine,
+    /// [`EngineChoice::Reference`] or [`EngineChoice::Fast`].
+    pub engine: EngineChoice,
     /// Its order seed.
     pub order_seed: u64,
     /// Its outcome, or where it diverged.
@@ -42,9 +42,9 @@ pub struct Member {
 
 impl Ensemble<'_> {
     /// One run on `engine` with `order_seed`, the fast engine on `threads` threads.
-    pub fn run_one(
+    pub(crate) fn run_one(
         &self,
-        engine: Engine,
+        engine: EngineChoice,
         order_seed: Option<u64>,
         threads: usize,
     ) -> Result<Outcome, Divergence> {
@@ -70,8 +70,8 @@ impl Ensemble<'_> {
 
     /// Every (engine, seed) of `engines` × `seeds`, on `workers` threads at once; the members in
     /// that order.
-    pub fn run(&self, engines: &[Engine], seeds: &[u64], workers: usize) -> Vec<Member> {
-        let jobs: Vec<(Engine, u64)> = engines
+    pub fn run(&self, engines: &[EngineChoice], seeds: &[u64], workers: usize) -> Vec<Member> {
+        let jobs: Vec<(EngineChoice, u64)> = engines
             .iter()
             .flat_map(|&engine| seeds.iter().map(move |&seed| (engine, seed)))
             .collect();
@@ -112,7 +112,7 @@ impl Ensemble<'_> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tally {
     /// The engine.
-    pub engine: Engine,
+    pub engine: EngineChoice,
     /// How many members ran on it.
     pub members: usize,
     /// How many ended with no inverted tet (and did not diverge).
@@ -130,7 +130,7 @@ pub struct Tally {
 
 impl Tally {
     /// The members of `members` that ran on `engine`, counted.
-    pub fn of(members: &[Member], engine: Engine) -> Tally {
+    pub fn of(members: &[Member], engine: EngineChoice) -> Tally {
         let mine: Vec<&Member> = members.iter().filter(|m| m.engine == engine).collect();
         let outcomes: Vec<&Outcome> = mine.iter().filter_map(|m| m.result.as_ref().ok()).collect();
         let mut inverted_at_the_end: Vec<usize> =
@@ -156,9 +156,9 @@ impl Tally {
     ///
     /// ```
     /// use tetlab_core::measures::ensemble::Tally;
-    /// use tetlab_core::simulation::Engine;
+    /// use tetlab_core::simulation::EngineChoice;
     /// let tally = Tally {
-    ///     engine: Engine::Fast,
+    ///     engine: EngineChoice::Fast,
     ///     members: 4,
     ///     recovered: 2,
     ///     diverged: 1,

@@ -11,22 +11,8 @@ use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign
 
 /// K numbers, each computed on its own: `(a + b).0[k] == a.0[k] + b.0[k]`, and likewise for
 /// every operation of [`Real`].
-///
-/// ```
-/// use tetlab_core::numbers::block::Block;
-/// use tetlab_core::numbers::vector::Real;
-/// let a = Block([0.25f32, 4.0, -1.0]);
-/// let b = Block([2.0f32, 0.5, 3.0]);
-/// // Each number of the block is what the operation gives on that number alone, to the bit.
-/// let r = (a * b + a.sqrt()).atan2(b);
-/// for k in 0..3 {
-///     assert_eq!(r.0[k].to_bits(), (a.0[k] * b.0[k] + a.0[k].sqrt()).atan2(b.0[k]).to_bits());
-/// }
-/// // A comparison gives one flag per number, and select picks per number.
-/// assert_eq!(Block::select(a.gt(b), a, b).0, [2.0, 4.0, 3.0]);
-/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Block<T, const K: usize>(pub [T; K]);
+pub(crate) struct Block<T, const K: usize>(pub [T; K]);
 
 // Plain loops over the K numbers (not `array::map`, which the optimiser does not always see
 // through): each operation compiles to K instructions of T.
@@ -191,5 +177,30 @@ impl<T: Real, const K: usize> Real for Block<T, K> {
     #[inline(always)]
     fn cbrt(self) -> Self {
         self.map(T::cbrt)
+    }
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `block`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn block_example() {
+        use crate::numbers::block::Block;
+        use crate::numbers::vector::Real;
+        let a = Block([0.25f32, 4.0, -1.0]);
+        let b = Block([2.0f32, 0.5, 3.0]);
+        // Each number of the block is what the operation gives on that number alone, to the bit.
+        let r = (a * b + a.sqrt()).atan2(b);
+        for k in 0..3 {
+            assert_eq!(
+                r.0[k].to_bits(),
+                (a.0[k] * b.0[k] + a.0[k].sqrt()).atan2(b.0[k]).to_bits()
+            );
+        }
+        // A comparison gives one flag per number, and select picks per number.
+        assert_eq!(Block::select(a.gt(b), a, b).0, [2.0, 4.0, 3.0]);
     }
 }

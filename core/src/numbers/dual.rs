@@ -184,7 +184,7 @@ pub type Dual64 = Tangent<f64>;
 /// The numbers `x` (N groups of three, a point each) as dual numbers with number `j` (group j / 3,
 /// entry j % 3) seeded: the slope of anything computed from them is its derivative along that one
 /// number. One pass of forward mode.
-pub fn seed_one<const N: usize>(x: &[[f64; 3]; N], j: usize) -> [[Tangent<f64>; 3]; N] {
+pub(crate) fn seed_one<const N: usize>(x: &[[f64; 3]; N], j: usize) -> [[Tangent<f64>; 3]; N] {
     std::array::from_fn(|k| {
         std::array::from_fn(|a| Tangent::new(x[k][a], if 3 * k + a == j { 1.0 } else { 0.0 }))
     })
@@ -193,7 +193,7 @@ pub fn seed_one<const N: usize>(x: &[[f64; 3]; N], j: usize) -> [[Tangent<f64>; 
 /// The numbers `x` as second-order dual numbers, number `i` seeded along the inner ε₁ and `j`
 /// along the outer ε₂: the ε₁ε₂ part (`.slope.slope`) of anything computed from them is its second
 /// derivative ∂²/∂xᵢ∂xⱼ.
-pub fn seed_two<const N: usize>(
+pub(crate) fn seed_two<const N: usize>(
     x: &[[f64; 3]; N],
     i: usize,
     j: usize,

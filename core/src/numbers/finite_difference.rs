@@ -4,12 +4,12 @@ use glam::DVec3;
 
 /// The step of a central difference for coordinates of size `scale`: h = ∛ε · max(scale, 1e-3),
 /// which balances the truncation error (∝ h²) against rounding (∝ ε/h).
-pub fn step_for_scale(scale: f64) -> f64 {
+pub(crate) fn step_for_scale(scale: f64) -> f64 {
     f64::EPSILON.cbrt() * scale.max(1e-3)
 }
 
 /// ∇C by central differences: ∂C/∂xᵢ ≈ (C(x + h eᵢ) − C(x − h eᵢ)) / 2h for every coordinate
-/// of every point, with h from [`step_for_scale`] of the largest coordinate.
+/// of every point, with h from `step_for_scale` of the largest coordinate.
 ///
 /// ```
 /// use glam::DVec3;

@@ -38,7 +38,7 @@ pub fn padded(v: Vec3A) -> f32x4 {
 
 /// The 3-vector of the first three lanes: the inverse of [`padded`].
 #[inline(always)]
-pub fn unpadded(lanes: f32x4) -> Vec3A {
+pub(crate) fn unpadded(lanes: f32x4) -> Vec3A {
     #[cfg(target_feature = "sse2")]
     return bytemuck::cast(lanes);
     #[cfg(not(target_feature = "sse2"))]
@@ -246,7 +246,7 @@ impl Vec3x8 {
     /// register, then one 4 × 4 transpose in both halves at once (11 shuffles); elsewhere two
     /// 4 × 4 transposes of `wide`. The same bits either way: only data moves.
     #[inline(always)]
-    pub fn from_rows(rows: [f32x4; LANES]) -> Self {
+    pub(crate) fn from_rows(rows: [f32x4; LANES]) -> Self {
         let [x, y, z] = transpose::from_rows(rows);
         Vec3x8 {
             x: F32x8(x),
@@ -256,7 +256,7 @@ impl Vec3x8 {
     }
 
     /// The lanes as registers of padded 3-vectors (fourth component zero): the inverse of
-    /// [`Vec3x8::from_rows`].
+    /// `Vec3x8::from_rows`.
     #[inline(always)]
     pub fn rows(self) -> [f32x4; LANES] {
         transpose::rows([self.x.0, self.y.0, self.z.0])

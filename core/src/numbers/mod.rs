@@ -1,9 +1,9 @@
 //! The numbers the formulas run on: the [`vector::Vector3`] trait they are generic over, with f64,
-//! f32 and eight f32 [`lanes`], and several of one type side by side in a [`block`]; [`dual`]
+//! f32 and eight f32 [`lanes`], and several of one type side by side in a `block`; [`dual`]
 //! numbers for automatic differentiation; [`finite_difference`] gradients to check against; and a
 //! seeded [`random`] generator, so that random inputs are the same everywhere.
 
-pub mod block;
+pub(crate) mod block;
 pub mod dual;
 pub mod finite_difference;
 pub mod lanes;

@@ -58,17 +58,7 @@ impl SplitMix64 {
 /// A permutation of 0..n drawn by Fisher–Yates from `seed` (with [`SplitMix64`]): the same
 /// permutation for the same seed on every machine. The order seeds of the solvers use it
 /// ([`crate::simulation::Settings::order_seed`]).
-///
-/// ```
-/// use tetlab_core::numbers::random::permutation;
-/// let p = permutation(10, 7);
-/// let mut sorted = p.clone();
-/// sorted.sort_unstable();
-/// assert_eq!(sorted, (0..10).collect::<Vec<u32>>(), "every index once");
-/// assert_eq!(p, permutation(10, 7), "the same seed, the same order");
-/// assert_ne!(p, permutation(10, 8));
-/// ```
-pub fn permutation(n: usize, seed: u64) -> Vec<u32> {
+pub(crate) fn permutation(n: usize, seed: u64) -> Vec<u32> {
     let mut order: Vec<u32> = (0..n as u32).collect();
     let mut random = SplitMix64::new(seed);
     for i in (1..n).rev() {
@@ -77,4 +67,22 @@ pub fn permutation(n: usize, seed: u64) -> Vec<u32> {
         order.swap(i, j);
     }
     order
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `permutation`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn permutation_example() {
+        use crate::numbers::random::permutation;
+        let p = permutation(10, 7);
+        let mut sorted = p.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..10).collect::<Vec<u32>>(), "every index once");
+        assert_eq!(p, permutation(10, 7), "the same seed, the same order");
+        assert_ne!(p, permutation(10, 8));
+    }
 }

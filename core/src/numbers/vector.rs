@@ -256,7 +256,7 @@ impl_vector3!(glam::DVec3, f64);
 /// Set when either vector is zero or the sine of the angle between them is below machine
 /// epsilon; the normal `a×b/|a×b|` is then meaningless.
 #[inline]
-pub fn spans_no_plane<V: Vector3>(a: V, b: V, a_cross_b: V) -> <V::Real as Real>::Mask {
+pub(crate) fn spans_no_plane<V: Vector3>(a: V, b: V, a_cross_b: V) -> <V::Real as Real>::Mask {
     let lhs = a_cross_b.length_squared();
     let epsilon = V::Real::EPSILON;
     let rhs = epsilon * epsilon * a.length_squared() * b.length_squared();

@@ -64,7 +64,7 @@ impl Builtin {
     }
 
     /// The largest resolution at which the scene has at most [`limits::MAX_TETS`] tets.
-    pub fn largest_resolution(self) -> u32 {
+    pub(crate) fn largest_resolution(self) -> u32 {
         (limits::RESOLUTION.min..=limits::RESOLUTION.max)
             .rev()
             .find(|&n| self.tets(n) <= limits::MAX_TETS as u64)
@@ -241,19 +241,7 @@ fn regular_tet() -> TetMesh {
 /// A block of `cells` boxes of sides `size` with its low corner at `origin`, each box split into
 /// six tets around its main diagonal (Kuhn's subdivision), so neighbouring cells share faces.
 /// Particle (i, j, k) is number (i (ny + 1) + j)(nz + 1) + k.
-///
-/// ```
-/// use glam::DVec3;
-/// use tetlab_core::constraints::volume::signed_volume;
-/// use tetlab_core::scene::lattice;
-/// let block = lattice([2, 1, 1], DVec3::ZERO, DVec3::new(0.5, 0.1, 0.1));
-/// assert_eq!((block.positions.len(), block.tets.len()), (12, 12));
-/// // Every tet positively oriented, and together they fill the block: 1 × 0.1 × 0.1.
-/// let volumes: Vec<f64> = (0..12).map(|t| signed_volume(&block.corners(t))).collect();
-/// assert!(volumes.iter().all(|&v| v > 0.0));
-/// assert!((volumes.iter().sum::<f64>() - 0.01).abs() < 1e-15);
-/// ```
-pub fn lattice(cells: [usize; 3], origin: DVec3, size: DVec3) -> TetMesh {
+pub(crate) fn lattice(cells: [usize; 3], origin: DVec3, size: DVec3) -> TetMesh {
     let [nx, ny, nz] = cells;
     let index = |i: usize, j: usize, k: usize| ((i * (ny + 1) + j) * (nz + 1) + k) as u32;
     let mut positions = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
@@ -430,5 +418,25 @@ impl fmt::Display for Perturbation {
             Perturbation::Flatten => f.write_str("flatten"),
             Perturbation::Scramble(seed) => write!(f, "scramble:{seed}"),
         }
+    }
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `lattice`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn lattice_example() {
+        use crate::constraints::volume::signed_volume;
+        use crate::scene::lattice;
+        use glam::DVec3;
+        let block = lattice([2, 1, 1], DVec3::ZERO, DVec3::new(0.5, 0.1, 0.1));
+        assert_eq!((block.positions.len(), block.tets.len()), (12, 12));
+        // Every tet positively oriented, and together they fill the block: 1 × 0.1 × 0.1.
+        let volumes: Vec<f64> = (0..12).map(|t| signed_volume(&block.corners(t))).collect();
+        assert!(volumes.iter().all(|&v| v > 0.0));
+        assert!((volumes.iter().sum::<f64>() - 0.01).abs() < 1e-15);
     }
 }

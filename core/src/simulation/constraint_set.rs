@@ -1,11 +1,12 @@
-//! The constraints of one family as the reference solver keeps them: flat arrays, one entry per
-//! constraint in the binding's order (the particles, `arity` of them each; the rest value; the
-//! XPBD multiplier λ), built once from the family's binding to the mesh, and the order a sweep
-//! projects them in (the binding's, or a permutation drawn from an order seed).
+//! The constraints of one family as a simulation keeps them: flat arrays, one entry per
+//! constraint in the binding's order (the particles, `arity` of them each; the rest value; what
+//! it stores; the size of its element), built once from the family's binding to the mesh, and
+//! the order a sweep projects them in (the binding's, or a permutation drawn from an order seed).
+//! Their multipliers λ are the state's ([`super::State::lambdas`]).
 
 use crate::constraint_file::ConstraintFile;
 use crate::constraints::material::Material;
-use crate::constraints::{Constraint, Families, Family, Visit};
+use crate::constraints::{Families, Family};
 use crate::scene::mesh::TetMesh;
 use glam::DVec3;
 use std::sync::Arc;
@@ -24,7 +25,6 @@ pub struct ConstraintSet {
     /// What each constraint stores ([`Constraint::store`]), `stored_len` numbers each.
     stored: Vec<f64>,
     stored_len: usize,
-    lambda: Vec<f64>,
     /// The size of each constraint's element: the longest rest edge among its particles, what
     /// its reach is measured in ([`crate::simulation::Settings::reach`]).
     size: Vec<f64>,
@@ -54,7 +54,6 @@ impl ConstraintSet {
             built: true,
             file: families.file(family).cloned(),
             arity,
-            lambda: vec![0.0; particles.len() / arity],
             particles,
             rest: Vec::new(),
             stored: Vec::new(),
@@ -75,31 +74,28 @@ impl ConstraintSet {
         rest_positions: &[DVec3],
         material: &Material,
     ) {
-        struct RestValues<'a>(&'a [u32], &'a [DVec3], &'a Material);
-        impl Visit for RestValues<'_> {
-            type Output = (Vec<f64>, Vec<f64>, usize);
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
-                let (particles, positions, material) = (self.0, self.1, self.2);
-                let (groups, _) = particles.as_chunks::<N>();
-                let shapes = || groups.iter().map(|idx| idx.map(|i| positions[i as usize]));
-                let rest = shapes()
-                    .map(|shape| c.rest_value(&shape, material))
-                    .collect();
-                let stored_len = c.stored_len();
-                let stored = if stored_len == 0 {
-                    Vec::new()
-                } else {
-                    shapes()
-                        .flat_map(|shape| c.store(&shape, material))
-                        .collect()
-                };
-                (rest, stored, stored_len)
+        if !self.built {
+            return;
+        }
+        let constraint = families.constraint(family);
+        let shapes = || {
+            self.particles
+                .chunks_exact(self.arity)
+                .map(|idx| idx.iter().map(|&i| rest_positions[i as usize]))
+        };
+        let mut shape = Vec::with_capacity(self.arity);
+        let mut rest = Vec::with_capacity(self.particles.len() / self.arity);
+        let stored_len = families.row(family).stored_len;
+        let mut stored = Vec::with_capacity(rest.capacity() * stored_len);
+        for points in shapes() {
+            shape.clear();
+            shape.extend(points);
+            rest.push(constraint.rest_value(&shape, material));
+            if stored_len > 0 {
+                stored.extend(constraint.store(&shape, material));
             }
         }
-        (self.rest, self.stored, self.stored_len) = families.visit(
-            family,
-            RestValues(&self.particles, rest_positions, material),
-        );
+        (self.rest, self.stored, self.stored_len) = (rest, stored, stored_len);
     }
 
     /// Whether it was built from the definition of `family` in `families`.
@@ -151,8 +147,7 @@ impl ConstraintSet {
         groups[c]
     }
 
-    /// The rest value (d, V) of each constraint.
-    /// What constraint `c` stores ([`Constraint::store`]; empty for a built-in family).
+    /// What constraint `c` stores ([`crate::constraints::Constraint::store`]; empty for a built-in family).
     pub fn stored(&self, c: usize) -> &[f64] {
         &self.stored[c * self.stored_len..(c + 1) * self.stored_len]
     }
@@ -172,22 +167,6 @@ impl ConstraintSet {
         &self.size
     }
 
-    /// The XPBD multiplier λ of each constraint, accumulated within the current substep.
-    pub fn lambda(&self) -> &[f64] {
-        &self.lambda
-    }
-
-    /// λ of constraint `c` grows by `delta`.
-    #[inline]
-    pub(crate) fn add_lambda(&mut self, c: usize, delta: f64) {
-        self.lambda[c] += delta;
-    }
-
-    /// λ = 0 for every constraint (a new substep).
-    pub(crate) fn reset_lambda(&mut self) {
-        self.lambda.fill(0.0);
-    }
-
     /// Sets the order a sweep projects the constraints in: a permutation of 0..len, or `None`
     /// for the binding's order.
     pub(crate) fn set_order(&mut self, order: Option<Vec<u32>>) {
@@ -204,7 +183,7 @@ impl ConstraintSet {
     /// The bytes its arrays take (their capacities).
     pub(crate) fn heap_bytes(&self) -> usize {
         (self.particles.capacity() + self.order.capacity()) * size_of::<u32>()
-            + (self.rest.capacity() + self.lambda.capacity() + self.size.capacity())
+            + (self.rest.capacity() + self.stored.capacity() + self.size.capacity())
                 * size_of::<f64>()
     }
 }

@@ -1,41 +1,40 @@
 //! What a reader asks of a simulation between steps: the order of a sweep, the constraints of
-//! one tet, one projection described ([`Projection`]) or made (step-by-step mode), and the
-//! counts and warnings the front ends show.
+//! one tet, one projection described ([`Projection`], by the projection a sweep makes,
+//! [`super::reference::project_unit`]), and the counts and warnings the front ends show.
 
-use super::*;
+use super::reference::project_unit;
+use super::{ConstraintSet, DENSITY, Simulation};
+use crate::constraints::{Family, Projected, VisitProjected};
+use crate::simulation::projection::Rule;
+use glam::DVec3;
 
 impl Simulation {
     /// The constraints one sweep projects, in order: every constraint of each active family
     /// (edges, then heights, then volumes), each family's in the order of
-    /// [`Settings::order_seed`], as (family, index in the family).
+    /// [`super::Settings::order_seed`], as (family, index in the family).
     pub fn projection_order(&self) -> impl Iterator<Item = (Family, usize)> + '_ {
-        let active = self.settings.active;
-        self.families
-            .all()
-            .filter(move |&f| active[f] && !self.families.projected_by_partner(f, &active))
-            .flat_map(move |f| {
-                let set = &self.sets[f];
-                (0..set.len()).map(move |k| (f, set.in_order(k)))
-            })
+        self.families.units(self.active()).flat_map(move |unit| {
+            let set = &self.body.sets[unit.lead];
+            (0..set.len()).map(move |k| (unit.lead, set.in_order(k)))
+        })
     }
 
     /// The constraints of `family` on tet `tet`, as indices in the family: its edges (six), its
     /// four heights, or its volume ([`crate::constraints::Binding::of_tet`]).
-    pub fn tet_constraints(&self, tet: usize, family: Family) -> impl Iterator<Item = usize> + '_ {
-        let edges = self.sets[Family::EDGES].all_particles();
+    pub(crate) fn tet_constraints(
+        &self,
+        tet: usize,
+        family: Family,
+    ) -> impl Iterator<Item = usize> + '_ {
+        let edges = self.body.sets[Family::EDGES].all_particles();
         self.families
             .binding(family)
-            .of_tet(tet, self.tets[tet], edges)
-    }
-
-    /// The constraints of `family`: their particles, rest values and multipliers.
-    pub fn constraints(&self, family: Family) -> &ConstraintSet {
-        &self.sets[family]
+            .of_tet(tet, self.body.tets[tet], edges)
     }
 
     /// The shortest edge of the rest shape (0 without edges).
     pub fn shortest_edge(&self) -> f64 {
-        let lengths = self.sets[Family::EDGES].rest().iter().copied();
+        let lengths = self.body.sets[Family::EDGES].rest().iter().copied();
         lengths.filter(|&l| l > 0.0).reduce(f64::min).unwrap_or(0.0)
     }
 
@@ -45,10 +44,7 @@ impl Simulation {
     /// every front end shows.
     pub fn stability_warning(&self) -> Option<String> {
         let settings = &self.settings;
-        let material_family = settings
-            .active
-            .families()
-            .find(|&f| settings.from_material[f])?;
+        let material_family = self.resolved.material_family()?;
         let shortest = self.shortest_edge();
         let material = settings.material;
         let needed = material.substeps_needed(settings.dt, shortest, DENSITY);
@@ -70,60 +66,30 @@ impl Simulation {
     /// Constraint projections one frame makes with the current settings: the active families'
     /// constraints × substeps × iterations.
     pub fn projections_per_frame(&self) -> u64 {
-        self.settings
-            .projections_per_frame(self.families.per_family(|f| self.constraint_count(f)))
+        let counts = self.families.per_family(|f| self.constraint_count(f));
+        self.settings.projections_per_frame(counts)
     }
 
     /// How many constraints `family` has.
     pub fn constraint_count(&self, family: Family) -> usize {
-        self.sets[family].len()
+        self.body.sets[family].len()
     }
 
     /// What projecting constraint `c` of `family` now would do, with the current λ and the rule
     /// (XPBD or PBD) of the current settings: C, ∇C, the inverse masses, Δλ and Δx.
     ///
-    /// A family projected together with another ([`Families::partner_in`]) shows its own C and
-    /// ∇C, and the Δλ and Δx of the pair's projection.
+    /// A family projected together with another ([`crate::constraints::Row::projected_with`])
+    /// shows its own C and ∇C, and its Δλ and the Δx of the pair's projection: what a sweep does.
     pub fn projection(&self, family: Family, c: usize) -> Projection {
+        let unit = self.families.unit_of(family, self.active());
         let h = self.substep_length();
-        let rule = self.rule(family, h);
-        let mut projection = self.families.visit(
+        let describe = Describe {
+            simulation: self,
             family,
-            Describe {
-                set: &self.sets[family],
-                positions: &self.positions,
-                rest_positions: &self.rest_positions,
-                inverse_masses: &self.inverse_masses,
-                rule,
-                c,
-                reach: self.settings.reach,
-            },
-        );
-        if let Some(partner) = self.families.partner_in(family, &self.settings.active) {
-            let pair = pair::Pair {
-                first: &self.sets[family],
-                second: &self.sets[partner],
-                positions: &self.positions,
-                rest_positions: &self.rest_positions,
-                inverse_masses: &self.inverse_masses,
-                rules: [rule, self.rule(partner, h)],
-                reach: self.settings.reach,
-            };
-            let correction = self
-                .families
-                .visit_pair(family, partner, pair::PairAt { pair, c });
-            let skipped = projection.delta_lambda.is_none();
-            projection.delta_lambda = (!skipped).then_some(correction.delta_lambda[0]);
-            projection.delta_x = correction.delta_x;
-        }
-        projection
-    }
-
-    /// Projects constraint `c` of `family` once, exactly as a sweep does (with its partner, if
-    /// it leads a pair).
-    pub fn project(&mut self, family: Family, c: usize) {
-        self.fast.edited();
-        self.project_range(family, Projected::One(c), self.substep_length());
+            c,
+            rule: |f| self.resolved.rule(f, h),
+        };
+        self.families.visit_unit(unit, describe)
     }
 }
 
@@ -163,7 +129,7 @@ pub struct Projection {
     /// λ accumulated so far in this substep (XPBD).
     pub lambda: f64,
     /// XPBD: Δλ; PBD: k′ s. `None` when the projection is skipped (degenerate, every particle
-    /// fixed, or [`LOCKED`]).
+    /// fixed, or [`crate::simulation::projection::LOCKED`]).
     pub delta_lambda: Option<f64>,
     /// Δx the projection would give each particle (zero when skipped).
     pub delta_x: [DVec3; 4],
@@ -178,56 +144,74 @@ impl Projection {
     }
 }
 
-/// [`Projection`] of constraint `c` of `set`.
-struct Describe<'a> {
-    set: &'a ConstraintSet,
-    positions: &'a [DVec3],
-    rest_positions: &'a [DVec3],
-    inverse_masses: &'a [f64],
-    rule: Rule<f64>,
+/// [`Projection`] of constraint `c` of `family`, within the projection of its unit.
+struct Describe<'a, R> {
+    simulation: &'a Simulation,
+    family: Family,
     c: usize,
-    reach: f64,
+    rule: R,
 }
 
-impl Visit for Describe<'_> {
+impl<R: Fn(Family) -> Rule<f64>> VisitProjected for Describe<'_, R> {
     type Output = Projection;
 
-    fn visit<const N: usize, C: Constraint<N>>(self, family: Family, constraint: &C) -> Projection {
-        let c = self.c;
-        let idx = self.set.indices::<N>(c);
-        let p = idx.map(|i| self.positions[i as usize]);
-        let shape = idx.map(|i| self.rest_positions[i as usize]);
-        let evaluation =
-            constraint.evaluate_stored(&p, self.set.rest()[c], &shape, self.set.stored(c));
-        let weights = idx.map(|i| self.inverse_masses[i as usize]);
-        let lambda = self.set.lambda()[c];
-        let reach = self.reach * self.set.size()[c];
-        let correction = correction(evaluation, weights, lambda, self.rule, reach);
+    fn visit<const N: usize, const K: usize, P: Projected<N, K>>(
+        self,
+        families: [Family; K],
+        constraint: &P,
+    ) -> Projection {
+        let (simulation, c) = (self.simulation, self.c);
+        let (body, state) = (&simulation.body, &simulation.state);
+        let arrays = (
+            &state.positions[..],
+            &body.rest_positions[..],
+            &state.inverse_masses[..],
+        );
+        let rules = families.map(&self.rule);
+        let reach = simulation.settings.reach;
+        let unit = project_unit(
+            constraint,
+            families,
+            &body.sets,
+            &state.lambdas,
+            arrays,
+            rules,
+            reach,
+            c,
+        );
+        let v = families.iter().position(|&f| f == self.family).unwrap_or(0);
+        let (evaluation, correction) = (unit.evaluations[v], unit.correction);
+        let set: &ConstraintSet = &body.sets[self.family];
+        let skipped = if K == 1 {
+            correction.skipped[0].any()
+        } else {
+            correction.skipped[v].all
+        };
         let mut projection = Projection {
-            family,
+            family: self.family,
             constraint: c,
             particles: [0; 4],
             len: N,
             value: evaluation.value,
-            rest: self.set.rest()[c],
-            stored: std::array::from_fn(|k| self.set.stored(c).get(k).copied().unwrap_or(0.0)),
-            stored_len: self.set.stored_len(),
+            rest: set.rest()[c],
+            stored: std::array::from_fn(|k| set.stored(c).get(k).copied().unwrap_or(0.0)),
+            stored_len: set.stored_len(),
             gradients: [DVec3::ZERO; 4],
             inverse_masses: [0.0; 4],
             weighted_norm: crate::simulation::projection::weighted_norm(
-                &weights,
+                &unit.weights,
                 &evaluation.gradients,
             ),
-            lambda,
-            delta_lambda: correction.map(|c| c.delta_lambda),
+            lambda: unit.lambda[v],
+            delta_lambda: (!skipped).then_some(correction.delta_lambda[v]),
             delta_x: [DVec3::ZERO; 4],
             degenerate: evaluation.degenerate,
         };
         for k in 0..N {
-            projection.particles[k] = idx[k];
+            projection.particles[k] = unit.particles[k];
             projection.gradients[k] = evaluation.gradients[k];
-            projection.inverse_masses[k] = weights[k];
-            if let Some(correction) = &correction {
+            projection.inverse_masses[k] = unit.weights[k];
+            if !(K == 1 && skipped) {
                 projection.delta_x[k] = correction.delta_x[k];
             }
         }

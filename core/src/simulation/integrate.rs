@@ -23,12 +23,16 @@ pub(crate) struct Residuals<'a, V> {
 
 /// What a substep's prediction needs to know: gravity g (m/s², along −y), the substep's length
 /// h (s), the ground's height, if there is one, and whether every particle keeps its z
-/// (plane strain, [`hold_plane`]).
+/// (plane strain, `hold_plane`).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Substep {
+pub struct Substep {
+    /// Gravity g in m/s², along −y.
     pub gravity: f64,
+    /// The substep's length h in s.
     pub h: f64,
+    /// The ground's height, if there is a ground.
     pub ground: Option<f64>,
+    /// Whether every particle keeps its z.
     pub plane_strain: bool,
 }
 

@@ -1,126 +1,89 @@
-//! The simulation that every front end drives: XPBD (default) or PBD on the constraint families
-//! of [`crate::constraints::TABLE`], with substeps, gravity, a ground plane, pins and a grab
-//! constraint.
+//! The simulation every front end drives: XPBD (default) or PBD on the constraint families of a
+//! table ([`crate::constraints::Families`]), with substeps, gravity, a ground plane, pins, a grab
+//! and external forces.
 //!
-//! One substep of length h = Δt / substeps:
-//! 1. predict: v += g h, x_prev = x, x += v h; a particle predicted below the ground (y < 0) is put
-//!    back at its previous position, on the ground (sticking friction);
-//! 2. XPBD only: λ = 0 for every constraint;
-//! 3. `iterations` Gauss–Seidel sweeps over the active families in the table's order (edges,
-//!    heights, volume), then the grab, then the ground y ≥ 0, each constraint projected at once;
-//! 4. v = (x − x_prev) / h, then damped: v *= max(0, 1 − damping · h) — except, with
-//!    [`Settings::settle_edits`], while an edit settles: there |v| is also capped at the predicted
-//!    speed, so the projections may turn the motion but never speed it up.
+//! A [`Simulation`] owns what it simulates: the settings as the user set them ([`Settings`]; what
+//! follows from them is [`Resolved`]), the table of families, the [`Body`] and the [`State`]. An
+//! [`Engine`] steps the state a frame at a time (`engine.rs`): the reference engine (f64, one
+//! constraint at a time, `reference.rs`) or the fast one (f32, SIMD lanes, threads, [`fast`]);
+//! both run the substep written once in `substep.rs`, and both project by the one rule of
+//! [`projection`]. Edits (`edits.rs`) change the state through `Simulation::state_mut` (or the
+//! body through `Simulation::body_mut`), which bump the [`Revision`] that engines compare; what
+//! a reader asks between steps is `inspection.rs`.
 //!
-//! The correction Δp of a substep is, per particle, the position after the sweeps minus the
-//! predicted one ([`Simulation::corrections`]). An edit (a perturbation, a particle placed by hand)
-//! settles until no particle's Δp, summed over a frame's substeps, exceeds
-//! [`Simulation::settle_tolerance`]: until its violation is undone, however long that takes. (It
-//! once ended after at most a second as well; a body still tangled then, its rigid constraints
-//! still fighting, was launched at hundreds of m/s when the cap came off.)
-//!
-//! Each constraint is projected by the rule of [`crate::simulation::projection`] (XPBD or PBD), which the
-//! fast solver shares. All state lives in flat arrays, one [`ConstraintSet`] per family,
-//! allocated once: a step allocates nothing, and the same inputs give the same bits.
-//!
-//! Reading map, for one volume projection: [`Simulation::step`] → [`Simulation::substep`]
-//! (`substep.rs`: predict, then `sweep` over each active family, through [`Family::visit`], then
-//! `end_substep`) → `project_range` → the `Sweep` visitor → [`crate::constraints::volume::evaluate`]
-//! → `correction_lanes` ([`crate::simulation::projection`]). Edits (`edits.rs`) and what a reader
-//! asks between steps (`inspection.rs`) stand beside it; `engine.rs` hands a frame to the fast
-//! solver instead.
+//! Reading map, for one volume projection: [`Simulation::step`] → [`Engine::step`] of
+//! [`reference::ReferenceEngine`] → `substep::frame` → `OnState::project` →
+//! [`crate::constraints::Families::visit_unit`] → the `Sweep` visitor → `project_unit` →
+//! [`crate::constraints::volume::evaluate`] and [`projection::correct`].
 
 mod constraint_set;
 pub mod divergence;
 mod edits;
 mod engine;
+mod engine_choice;
+mod engine_slot;
 pub mod fast;
 mod inspection;
 mod integrate;
 mod masses;
-mod pair;
 pub mod projection;
-mod settings;
-mod substep;
+mod reference;
+mod resolved;
+pub(crate) mod settings;
+mod state;
+mod stepping;
+pub mod substep;
 
 pub use crate::input::limits::SOUND_LIMIT;
 pub use constraint_set::ConstraintSet;
+pub use engine::{Build, Engine, Frame, Start};
+pub use engine_choice::{EngineChoice, FAST_FROM_TETS};
 pub use inspection::Projection;
 pub use masses::DENSITY;
-pub use settings::{
-    DEFAULT_SUBSTEPS, Engine, FAST_FROM_TETS, Method, Settings, family_value, settable_family,
-};
-use substep::Projected;
+pub use reference::{OnState, ReferenceEngine};
+pub use resolved::Resolved;
+pub use settings::{DEFAULT_SUBSTEPS, Method, Settings, settable_family};
+pub use state::{Body, Grab, Revision, State};
 
-use crate::constraints::{Constraint, Families, Family, PerFamily, Visit, distance};
+use crate::constraints::{Families, Family, PerFamily};
 use crate::scene::Scene;
 use crate::scene::mesh::TetMesh;
 use crate::simulation::divergence::Divergence;
-use crate::simulation::projection::{Rule, SkipCounts, correction, correction_lanes};
+use crate::simulation::projection::SkipCounts;
+use engine_slot::EngineSlot;
 use glam::DVec3;
 
 /// An edit has settled when the speed the corrections of a frame would give a particle, ΣΔp / h
 /// over its substeps, is at most this many mean rest edge lengths per second (plus what gravity
-/// alone causes; see [`Simulation::settle_tolerance`]).
-///
-/// Why a frame's sum, as a speed: each substep's Δp adds Δp / h to the velocity once settling
-/// ends, so what is released is the sum, divided by h. The first rule, the largest Δp of the last
-/// substep below 10⁻³ of an edge, held at 10 substeps (where it is about this bound); at 100 a
-/// cube still being unmirrored at capped speed passed it (4 × 10⁻⁵ m a substep, a hundred
-/// substeps a frame) and took off at 2.6 m/s.
+/// alone causes; see [`Simulation::settle_tolerance`]). docs/experiments.md says how it was
+/// chosen.
 pub const SETTLE_SPEED: f64 = 6.0;
-
-/// A particle held by the user.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Grab {
-    /// The particle.
-    pub particle: usize,
-    /// Where the user holds it.
-    pub target: DVec3,
-    target_at_last_step: DVec3,
-    /// How fast the target moved over the last step.
-    pub target_velocity: DVec3,
-    lambda: f64,
-}
 
 /// The soft body in motion.
 #[derive(Clone, Debug)]
 pub struct Simulation {
+    /// The settings as they were set.
     settings: Settings,
-    rest_positions: Vec<DVec3>,
-    positions: Vec<DVec3>,
-    previous: Vec<DVec3>,
-    velocities: Vec<DVec3>,
-    /// Inverse masses from the lumped masses, 0 where pinned.
-    inverse_masses: Vec<f64>,
-    pinned: Vec<bool>,
-    lumped_inverse_masses: Vec<f64>,
-    tets: Vec<[u32; 4]>,
-    /// The constraints of each family, as its binding makes them.
-    sets: PerFamily<ConstraintSet>,
-    grab: Option<Grab>,
-    /// Δp of the last substep; during a substep, the predicted positions.
-    corrections: Vec<DVec3>,
-    /// The sum of Δp over the substeps of the frame so far, the measure of "settled".
-    frame_corrections: Vec<DVec3>,
-    /// The mean rest edge length, the scale of "settled".
-    mean_edge: f64,
+    /// The table of families it simulates: the built-in ones and the files it was given.
+    families: Families,
+    /// The settings resolved against the table (kept with them: [`Simulation::resolve`]).
+    resolved: Resolved,
+    /// The material the rest values were measured with.
+    measured_with: crate::constraints::material::Material,
+    body: Body,
+    state: State,
+    /// How often the body and the state have been edited.
+    revision: Revision,
     /// Frames an edit has been settling, `None` when none is; see [`Settings::settle_edits`].
     settling: Option<u32>,
     frame: u64,
     time: f64,
-    /// The table of families it simulates: the built-in ones and the files it was given.
-    families: Families,
-    /// The fast engine, when [`Simulation::engine`] is [`Engine::Fast`] ([`engine`]).
-    fast: engine::FastEngine,
-    /// Threads for the fast engine.
+    /// The engine that steps it.
+    engine: EngineSlot,
+    /// Threads an engine may use.
     threads: usize,
     /// Projections skipped for a counted reason since the start (or the last reset), per family.
     skipped: PerFamily<SkipCounts>,
-    /// External forces per particle in N, besides gravity (empty: none).
-    forces: Vec<DVec3>,
-    /// Whether every particle keeps its z (plane strain).
-    plane_strain: bool,
 }
 
 impl Simulation {
@@ -131,82 +94,67 @@ impl Simulation {
     }
 
     /// [`Simulation::new`] on the families of `families`: the built-in ones and those of the
-    /// constraint files in it.
-    ///
-    /// Only families of the table are active: `settings.active` is kept to them (a
-    /// [`PerFamily::splat`] of `true` means every family the table has).
+    /// constraint files in it. Only families of the table are active ([`Resolved::active`]).
     pub fn with_families(scene: &Scene, settings: Settings, families: Families) -> Simulation {
-        let settings = Settings {
-            active: families.per_family(|f| settings.active[f]),
-            compliance: families.with_file_stiffness(settings.compliance, &settings.material),
-            from_material: families.from_material(),
-            ..settings
-        };
         let mesh = &scene.mesh;
-        let positions = mesh.positions.clone();
-        let sets = families
-            .per_family(|family| ConstraintSet::new(&families, family, mesh, &settings.material));
-        let lumped_inverse_masses = masses::lumped_inverse_masses(mesh);
+        let resolved = Resolved::new(&settings, &families);
+        let material = settings.material;
+        let sets = families.per_family(|f| ConstraintSet::new(&families, f, mesh, &material));
         let edges = mesh.edges();
+        let positions = &mesh.positions;
         let mean_edge = if edges.is_empty() {
             1.0
         } else {
             let length = |&[i, j]: &[u32; 2]| positions[i as usize].distance(positions[j as usize]);
             edges.iter().map(length).sum::<f64>() / edges.len() as f64
         };
-        let mut pinned = vec![false; positions.len()];
+        let body = Body {
+            rest_positions: mesh.positions.clone(),
+            tets: mesh.tets.clone(),
+            lumped_inverse_masses: masses::lumped_inverse_masses(mesh),
+            forces: Vec::new(),
+            plane_strain: false,
+            mean_edge,
+            sets,
+        };
+        let mut state = State::at_rest(&body);
         for &i in &scene.pinned {
-            pinned[i as usize] = true;
+            state.pinned[i as usize] = true;
+            state.inverse_masses[i as usize] = 0.0;
         }
-        let n = positions.len();
         let mut simulation = Simulation {
             settings,
-            rest_positions: positions.clone(),
-            previous: positions.clone(),
-            positions,
-            velocities: vec![DVec3::ZERO; n],
-            inverse_masses: vec![0.0; n],
-            pinned,
-            lumped_inverse_masses,
-            tets: mesh.tets.clone(),
-            sets,
-            grab: None,
-            corrections: vec![DVec3::ZERO; n],
-            frame_corrections: vec![DVec3::ZERO; n],
-            mean_edge,
+            families,
+            resolved,
+            measured_with: material,
+            body,
+            state,
+            revision: Revision::default(),
             settling: None,
             frame: 0,
             time: 0.0,
-            families,
-            fast: engine::FastEngine::default(),
+            engine: EngineSlot::default(),
             threads: 1,
             skipped: PerFamily::default(),
-            forces: Vec::new(),
-            plane_strain: false,
         };
-        simulation.update_inverse_masses();
         simulation.apply_orders();
         simulation
     }
 
-    #[doc(hidden)]
-    pub fn scratch_set_order(&mut self, family: Family, order: Vec<u32>) {
-        self.sets[family].set_order(Some(order));
-    }
-
-    /// Gives every family's constraints the order [`Settings::order_seed`] asks for.
-    fn apply_orders(&mut self) {
-        for family in self.families.all() {
-            let order = self
-                .settings
-                .projection_order(family, self.sets[family].len());
-            self.sets[family].set_order(order);
-        }
-    }
-
-    /// The settings in force.
+    /// The settings as they were set ([`Simulation::set_settings`]).
     pub fn settings(&self) -> &Settings {
         &self.settings
+    }
+
+    /// The settings resolved against the table: the compliances the material gives, the
+    /// active families of the table, the rules.
+    pub fn resolved(&self) -> &Resolved {
+        &self.resolved
+    }
+
+    /// The active families of the table ([`Resolved::active`]).
+    pub fn active(&self) -> &PerFamily<bool> {
+        &self.resolved.active
     }
 
     /// The table of families it simulates.
@@ -214,20 +162,45 @@ impl Simulation {
         &self.families
     }
 
+    /// Changes the settings; they apply from the next substep. The constraints of a family they
+    /// switch on that the simulation has not built yet (one a file added to the table since) are
+    /// built, rest values that depend on the material are measured again when it changed, and
+    /// the constraints are put in the order a new order seed asks for.
+    pub fn set_settings(&mut self, settings: Settings) {
+        let reorder = settings.order_seed != self.settings.order_seed;
+        self.settings = settings;
+        self.resolve();
+        if reorder {
+            self.apply_orders();
+        }
+    }
+
     /// Simulates the families of `families` from now on (the workbench's editor redefines a
     /// constraint file's family as you type): the constraints of a family whose definition
     /// changed are rebuilt, those of an active family new to the table are built, and nothing
     /// else is touched.
     pub fn set_families(&mut self, families: Families) {
-        let active = families.per_family(|f| self.settings.active[f]);
-        if active != self.settings.active {
-            self.fast.solver = None;
-        }
-        self.settings.active = active;
-        self.settings.compliance =
-            families.with_file_stiffness(self.settings.compliance, &self.settings.material);
-        self.settings.from_material = families.from_material();
         self.families = families;
+        self.resolve();
+    }
+
+    /// Works out what follows from the settings and the table ([`Resolved`]), and brings the
+    /// body's constraints in line with them: built for every active family, rebuilt where the
+    /// definition changed, rest values measured again when the material changed.
+    fn resolve(&mut self) {
+        self.resolved = Resolved::new(&self.settings, &self.families);
+        let material = self.settings.material;
+        if material != self.measured_with {
+            self.measured_with = material;
+            let families = self.families.clone();
+            let body = self.body_mut();
+            for family in families.all() {
+                if families.row(family).rest_uses_material {
+                    let rest = &body.rest_positions;
+                    body.sets[family].measure_rest(&families, family, rest, &material);
+                }
+            }
+        }
         self.rebuild_stale_sets();
     }
 
@@ -235,83 +208,125 @@ impl Simulation {
     /// builds those of an active family that joined the table since the simulation was made.
     /// Allocates only what it builds.
     fn rebuild_stale_sets(&mut self) {
-        let mut mesh = None;
-        for family in self.families.all() {
-            let set = &self.sets[family];
-            if set.is_current(&self.families, family)
-                || !(set.is_built() || self.settings.active[family])
-            {
-                continue;
-            }
-            let mesh = mesh.get_or_insert_with(|| TetMesh {
-                positions: self.rest_positions.clone(),
-                tets: self.tets.clone(),
-            });
-            self.sets[family] =
-                ConstraintSet::new(&self.families, family, mesh, &self.settings.material);
-            let order = self
-                .settings
-                .projection_order(family, self.sets[family].len());
-            self.sets[family].set_order(order);
-            // The fast engine's constraints were built from the old ones.
-            self.fast.solver = None;
+        let stale = self.families.per_family(|family| {
+            let set = &self.body.sets[family];
+            !set.is_current(&self.families, family) && (set.is_built() || self.active()[family])
+        });
+        if stale.families().next().is_none() {
+            return;
+        }
+        let mesh = TetMesh {
+            positions: self.body.rest_positions.clone(),
+            tets: self.body.tets.clone(),
+        };
+        let (families, settings) = (self.families.clone(), self.settings);
+        for family in stale.families() {
+            let set = ConstraintSet::new(&families, family, &mesh, &settings.material);
+            let len = set.len();
+            self.body_mut().sets[family] = set;
+            self.state_mut().lambdas[family] = vec![0.0; len];
+        }
+        self.apply_orders();
+    }
+
+    /// Gives every family's constraints the order [`Settings::order_seed`] asks for. Not an
+    /// edit of the body: the order follows from the settings, which every engine reads afresh
+    /// each frame.
+    fn apply_orders(&mut self) {
+        let (families, settings) = (&self.families, &self.settings);
+        let sets = &mut self.body.sets;
+        for family in families.all() {
+            let order = settings.projection_order(family, sets[family].len());
+            sets[family].set_order(order);
         }
     }
 
-    /// Changes the settings; they apply from the next substep. The constraints of a family
-    /// they switch on that the simulation has not built yet (one a file added to the table
-    /// since) are built.
-    pub fn set_settings(&mut self, settings: Settings) {
-        let settings = Settings {
-            active: self.families.per_family(|f| settings.active[f]),
-            compliance: self
-                .families
-                .with_file_stiffness(settings.compliance, &settings.material),
-            from_material: self.families.from_material(),
-            ..settings
-        };
-        if settings.material != self.settings.material {
-            for family in self.families.all() {
-                if self.families.rest_uses_material(family) {
-                    let rest = &self.rest_positions;
-                    self.sets[family].measure_rest(
-                        &self.families,
-                        family,
-                        rest,
-                        &settings.material,
-                    );
-                }
-            }
+    /// The state to edit, beside the table and the body it is read with: the one place the
+    /// state changes outside an engine's step, so that the [`Revision`] every engine compares
+    /// is bumped.
+    pub(crate) fn edit(&mut self) -> (&Families, &Body, &mut State) {
+        self.revision.state += 1;
+        (&self.families, &self.body, &mut self.state)
+    }
+
+    /// The state, to edit ([`Simulation::edit`]).
+    pub(crate) fn state_mut(&mut self) -> &mut State {
+        self.edit().2
+    }
+
+    /// The body, to edit ([`Simulation::state_mut`], for the body).
+    pub(crate) fn body_mut(&mut self) -> &mut Body {
+        self.revision.body += 1;
+        &mut self.body
+    }
+
+    /// The state: positions, velocities, multipliers, the grab.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// The body: rest positions, tets, masses, constraints, loads.
+    pub fn body(&self) -> &Body {
+        &self.body
+    }
+
+    /// How often the body and the state have been edited.
+    pub fn revision(&self) -> Revision {
+        self.revision
+    }
+
+    /// What an engine would be built from now.
+    pub fn start(&self) -> Start<'_> {
+        Start {
+            families: &self.families,
+            resolved: &self.resolved,
+            body: &self.body,
+            state: &self.state,
+            revision: self.revision,
+            threads: self.threads,
         }
-        self.fast.set_settings(&self.settings, &settings);
-        let reorder = settings.order_seed != self.settings.order_seed;
-        self.settings = settings;
-        if reorder {
-            self.apply_orders();
-        }
-        self.rebuild_stale_sets();
     }
 
     /// Current particle positions.
     pub fn positions(&self) -> &[DVec3] {
-        &self.positions
+        &self.state.positions
     }
 
     /// Rest positions (the scene as made).
     pub fn rest_positions(&self) -> &[DVec3] {
-        &self.rest_positions
+        &self.body.rest_positions
     }
 
     /// Current particle velocities.
     pub fn velocities(&self) -> &[DVec3] {
-        &self.velocities
+        &self.state.velocities
     }
 
     /// Δp of the last substep, per particle: the position after the constraint projections minus
     /// the predicted position. Zero after a perturbation or a reset, and for a particle placed by
     /// hand, until the next substep.
     pub fn corrections(&self) -> &[DVec3] {
-        &self.corrections
+        &self.state.corrections
+    }
+
+    /// Inverse masses in use (0 for pinned or grabbed-rigidly particles).
+    pub fn inverse_masses(&self) -> &[f64] {
+        &self.state.inverse_masses
+    }
+
+    /// The tets, as indices into the positions.
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.body.tets
+    }
+
+    /// The external forces on the particles in N, besides gravity: empty when there are none.
+    pub fn forces(&self) -> &[DVec3] {
+        &self.body.forces
+    }
+
+    /// Whether every particle keeps its z coordinate ([`Simulation::set_plane_strain`]).
+    pub fn plane_strain(&self) -> bool {
+        self.body.plane_strain
     }
 
     /// Whether an edit is settling (see [`Settings::settle_edits`]).
@@ -319,9 +334,28 @@ impl Simulation {
         self.settling.is_some()
     }
 
-    /// For how many frames the edit being settled has been settling, `None` when none is.
-    pub fn settling_frames(&self) -> Option<u32> {
-        self.settling
+    /// Frames stepped since the start.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Simulated time in seconds.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Per family, the projections skipped since the start (or the last reset) because ∇C was
+    /// undefined or not finite, or because the step would have moved a particle further than
+    /// [`crate::simulation::projection::DEFAULT_REACH`] rest edges of its element. Zero for every
+    /// built-in family on every scene tetlab ships; a constraint file whose ∇C vanishes where C
+    /// does not counts here instead of flinging particles away.
+    pub fn skipped(&self) -> &PerFamily<SkipCounts> {
+        &self.skipped
+    }
+
+    /// h = Δt / substeps.
+    pub fn substep_length(&self) -> f64 {
+        self.resolved.substep_length()
     }
 
     /// The largest sum of Δp over a frame's substeps, in metres, at which an edit counts as
@@ -341,7 +375,7 @@ impl Simulation {
     /// ```
     pub fn settle_tolerance(&self) -> f64 {
         let h = self.substep_length();
-        (SETTLE_SPEED * self.mean_edge + self.settings.gravity.abs() * self.settings.dt) * h
+        (SETTLE_SPEED * self.body.mean_edge + self.settings.gravity.abs() * self.settings.dt) * h
     }
 
     /// The centre of mass of the particles at `positions` (one per particle, e.g.
@@ -359,7 +393,7 @@ impl Simulation {
     pub fn centre_of_mass(&self, positions: &[DVec3]) -> DVec3 {
         let mut weighted = DVec3::ZERO;
         let mut mass = 0.0;
-        for (p, w) in positions.iter().zip(&self.lumped_inverse_masses) {
+        for (p, w) in positions.iter().zip(&self.body.lumped_inverse_masses) {
             weighted += *p / *w;
             mass += 1.0 / *w;
         }
@@ -372,60 +406,31 @@ impl Simulation {
 
     /// The diagonal of the rest shape's bounding box, in metres: the size of the body.
     pub fn rest_diagonal(&self) -> f64 {
-        let (low, high) = self.rest_positions.iter().fold(
+        let rest = &self.body.rest_positions;
+        let (low, high) = rest.iter().fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(low, high), p| (low.min(*p), high.max(*p)),
         );
-        if self.rest_positions.is_empty() {
+        if rest.is_empty() {
             0.0
         } else {
             low.distance(high)
         }
     }
 
-    /// Inverse masses in use (0 for pinned or grabbed-rigidly particles).
-    pub fn inverse_masses(&self) -> &[f64] {
-        &self.inverse_masses
-    }
-
-    /// Per family, the projections skipped since the start (or the last reset) because ∇C was
-    /// undefined or not finite, or because the step would have moved a particle further than
-    /// [`crate::simulation::projection::DEFAULT_REACH`] rest edges of its element. Zero for every built-in family on
-    /// every scene tetlab ships; a constraint file whose ∇C vanishes where C does not counts
-    /// here instead of flinging particles away.
-    pub fn skipped(&self) -> &PerFamily<SkipCounts> {
-        &self.skipped
-    }
-
-    /// The tets, as indices into the positions.
-    pub fn tets(&self) -> &[[u32; 4]] {
-        &self.tets
-    }
-
-    /// Frames stepped since the start.
-    pub fn frame(&self) -> u64 {
-        self.frame
-    }
-
-    /// Simulated time in seconds.
-    pub fn time(&self) -> f64 {
-        self.time
-    }
-
     /// Ok while every coordinate and velocity component is finite and below [`SOUND_LIMIT`] in
-    /// size, and on the fast engine every f32 coordinate (measured from its origin, which
-    /// follows the body) below [`crate::simulation::fast::POSITION_LIMIT`]; otherwise the first that is not.
-    /// Within the input [`crate::input::limits`] only an instability leaves that range; front ends
-    /// check after every frame and stop.
+    /// size, and what the engine holds of its own is sound ([`Engine::check`]); otherwise the
+    /// first that is not. Within the input [`crate::input::limits`] only an instability leaves
+    /// that range; front ends check after every frame and stop.
     pub fn check(&self) -> Result<(), Divergence> {
-        if let (Engine::Fast, Some(fast)) = (self.engine(), &self.fast.solver) {
-            fast.check()?;
+        if let Some((_, engine)) = &self.engine.built {
+            engine.check()?;
         }
         Divergence::find(
             self.frame,
             (SOUND_LIMIT, SOUND_LIMIT),
-            self.positions.iter().map(|p| p.to_array()),
-            self.velocities.iter().map(|v| v.to_array()),
+            self.state.positions.iter().map(|p| p.to_array()),
+            self.state.velocities.iter().map(|v| v.to_array()),
             |i| i,
         )
     }
@@ -435,36 +440,16 @@ impl Simulation {
         self.check().is_ok()
     }
 
-    /// The bytes of memory the simulation's arrays take (their capacities).
+    /// The bytes of memory the simulation's arrays take (their capacities), its engine's
+    /// included.
     pub fn heap_bytes(&self) -> usize {
-        fn bytes<T>(v: &Vec<T>) -> usize {
-            v.capacity() * size_of::<T>()
-        }
-        bytes(&self.rest_positions)
-            + bytes(&self.positions)
-            + bytes(&self.previous)
-            + bytes(&self.velocities)
-            + bytes(&self.inverse_masses)
-            + bytes(&self.pinned)
-            + bytes(&self.lumped_inverse_masses)
-            + bytes(&self.tets)
-            + bytes(&self.corrections)
-            + bytes(&self.frame_corrections)
-            + self
-                .sets
-                .every_place()
-                .map(ConstraintSet::heap_bytes)
-                .sum::<usize>()
-            + self.fast.solver.as_ref().map_or(0, |f| f.heap_bytes())
+        self.body.heap_bytes()
+            + self.state.heap_bytes()
+            + (self.engine.built.as_ref()).map_or(0, |(_, engine)| engine.heap_bytes())
     }
 
-    /// The external forces on the particles in N, besides gravity: empty when there are none.
-    pub fn forces(&self) -> &[DVec3] {
-        &self.forces
-    }
-
-    /// Whether every particle keeps its z coordinate ([`Simulation::set_plane_strain`]).
-    pub fn plane_strain(&self) -> bool {
-        self.plane_strain
+    /// The constraints of `family`: their particles, rest values and order.
+    pub fn constraints(&self, family: Family) -> &ConstraintSet {
+        &self.body.sets[family]
     }
 }

@@ -1,5 +1,6 @@
-//! The projection rule both solvers share: how one constraint moves its particles, in any
-//! precision and for one constraint or eight in SIMD lanes.
+//! The projection rule every engine shares ([`correct`]): how one projection moves its
+//! particles, in any precision and for one element or eight in SIMD lanes, for a family alone
+//! (K = 1 value) or two projected together (K = 2).
 //!
 //! Projecting one constraint C with particles i, gradients ∇ᵢC and inverse masses wᵢ:
 //! - XPBD: α̃ = α / h², Δλ = (−C − α̃ λ) / (Σ wᵢ|∇ᵢC|² + α̃), λ += Δλ, Δxᵢ = wᵢ ∇ᵢC Δλ;
@@ -13,21 +14,77 @@
 //! where every particle is fixed, where it is [`LOCKED`], and where its step would be longer
 //! than [`DEFAULT_REACH`] times the longest rest edge of its element: such a step is not a correction
 //! but a singularity of ∇C (see [`DEFAULT_REACH`]). The degenerate and the too long are counted
-//! ([`Skips`]).
+//! ([`SkipCounts`]).
 
 pub use super::settings::DEFAULT_REACH;
-use super::settings::{Method, Settings};
-use crate::constraints::{Evaluation, Family};
+use crate::constraints::Evaluation;
 use crate::numbers::vector::{Real, Vector3};
 use glam::DVec3;
 
-/// The change one projection makes: Δλ (XPBD; the scaled step s for PBD) and Δx per particle.
+/// The change one projection of `K` values makes: Δλ of each (XPBD; the scaled step s for PBD),
+/// Δx per particle, and why each value was skipped, among the counted reasons.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Correction<const N: usize, V: Vector3 = DVec3> {
-    /// XPBD: Δλ. PBD: k′ s.
-    pub delta_lambda: V::Real,
-    /// Δx for each particle of the constraint.
+pub struct Correction<const N: usize, const K: usize, V: Vector3 = DVec3> {
+    /// XPBD: Δλ. PBD: k′ s. Zero for a value that is skipped.
+    pub delta_lambda: [V::Real; K],
+    /// Δx for each particle (zero when every value is skipped).
     pub delta_x: [V; N],
+    /// Whether each value was skipped, and why ([`Skipped`]).
+    pub skipped: [Skipped<<V::Real as Real>::Mask>; K],
+}
+
+/// The correction of a projection of `K` values at once, the rule every engine runs: for
+/// K = 1 the rule of the module's documentation, for K = 2 the 2 × 2 solve of two constraints on
+/// the same particles (`pair_correction_lanes`). In any precision, for one element or eight in
+/// SIMD lanes; branch-free within each.
+///
+/// ```
+/// use glam::DVec3;
+/// use tetlab_core::constraints::distance;
+/// use tetlab_core::simulation::projection::{Rule, correct};
+/// // A rigid edge stretched from 1 to 2 between equal masses: each end moves half the way.
+/// let (a, b) = (DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0));
+/// let e = distance::evaluate(&[a, b], 1.0);
+/// let rule = Rule::Xpbd { alpha_tilde: 0.0 };
+/// let c = correct([e], [1.0, 1.0], [0.0], [rule], f64::INFINITY);
+/// assert!((c.delta_x[0] - DVec3::new(0.5, 0.0, 0.0)).length() < 1e-15);
+/// assert!((c.delta_x[1] + DVec3::new(0.5, 0.0, 0.0)).length() < 1e-15);
+/// ```
+#[inline(always)]
+pub fn correct<V: Vector3, const N: usize, const K: usize>(
+    evaluations: [Evaluation<V, N>; K],
+    weights: [V::Real; N],
+    lambda: [V::Real; K],
+    rules: [Rule<V::Real>; K],
+    reach: V::Real,
+) -> Correction<N, K, V> {
+    match K {
+        1 => {
+            let (skipped, (delta_lambda, delta_x)) =
+                correction_lanes(evaluations[0], weights, lambda[0], rules[0], reach);
+            Correction {
+                delta_lambda: [delta_lambda; K],
+                delta_x,
+                skipped: [skipped; K],
+            }
+        }
+        2 => {
+            let pair = pair_correction_lanes(
+                evaluations[0],
+                evaluations[1],
+                weights,
+                [lambda[0], lambda[1]],
+                [rules[0], rules[1]],
+                reach,
+            );
+            Correction {
+                delta_lambda: std::array::from_fn(|k| pair.delta_lambda[k]),
+                delta_x: pair.delta_x,
+                skipped: std::array::from_fn(|k| pair.skipped[k]),
+            }
+        }
+        _ => unreachable!("a projection has one value or two"),
+    }
 }
 
 /// How a correction is scaled: XPBD with α̃ = α / h², or PBD with the per-iteration stiffness k′.
@@ -50,27 +107,16 @@ pub enum Rule<R> {
     },
 }
 
-impl Rule<f64> {
-    /// The rule `settings` give `family` in a substep of length h: XPBD α̃ = α / h², or PBD
-    /// k′ = 1 − (1 − k)^(1/iterations), so that the sweeps of a substep compound to k.
-    pub fn for_settings(settings: &Settings, family: Family, h: f64) -> Rule<f64> {
-        match settings.method {
-            Method::Xpbd => Rule::Xpbd {
-                alpha_tilde: settings.compliance[family] / (h * h),
-            },
-            Method::Pbd if settings.from_material[family] => Rule::CompliantPbd {
-                alpha_tilde: settings.compliance[family] / (h * h),
-            },
-            Method::Pbd => {
-                let k = settings.stiffness[family].clamp(0.0, 1.0);
-                let n = settings.iterations.max(1) as f64;
-                Rule::Pbd {
-                    k: 1.0 - (1.0 - k).powf(1.0 / n),
-                }
-            }
+/// Rigid XPBD (α̃ = 0).
+impl<R: Real> Default for Rule<R> {
+    fn default() -> Self {
+        Rule::Xpbd {
+            alpha_tilde: R::ZERO,
         }
     }
+}
 
+impl Rule<f64> {
     /// The same rule in another precision.
     pub fn to<R: Real>(self) -> Rule<R> {
         match self {
@@ -86,8 +132,8 @@ impl Rule<f64> {
 }
 
 /// The correction that projecting one constraint would make, or `None` when it is skipped
-/// (degenerate, every particle pinned, or a step longer than `reach`, [`DEFAULT_REACH`]). In any
-/// precision: the f64 path and the fast f32 path share it, through [`correction_lanes`].
+/// (degenerate, every particle pinned, or a step longer than `reach`, [`DEFAULT_REACH`]), for one
+/// constraint in f64 or f32 ([`correct`] with K = 1).
 #[inline]
 pub(crate) fn correction<V: Vector3, const N: usize>(
     evaluation: Evaluation<V, N>,
@@ -95,12 +141,12 @@ pub(crate) fn correction<V: Vector3, const N: usize>(
     lambda: V::Real,
     rule: Rule<V::Real>,
     reach: V::Real,
-) -> Option<Correction<N, V>>
+) -> Option<Correction<N, 1, V>>
 where
     V::Real: Real<Mask = bool>,
 {
-    let (skipped, correction) = correction_lanes(evaluation, weights, lambda, rule, reach);
-    (!skipped.any()).then_some(correction)
+    let correction = correct([evaluation], weights, [lambda], [rule], reach);
+    (!correction.skipped[0].any()).then_some(correction)
 }
 
 /// Whether a projection (or each lane of one) was skipped (`all`), and the reasons that are
@@ -165,13 +211,13 @@ impl std::ops::Add for SkipCounts {
 /// can barely change it), and where the step max |Δxᵢ| is longer than `reach` (or not a number);
 /// the counted reasons are returned ([`Skipped`]).
 #[inline(always)]
-pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
+fn correction_lanes<V: Vector3, const N: usize>(
     evaluation: Evaluation<V, N>,
     weights: [V::Real; N],
     lambda: V::Real,
     rule: Rule<V::Real>,
     reach: V::Real,
-) -> (Skipped<<V::Real as Real>::Mask>, Correction<N, V>) {
+) -> (Skipped<<V::Real as Real>::Mask>, Step<V, N>) {
     let (skipped, degenerate, weighted_norm, largest) = skipped_lanes(&evaluation, &weights);
     let delta_lambda = match rule {
         Rule::Xpbd { alpha_tilde } => {
@@ -195,12 +241,15 @@ pub(crate) fn correction_lanes<V: Vector3, const N: usize>(
             degenerate,
             too_long,
         },
-        Correction {
-            delta_lambda: V::Real::select(skipped, V::Real::ZERO, delta_lambda),
+        (
+            V::Real::select(skipped, V::Real::ZERO, delta_lambda),
             delta_x,
-        },
+        ),
     )
 }
+
+/// What one value's projection changes: Δλ, and Δx per particle.
+type Step<V, const N: usize> = (<V as Vector3>::Real, [V; N]);
 
 /// What [`skipped_lanes`] finds: whether each lane is skipped, which of those are counted as
 /// degenerate, Σ wᵢ|∇ᵢC|², and max wᵢ²|∇ᵢC|².
@@ -239,18 +288,6 @@ fn skipped_lanes<V: Vector3, const N: usize>(
     )
 }
 
-/// What projecting two constraints of the same particles together makes: Δλ of each and the
-/// particles' Δx.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PairCorrection<const N: usize, V: Vector3 = DVec3> {
-    /// Δλ of the first and of the second constraint (0 for one that is skipped).
-    pub delta_lambda: [V::Real; 2],
-    /// Δx for each particle.
-    pub delta_x: [V; N],
-    /// Why each of the two was skipped, among the counted reasons (a step too long skips both).
-    pub skipped: [Skipped<<V::Real as Real>::Mask>; 2],
-}
-
 /// Two constraints on the same particles projected together (the neo-Hookean pair, whose two
 /// constraints pull against each other at rest): with gᵃ, gᵇ their gradients, W the inverse
 /// masses and α̃ each one's compliance / h², Δλ solves the 2 × 2 system
@@ -265,14 +302,14 @@ pub struct PairCorrection<const N: usize, V: Vector3 = DVec3> {
 /// the gradients are parallel and the compliances nearly 0 (a tet at rest). A step longer than
 /// `reach` skips both ([`DEFAULT_REACH`]).
 #[inline(always)]
-pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
+fn pair_correction_lanes<V: Vector3, const N: usize>(
     first: Evaluation<V, N>,
     second: Evaluation<V, N>,
     weights: [V::Real; N],
     lambda: [V::Real; 2],
     rules: [Rule<V::Real>; 2],
     reach: V::Real,
-) -> PairCorrection<N, V> {
+) -> Correction<N, 2, V> {
     let zero = V::Real::ZERO;
     let one = V::Real::ONE;
     let part = |e: &Evaluation<V, N>, lambda: V::Real, rule: Rule<V::Real>| {
@@ -323,7 +360,7 @@ pub(crate) fn pair_correction_lanes<V: Vector3, const N: usize>(
         degenerate,
         too_long,
     };
-    PairCorrection {
+    Correction {
         delta_lambda: [
             V::Real::select(too_long, zero, delta_a),
             V::Real::select(too_long, zero, delta_b),
@@ -346,9 +383,14 @@ pub fn project_kernel<V: Vector3, const N: usize>(
     let rule = Rule::Xpbd {
         alpha_tilde: V::Real::ZERO,
     };
-    correction_lanes(evaluate(points, rest), weights, V::Real::ZERO, rule, reach)
-        .1
-        .delta_x
+    correct(
+        [evaluate(points, rest)],
+        weights,
+        [V::Real::ZERO],
+        [rule],
+        reach,
+    )
+    .delta_x
 }
 
 /// Below this fraction of max wᵢ · Σ|∇ᵢC|², Σ wᵢ|∇ᵢC|² says that the particles free to move

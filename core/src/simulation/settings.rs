@@ -1,8 +1,11 @@
-//! How a simulation runs: [`Settings`], and the rules they follow (their ranges are
-//! [`crate::input::limits`], checked by [`Settings::check`]; the ground is on when gravity is not zero,
-//! [`Settings::set_gravity`]). The command line, lessons, `tetlab bench` and the workbench all
-//! build their settings here.
+//! How a simulation runs, as the user asked it: [`Settings`] (their ranges are
+//! [`crate::input::limits`], checked by [`Settings::check`]; the ground is on when gravity is not
+//! zero, [`Settings::set_gravity`]), the engine among them ([`EngineChoice`]). The command
+//! line, lessons, `tetlab bench` and the workbench all build their settings here; what follows
+//! from them for a table of families (the material's compliances, the rules) is
+//! [`super::Resolved`].
 
+use super::engine_choice::EngineChoice;
 use crate::constraints::material::Material;
 use crate::constraints::{Families, Family, PerFamily};
 use crate::input::limits::{self, Bounds};
@@ -10,7 +13,7 @@ use crate::input::limits::{self, Bounds};
 /// How far one projection may move a particle by default ([`crate::simulation::Settings::reach`]),
 /// in longest rest edges of its element (the constraint's particles at rest: an edge's length,
 /// a tet's longest edge): 100. A step
-/// max |Δxᵢ| = wᵢ|∇ᵢC||Δλ| beyond it is skipped and counted ([`Skipped::too_long`]).
+/// max |Δxᵢ| = wᵢ|∇ᵢC||Δλ| beyond it is skipped and counted ([`super::projection::Skipped::too_long`]).
 ///
 /// A projection moves a particle by about |C| / |∇C|, which grows without bound where ∇C
 /// vanishes and C does not: the dihedral angle's cosine at a folded or flattened hinge
@@ -26,73 +29,6 @@ use crate::input::limits::{self, Bounds};
 /// on every shipped scene and perturbation, settled and launched, at reach 10, 30, 100 and 10⁹,
 /// and prints in how many runs the rule skips a step and in how many it changes the outcome.
 pub const DEFAULT_REACH: f64 = 100.0;
-
-/// Which solver steps a simulation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Engine {
-    /// The reference solver for scenes of fewer than [`FAST_FROM_TETS`] tets, the fast one
-    /// from there.
-    #[default]
-    Auto,
-    /// The f64 solver, one constraint at a time: exact to f64, and the one step-by-step mode
-    /// walks through.
-    Reference,
-    /// The f32 solver in SIMD lanes and on threads: several times faster on a real mesh.
-    Fast,
-}
-
-/// The size from which [`Engine::Auto`] picks the fast engine. The reference solver's frame
-/// grows with the tets, about 19 µs a tet at the default 100 substeps with edges + volume (the
-/// 384-tet cube: 7.3 ms a frame; the 1351-tet bunny: 24 ms, where the fast engine takes 4.1;
-/// docs/performance.md): from about 900 tets it no longer holds 60 frames a second. The built-in
-/// teaching scenes and every lesson's scene but the bunny stay below it, on the exact path.
-pub const FAST_FROM_TETS: usize = 1000;
-
-impl Engine {
-    /// `auto`, `reference` or `fast`.
-    ///
-    /// ```
-    /// use tetlab_core::simulation::Engine;
-    /// assert_eq!(Engine::parse("fast"), Ok(Engine::Fast));
-    /// assert!(Engine::parse("gpu").unwrap_err().contains("auto, reference or fast"));
-    /// ```
-    pub fn parse(text: &str) -> Result<Engine, String> {
-        match text.trim() {
-            "auto" => Ok(Engine::Auto),
-            "reference" => Ok(Engine::Reference),
-            "fast" => Ok(Engine::Fast),
-            other => Err(format!(
-                "'{other}' is not an engine: expected auto, reference or fast"
-            )),
-        }
-    }
-
-    /// The name [`Engine::parse`] reads.
-    pub fn name(self) -> &'static str {
-        match self {
-            Engine::Auto => "auto",
-            Engine::Reference => "reference",
-            Engine::Fast => "fast",
-        }
-    }
-
-    /// The engine this choice runs a scene of `tets` tets on: [`Engine::Reference`] or
-    /// [`Engine::Fast`].
-    ///
-    /// ```
-    /// use tetlab_core::simulation::{Engine, FAST_FROM_TETS};
-    /// assert_eq!(Engine::Auto.resolve(162), Engine::Reference);
-    /// assert_eq!(Engine::Auto.resolve(FAST_FROM_TETS), Engine::Fast);
-    /// assert_eq!(Engine::Reference.resolve(100_000), Engine::Reference);
-    /// ```
-    pub fn resolve(self, tets: usize) -> Engine {
-        match self {
-            Engine::Auto if tets >= FAST_FROM_TETS => Engine::Fast,
-            Engine::Auto => Engine::Reference,
-            chosen => chosen,
-        }
-    }
-}
 
 /// XPBD or PBD.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -129,17 +65,14 @@ pub struct Settings {
     pub method: Method,
     /// Which families are projected.
     pub active: PerFamily<bool>,
-    /// XPBD compliance α per family: the inverse of stiffness, 0 is rigid, larger is softer.
+    /// XPBD compliance α per family: the inverse of stiffness, 0 is rigid, larger is softer. A
+    /// family whose compliance the material gives takes the material's instead.
     pub compliance: PerFamily<f64>,
-    /// The material of the families whose compliance it gives (the neo-Hookean pair): set it
-    /// with [`Settings::set_material`], which sets their compliances too.
+    /// The material of the families whose compliance it gives (the neo-Hookean pair, a
+    /// constraint file's with a `stiffness`): their compliances follow from it
+    /// ([`super::Resolved::compliance`]), whatever [`Settings::compliance`] holds for them.
     #[serde(default)]
     pub material: Material,
-    /// Which families take their compliance from the material: the built-in neo-Hookean pair,
-    /// and a constraint file's with a `stiffness` (a simulation marks these from its table). Not
-    /// stored: it follows from the table.
-    #[serde(skip, default = "builtin_material_families")]
-    pub from_material: PerFamily<bool>,
     /// PBD stiffness k ∈ [0, 1] per family.
     #[serde(deserialize_with = "stiffness_over_the_default")]
     pub stiffness: PerFamily<f64>,
@@ -161,9 +94,9 @@ pub struct Settings {
     /// move particles but not speed them up, until the edit's violation is undone. Otherwise rigid
     /// constraints undo a large violation within a substep, and v = Δx/h launches the body.
     pub settle_edits: bool,
-    /// Which solver steps the simulation ([`Engine`]).
+    /// Which engine steps the simulation ([`EngineChoice`]).
     #[serde(default)]
-    pub engine: Engine,
+    pub engine: EngineChoice,
     /// The order in which each family's constraints are projected in a sweep. `None`: the
     /// table's order, the mesh's (the order tetlab always used). A seed: an order drawn from
     /// it per family ([`Settings::projection_order`]): the reference engine projects the
@@ -190,25 +123,6 @@ impl Settings {
     pub fn set_gravity(&mut self, gravity: f64) {
         self.gravity = gravity;
         self.ground = gravity != 0.0;
-    }
-
-    /// Whether edits settle: [`Settings::settle_edits`], except while a family a material
-    /// describes is active. A material carries its own momentum through an inversion (a
-    /// mirrored tet's way back passes close to F = 0, where its hydrostatic gradient vanishes);
-    /// capping the speed there leaves the body squashed to a point.
-    pub fn edits_settle(&self) -> bool {
-        self.settle_edits && !self.active.families().any(|f| self.from_material[f])
-    }
-
-    /// Sets the material, and the compliance of each family it gives one
-    /// ([`crate::constraints::Row::compliance_from_material`]: 1/μ and 1/λ).
-    pub fn set_material(&mut self, material: Material) {
-        self.material = material;
-        for family in Family::builtins() {
-            if let Some(compliance) = family.compliance_from_material() {
-                self.compliance[family] = compliance(&material);
-            }
-        }
     }
 
     /// Ok when every number is within its range of [`crate::input::limits`]; otherwise the first that
@@ -279,11 +193,10 @@ pub const DEFAULT_SUBSTEPS: u32 = 100;
 
 impl Default for Settings {
     /// XPBD, edges + volume, rigid, [`DEFAULT_SUBSTEPS`] substeps of 1 iteration, Δt = 1/60 s,
-    /// gravity 9.81 m/s²,
-    /// the default [`Material`] for the neo-Hookean families,
-    /// ground on, no damping.
+    /// gravity 9.81 m/s², the default [`Material`] for the neo-Hookean families, ground on, no
+    /// damping.
     fn default() -> Self {
-        let mut settings = Self {
+        Self {
             method: Method::Xpbd,
             active: PerFamily::builtin_from_fn(|f| f == Family::EDGES || f == Family::VOLUME),
             compliance: PerFamily::splat(0.0),
@@ -297,19 +210,11 @@ impl Default for Settings {
             grab_compliance: 0.0,
             settle_edits: false,
             material: Material::default(),
-            from_material: builtin_material_families(),
-            engine: Engine::Auto,
+            engine: EngineChoice::Auto,
             order_seed: None,
             reach: DEFAULT_REACH,
-        };
-        settings.set_material(Material::default());
-        settings
+        }
     }
-}
-
-/// The built-in families whose compliance the material gives (the neo-Hookean pair).
-fn builtin_material_families() -> PerFamily<bool> {
-    PerFamily::builtin_from_fn(|f| f.compliance_from_material().is_some())
 }
 
 /// Stiffnesses as stored (the workbench's preferences): a family the stored map lacks keeps the
@@ -321,16 +226,7 @@ fn stiffness_over_the_default<'de, D: serde::Deserializer<'de>>(
 }
 
 /// `FAMILY=VALUE` (as in `--compliance edges=1e-6`), with the value checked against `bounds`.
-///
-/// ```
-/// use tetlab_core::constraints::{Families, Family};
-/// use tetlab_core::input::limits::COMPLIANCE;
-/// use tetlab_core::simulation::family_value;
-/// let families = Families::builtin();
-/// assert_eq!(family_value(&families, "volume=0.5", &COMPLIANCE), Ok((Family::VOLUME, 0.5)));
-/// assert!(family_value(&families, "edges=inf", &COMPLIANCE).unwrap_err().contains("out of range"));
-/// ```
-pub fn family_value(
+pub(crate) fn family_value(
     families: &Families,
     text: &str,
     bounds: &Bounds<f64>,
@@ -348,7 +244,7 @@ pub fn family_value(
 pub fn settable_family(families: &Families, name: &str) -> Result<Family, String> {
     let members = families.parse_group(name)?;
     let family = members.families().next().expect("a group has a family");
-    if family.compliance_from_material().is_some() {
+    if families.row(family).compliance_from_material.is_some() {
         return Err(format!(
             "{}: its constraints take their compliance from the material: give --material \
              E=PA,nu=N (or material = \"E=…,nu=…\" in a lesson)",
@@ -356,4 +252,28 @@ pub fn settable_family(families: &Families, name: &str) -> Result<Family, String
         ));
     }
     Ok(family)
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `family_value`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn family_value_example() {
+        use crate::constraints::{Families, Family};
+        use crate::input::limits::COMPLIANCE;
+        use crate::simulation::settings::family_value;
+        let families = Families::builtin();
+        assert_eq!(
+            family_value(&families, "volume=0.5", &COMPLIANCE),
+            Ok((Family::VOLUME, 0.5))
+        );
+        assert!(
+            family_value(&families, "edges=inf", &COMPLIANCE)
+                .unwrap_err()
+                .contains("out of range")
+        );
+    }
 }

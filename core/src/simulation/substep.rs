@@ -1,295 +1,242 @@
-//! The reference solver's frame, top to bottom: a frame is `substeps` substeps; a substep
-//! predicts, sweeps the active families `iterations` times (then the grab, the ground and the
-//! plane-strain hold), and takes Δp and the velocities from where the particles ended up.
+//! The substep of XPBD/PBD, written once for every CPU engine ([`frame`]): each engine says how it
+//! predicts, projects and integrates its own arrays ([`Substeps`]); the order of the stages is
+//! here, and only here.
+//!
+//! One substep of length h = Δt / substeps:
+//! 1. predict: v += g h, x_prev = x, x += v h; a particle predicted below the ground is put back
+//!    at its previous position, on the ground (sticking friction); a rigidly held particle is
+//!    put at its target;
+//! 2. XPBD only: λ = 0 for every constraint;
+//! 3. `iterations` Gauss–Seidel sweeps over what the active families project ([`Plan::units`]:
+//!    each family alone, or a pair together), in the table's order, then the compliant grab, the
+//!    ground y ≥ 0 and the plane-strain hold;
+//! 4. Δp = x − predicted x (kept when asked), then v = (x − x_prev) / h, damped; while an edit
+//!    settles, |v| is also capped at the predicted speed.
+//!
+//! Step-by-step mode walks the same stages ([`begin_substep`], one projection at a time,
+//! [`end_sweep`], [`end_substep`]) on the reference engine, so a substep taken one projection at
+//! a time gives the bits of one taken at once. An engine written outside the library may run
+//! the same skeleton: implement [`Substeps`], or wrap the reference engine's
+//! ([`super::OnState`]) and change what it does at one stage.
 
-use super::*;
+use super::engine::Frame;
+pub use super::integrate::Substep as Motion;
+use super::projection::{Rule, correction};
+use super::resolved::Resolved;
+use crate::constraints::{Families, MAX_FAMILIES, PerFamily, Unit, distance};
+use crate::numbers::vector::{Real, Vector3};
+use arrayvec::ArrayVec;
+use glam::DVec3;
 
-impl Simulation {
-    /// Advances one frame: `substeps` substeps of Δt / substeps, on the engine of
-    /// [`Simulation::engine`].
-    pub fn step(&mut self) {
-        self.update_inverse_masses();
-        self.frame_corrections.fill(DVec3::ZERO);
-        match self.engine() {
-            Engine::Fast => self.step_fast(),
-            _ => {
-                for _ in 0..self.settings.substeps.max(1) {
-                    self.substep();
-                }
-            }
-        }
-        if let Some(grab) = &mut self.grab {
-            grab.target_velocity = (grab.target - grab.target_at_last_step) / self.settings.dt;
-            grab.target_at_last_step = grab.target;
-        }
-        if let Some(frames) = self.settling {
-            let largest = self.largest_frame_correction();
-            self.settling = (self.settings.edits_settle() && largest > self.settle_tolerance())
-                .then_some(frames + 1);
-        }
-        self.frame += 1;
-        self.time += self.settings.dt;
-    }
+/// What a frame's substeps are to do, worked out once a frame from the settings and the inputs.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Substeps in the frame, ≥ 1.
+    pub substeps: u32,
+    /// Sweeps per substep, ≥ 1.
+    pub iterations: u32,
+    /// The substep's length h.
+    pub h: f64,
+    /// Gravity, the ground and plane strain, for the prediction.
+    pub motion: Motion,
+    /// Velocity damping per second.
+    pub damping: f64,
+    /// What one sweep projects, in order.
+    pub units: ArrayVec<Unit, MAX_FAMILIES>,
+    /// The rule each family is projected by.
+    pub rules: PerFamily<Rule<f64>>,
+    /// How far one projection may move a particle, in rest edges of its element.
+    pub reach: f64,
+    /// A particle held rigidly at a target (it moves with the target; its inverse mass is 0).
+    pub rigid_grab: Option<(usize, DVec3)>,
+    /// A particle pulled towards a target by a compliant constraint: the particle, the target,
+    /// the compliance.
+    pub soft_grab: Option<(usize, DVec3, f64)>,
+    /// Whether an edit settles: velocities are capped and Δp summed over every substep.
+    pub settling: bool,
+    /// Whether to keep Δp of the frame's last substep.
+    pub keep_corrections: bool,
+}
 
-    /// One substep: predict, project every active family `iterations` times, update velocities.
-    /// The same as [`Simulation::begin_substep`], then for each iteration every constraint of
-    /// [`Simulation::projection_order`] through [`Simulation::project`] and
-    /// [`Simulation::end_sweep`], then [`Simulation::end_substep`] — done here in tight loops.
-    pub fn substep(&mut self) {
-        let h = self.substep_length();
-        self.begin_substep();
-        for _ in 0..self.settings.iterations.max(1) {
-            self.sweep(h);
-        }
-        self.end_substep();
-    }
-
-    /// h = Δt / substeps.
-    pub fn substep_length(&self) -> f64 {
-        self.settings.dt / self.settings.substeps.max(1) as f64
-    }
-
-    /// The first part of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
-    pub fn begin_substep(&mut self) {
-        self.fast.edited();
-        let h = self.substep_length();
-        self.predict(h);
-        for family in self.families.all() {
-            self.sets[family].reset_lambda();
-        }
-        if let Some(grab) = &mut self.grab {
-            grab.lambda = 0.0;
-        }
-    }
-
-    pub(super) fn predict(&mut self, h: f64) {
-        integrate::predict(
-            &mut self.positions,
-            &mut self.previous,
-            &mut self.velocities,
-            &self.inverse_masses,
-            &self.forces,
-            integrate::Substep {
-                gravity: self.settings.gravity,
-                h,
-                ground: self.settings.ground.then_some(0.0),
-                plane_strain: self.plane_strain,
-            },
-            None,
-        );
-        if let Some(grab) = self.rigid_grab() {
-            self.positions[grab.particle] = grab.target;
-        }
-        self.corrections.copy_from_slice(&self.positions);
-    }
-
-    /// One Gauss–Seidel sweep over the active families, then the grab, the ground and the
-    /// plane-strain hold.
-    pub(super) fn sweep(&mut self, h: f64) {
-        let active = self.settings.active;
-        for family in self.families.all() {
-            if !active[family] || self.families.projected_by_partner(family, &active) {
-                continue;
-            }
-            self.project_range(family, Projected::All, h);
-        }
-        self.end_sweep();
-    }
-
-    /// Projects the constraints `which` of `family` in turn, alone or with its partner.
-    pub(super) fn project_range(&mut self, family: Family, which: Projected, h: f64) {
-        let rule = self.rule(family, h);
-        if let Some(partner) = self.families.partner_in(family, &self.settings.active) {
-            let rules = [rule, self.rule(partner, h)];
-            let (first, second) = self.sets.pair_mut(family, partner);
-            let (skipped_first, skipped_second) = self.skipped.pair_mut(family, partner);
-            let sweep = pair::PairSweep {
-                first,
-                second,
-                skipped: [skipped_first, skipped_second],
-                positions: &mut self.positions,
-                rest_positions: &self.rest_positions,
-                inverse_masses: &self.inverse_masses,
-                rules,
-                which,
-                reach: self.settings.reach,
-            };
-            self.families.visit_pair(family, partner, sweep);
-            return;
-        }
-        self.families.visit(
-            family,
-            Sweep {
-                set: &mut self.sets[family],
-                positions: &mut self.positions,
-                rest_positions: &self.rest_positions,
-                inverse_masses: &self.inverse_masses,
-                rule,
-                which,
-                skipped: &mut self.skipped[family],
-                reach: self.settings.reach,
-            },
-        );
-    }
-
-    /// The end of one sweep, after the constraint families: the grab, then the ground y ≥ 0.
-    pub fn end_sweep(&mut self) {
-        self.fast.edited();
-        let h = self.substep_length();
-        self.project_soft_grab(h);
-        if self.settings.ground {
-            integrate::project_ground(&mut self.positions, &self.inverse_masses, 0.0);
-        }
-        if self.plane_strain {
-            integrate::hold_plane(&mut self.positions, &self.previous);
-        }
-    }
-
-    pub(super) fn project_soft_grab(&mut self, h: f64) {
-        let compliance = self.settings.grab_compliance;
-        let Some(grab) = self.grab.as_mut().filter(|_| compliance > 0.0) else {
-            return;
-        };
-        let i = grab.particle;
-        let evaluation = distance::evaluate(&[self.positions[i], grab.target], 0.0);
-        let rule = Rule::Xpbd {
-            alpha_tilde: compliance / (h * h),
-        };
-        let unbounded = f64::INFINITY;
-        let weights = [self.inverse_masses[i], 0.0];
-        if let Some(c) = correction(evaluation, weights, grab.lambda, rule, unbounded) {
-            grab.lambda += c.delta_lambda;
-            self.positions[i] += c.delta_x[0];
-        }
-    }
-
-    /// The last part of a substep: Δp = x − predicted x, then velocities from the positions.
-    pub fn end_substep(&mut self) {
-        self.fast.edited();
-        let h = self.substep_length();
-        for ((correction, sum), p) in self
-            .corrections
-            .iter_mut()
-            .zip(&mut self.frame_corrections)
-            .zip(&self.positions)
-        {
-            *correction = *p - *correction;
-            *sum += *correction;
-        }
-        self.update_velocities(h, self.settings.edits_settle() && self.settling.is_some());
-    }
-
-    /// v = (x − x_prev) / h, damped; when `settling`, no faster than the predicted velocity.
-    pub(super) fn update_velocities(&mut self, h: f64, settling: bool) {
-        integrate::update_velocities(
-            &self.positions,
-            &self.previous,
-            &mut self.velocities,
+impl Plan {
+    /// The plan of a frame under `resolved`, for a body held in plane strain or not, with a
+    /// particle held at a target, if one is (`grab`: the particle and where it is held), and
+    /// `settling` when an edit settles.
+    pub fn new(
+        families: &Families,
+        resolved: &Resolved,
+        plane_strain: bool,
+        grab: Option<(usize, DVec3)>,
+        settling: bool,
+    ) -> Plan {
+        let settings = &resolved.settings;
+        let h = resolved.substep_length();
+        let compliance = settings.grab_compliance;
+        Plan {
+            substeps: settings.substeps.max(1),
+            iterations: settings.iterations.max(1),
             h,
-            self.settings.damping,
+            motion: Motion {
+                gravity: settings.gravity,
+                h,
+                ground: settings.ground.then_some(0.0),
+                plane_strain,
+            },
+            damping: settings.damping,
+            units: families.units(&resolved.active).collect(),
+            rules: families.per_family(|f| resolved.rule(f, h)),
+            reach: settings.reach,
+            rigid_grab: grab.filter(|_| compliance <= 0.0),
+            soft_grab: grab
+                .filter(|_| compliance > 0.0)
+                .map(|(particle, target)| (particle, target, compliance)),
             settling,
-            None,
-        );
-    }
-
-    pub(crate) fn rule(&self, family: Family, h: f64) -> Rule<f64> {
-        Rule::for_settings(&self.settings, family, h)
-    }
-
-    /// The longest Δp of the last substep among particles that can move.
-    pub(super) fn largest_frame_correction(&self) -> f64 {
-        self.frame_corrections
-            .iter()
-            .zip(&self.inverse_masses)
-            .filter(|(_, w)| **w > 0.0)
-            .map(|(c, _)| c.length())
-            .fold(0.0, f64::max)
-    }
-
-    pub(super) fn update_inverse_masses(&mut self) {
-        for i in 0..self.positions.len() {
-            self.inverse_masses[i] = if self.pinned[i] {
-                0.0
-            } else {
-                self.lumped_inverse_masses[i]
-            };
+            keep_corrections: true,
         }
-        if let Some(grab) = self.rigid_grab() {
-            self.inverse_masses[grab.particle] = 0.0;
+    }
+
+    /// The plan of `frame`: its settings, the grab the state holds, the body's plane strain,
+    /// whether an edit settles; Δp of the last substep kept.
+    pub fn of(frame: &Frame<'_>) -> Plan {
+        let grab = frame.state.grab.map(|g| (g.particle, g.target));
+        let (families, resolved) = (frame.families, frame.resolved);
+        Plan::new(
+            families,
+            resolved,
+            frame.body.plane_strain,
+            grab,
+            frame.settling,
+        )
+    }
+
+    /// Whether substep `substep` (from 0) keeps its Δp: every one while an edit settles (their
+    /// sum is the measure of "settled"), otherwise the frame's last, when asked.
+    pub fn tracks(&self, substep: u32) -> bool {
+        self.settling || (self.keep_corrections && substep + 1 == self.substeps)
+    }
+}
+
+/// What a CPU engine does at each stage of a substep, on its own arrays.
+pub trait Substeps {
+    /// Before the frame's first substep (the fast engine moves its origin to the body).
+    fn begin_frame(&mut self, plan: &Plan) {
+        let _ = plan;
+    }
+    /// x_prev = x, then v += (g + w f) h and x += v h for every free particle, the ground's
+    /// sticking friction and the plane-strain hold on v (`integrate::predict`).
+    fn predict(&mut self, plan: &Plan);
+    /// Puts `particle` at `target` (a rigid grab, after the prediction).
+    fn hold(&mut self, particle: usize, target: DVec3);
+    /// Keeps the predicted positions, which Δp is measured from.
+    fn keep_predicted(&mut self);
+    /// λ = 0 for every constraint of the active families, and for the compliant grab.
+    fn reset_multipliers(&mut self, plan: &Plan);
+    /// Projects every constraint of `unit`, in the engine's order.
+    fn project(&mut self, unit: Unit, plan: &Plan);
+    /// The position of `particle`, its inverse mass, and the compliant grab's multiplier, to
+    /// be projected towards a target (`project_soft_grab`).
+    fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_>;
+    /// Where `target` (in the scene's frame) is in the engine's coordinates.
+    fn target(&self, target: DVec3) -> DVec3 {
+        target
+    }
+    /// y ≥ 0 for every free particle, then the plane-strain hold on x.
+    fn ground_and_plane(&mut self, plan: &Plan);
+    /// Δp = x − predicted x, and its sum over the frame.
+    fn keep_corrections(&mut self);
+    /// v = (x − x_prev) / h, damped, and capped while an edit settles.
+    fn update_velocities(&mut self, plan: &Plan);
+}
+
+/// A grabbed particle as an engine holds it, in its own precision.
+pub enum GrabbedParticle<'a> {
+    /// In f64 (the reference engine).
+    F64(&'a mut DVec3, f64, &'a mut f64),
+    /// In f32 (the fast engine).
+    F32(&'a mut glam::Vec3A, f32, &'a mut f32),
+}
+
+/// One frame: `substeps` substeps, each [`begin_substep`], `iterations` × [`sweep`],
+/// [`end_substep`].
+pub fn frame(engine: &mut impl Substeps, plan: &Plan) {
+    engine.begin_frame(plan);
+    for substep in 0..plan.substeps {
+        let tracks = plan.tracks(substep);
+        begin_substep(engine, plan, tracks);
+        for _ in 0..plan.iterations {
+            sweep(engine, plan);
+        }
+        end_substep(engine, plan, tracks);
+    }
+}
+
+/// The start of a substep: predict, hold the rigidly grabbed particle, keep the predicted
+/// positions when Δp is `tracked`, and (XPBD) λ = 0.
+pub fn begin_substep(engine: &mut impl Substeps, plan: &Plan, tracked: bool) {
+    engine.predict(plan);
+    if let Some((particle, target)) = plan.rigid_grab {
+        engine.hold(particle, target);
+    }
+    if tracked {
+        engine.keep_predicted();
+    }
+    engine.reset_multipliers(plan);
+}
+
+/// One Gauss–Seidel sweep: what each active family projects, in order, then [`end_sweep`].
+pub fn sweep(engine: &mut impl Substeps, plan: &Plan) {
+    for &unit in &plan.units {
+        engine.project(unit, plan);
+    }
+    end_sweep(engine, plan);
+}
+
+/// The end of a sweep, after the families: the compliant grab, then the ground and the plane.
+pub fn end_sweep(engine: &mut impl Substeps, plan: &Plan) {
+    if let Some((particle, target, compliance)) = plan.soft_grab {
+        let target = engine.target(target);
+        project_soft_grab(engine.grabbed(particle), target, compliance, plan.h);
+    }
+    engine.ground_and_plane(plan);
+}
+
+/// The end of a substep: Δp when it is `tracked`, then the velocities.
+pub fn end_substep(engine: &mut impl Substeps, plan: &Plan, tracked: bool) {
+    if tracked {
+        engine.keep_corrections();
+    }
+    engine.update_velocities(plan);
+}
+
+/// The compliant grab: a zero-length XPBD constraint between the particle and the target, with
+/// the grab's compliance, in the engine's precision.
+fn project_soft_grab(grabbed: GrabbedParticle<'_>, target: DVec3, compliance: f64, h: f64) {
+    match grabbed {
+        GrabbedParticle::F64(position, w, lambda) => {
+            pull(position, w, lambda, target, compliance / (h * h));
+        }
+        GrabbedParticle::F32(position, w, lambda) => {
+            pull(
+                position,
+                w,
+                lambda,
+                target.as_vec3a(),
+                (compliance / (h * h)) as f32,
+            );
         }
     }
 }
 
-/// Which constraints of a family a projection call makes.
-#[derive(Clone, Copy)]
-pub(super) enum Projected {
-    /// Every one, in the set's order (a sweep).
-    All,
-    /// Constraint c alone (step-by-step mode).
-    One(usize),
-}
-
-impl Projected {
-    /// The positions in the set's order to go through.
-    pub(super) fn range(self, set: &ConstraintSet) -> std::ops::Range<usize> {
-        match self {
-            Projected::All => 0..set.len(),
-            Projected::One(c) => c..c + 1,
-        }
-    }
-
-    /// The constraint at position `k` of [`Projected::range`].
-    #[inline]
-    pub(super) fn at(self, set: &ConstraintSet, k: usize) -> usize {
-        match self {
-            Projected::All => set.in_order(k),
-            Projected::One(c) => c,
-        }
-    }
-}
-
-/// Projects the constraints of one family's `set` (every one in the set's order, Gauss–Seidel,
-/// or one): λ += Δλ, xᵢ += Δxᵢ.
-struct Sweep<'a> {
-    set: &'a mut ConstraintSet,
-    positions: &'a mut [DVec3],
-    rest_positions: &'a [DVec3],
-    inverse_masses: &'a [f64],
-    rule: Rule<f64>,
-    which: Projected,
-    skipped: &'a mut SkipCounts,
-    /// [`Settings::reach`].
-    reach: f64,
-}
-
-impl Visit for Sweep<'_> {
-    type Output = ();
-
-    #[inline]
-    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, constraint: &C) {
-        for k in self.which.range(self.set) {
-            let c = self.which.at(self.set, k);
-            let idx = self.set.indices::<N>(c);
-            let p = idx.map(|i| self.positions[i as usize]);
-            let shape = if C::STORED_USES_REST_SHAPE {
-                idx.map(|i| self.rest_positions[i as usize])
-            } else {
-                p
-            };
-            let evaluation =
-                constraint.evaluate_stored(&p, self.set.rest()[c], &shape, self.set.stored(c));
-            let weights = idx.map(|i| self.inverse_masses[i as usize]);
-            let (lambda, reach) = (self.set.lambda()[c], self.reach * self.set.size()[c]);
-            let (skipped, correction) =
-                correction_lanes(evaluation, weights, lambda, self.rule, reach);
-            if skipped.any() {
-                self.skipped.add(skipped);
-            } else {
-                self.set.add_lambda(c, correction.delta_lambda);
-                for (&i, dx) in idx.iter().zip(correction.delta_x) {
-                    self.positions[i as usize] += dx;
-                }
-            }
-        }
+/// One XPBD projection of |p − target| = 0 moving p alone (the target is fixed).
+fn pull<V: Vector3>(position: &mut V, w: V::Real, lambda: &mut V::Real, target: V, alpha: V::Real)
+where
+    V::Real: Real<Mask = bool>,
+{
+    let evaluation = distance::evaluate(&[*position, target], V::Real::ZERO);
+    let rule = Rule::Xpbd { alpha_tilde: alpha };
+    let unbounded = V::Real::from_f64(f64::INFINITY);
+    if let Some(c) = correction(evaluation, [w, V::Real::ZERO], *lambda, rule, unbounded) {
+        *lambda += c.delta_lambda[0];
+        *position += c.delta_x[0];
     }
 }

@@ -79,13 +79,11 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
     }
 }
 
-/// What else the family shows of the inspected constraint ([`crate::constraints::Families::describe_state`]: F and
+/// What else the family shows of the inspected constraint ([`crate::constraints::AnyConstraint::describe_state`]: F and
 /// det F for the neo-Hookean pair), one line each.
 pub fn state_lines(simulation: &Simulation, projection: &Projection) -> Vec<String> {
     let (points, rest_shape) = particles_of(simulation, projection);
-    simulation
-        .families()
-        .describe_state(projection.family, &points, &rest_shape)
+    (simulation.families().constraint(projection.family)).describe_state(&points, &rest_shape)
 }
 
 /// The constraint's particles now and at rest.
@@ -103,7 +101,7 @@ fn particles_of(simulation: &Simulation, projection: &Projection) -> (Vec<DVec3>
 /// Inspects every constraint of the active families on tet `tet`, family by family. Appends to
 /// `out`.
 pub fn inspect_tet(simulation: &Simulation, tet: usize, out: &mut Vec<Inspection>) {
-    let active = simulation.settings().active;
+    let active = *simulation.active();
     for family in active.families() {
         for c in simulation.tet_constraints(tet, family) {
             out.push(inspect(simulation, family, c));

@@ -3,7 +3,7 @@
 //!
 //! A substep is [`Simulation::begin_substep`] (predict), then `iterations` sweeps, each projecting
 //! every constraint of [`Simulation::projection_order`] with [`Simulation::project`] and closing
-//! with [`Simulation::end_sweep`], then [`Simulation::end_substep`]. [`StepByStep`] walks the same
+//! with `Simulation::end_sweep`, then `Simulation::end_substep`. [`StepByStep`] walks the same
 //! calls in the same order, so stepping through a whole substep gives the same bits as
 //! [`Simulation::substep`]. Like [`Simulation::substep`], it does not count frames.
 

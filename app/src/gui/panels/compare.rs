@@ -16,7 +16,9 @@ impl Default for ComparePanel {
     /// The geometric families: the material ones are another model, added by choice.
     fn default() -> Self {
         ComparePanel {
-            families: PerFamily::builtin_from_fn(|f| f.compliance_from_material().is_none()),
+            families: PerFamily::builtin_from_fn(|f| {
+                f.builtin_row().unwrap().compliance_from_material.is_none()
+            }),
         }
     }
 }

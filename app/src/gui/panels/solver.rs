@@ -7,7 +7,7 @@ use crate::gui::shortcuts::Action;
 use eframe::egui;
 use tetlab_core::constraints::material::{MAX_POISSON, YOUNG};
 use tetlab_core::constraints::{Families, PerFamily};
-use tetlab_core::simulation::{Engine, FAST_FROM_TETS, Method, Settings};
+use tetlab_core::simulation::{EngineChoice, Method, Settings};
 
 /// The solver panel: it edits a copy of the simulation's settings and asks for the copy when
 /// the user changed it. "Write a constraint" asks for the constraint editor, whose family joins
@@ -43,34 +43,16 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
     });
     ui.horizontal(|ui| {
         ui.label("engine");
-        for (engine, label, hover) in [
-            (
-                Engine::Auto,
-                "auto",
-                format!("reference below {FAST_FROM_TETS} tets, fast from there"),
-            ),
-            (
-                Engine::Reference,
-                "reference",
-                "f64, one constraint at a time: exact, and what step by step walks through"
-                    .to_owned(),
-            ),
-            (
-                Engine::Fast,
-                "fast",
-                "f32, coloured, eight constraints at a time in SIMD lanes, on every core"
-                    .to_owned(),
-            ),
-        ] {
-            ui.radio_value(&mut settings.engine, engine, label)
-                .on_hover_text(hover);
+        for engine in EngineChoice::ALL {
+            ui.radio_value(&mut settings.engine, engine, engine.name())
+                .on_hover_text(engine.summary());
         }
     });
     for (group, members) in families.groups() {
         let family = members.families().next().expect("a group has a family");
         // The material gives the compliance of the neo-Hookean pair and of a file's constraints
         // with a `stiffness`.
-        if families.compliance_from_material(family).is_some() {
+        if families.row(family).compliance_from_material.is_some() {
             material_group(ui, families, &mut settings, group, members);
             continue;
         }
@@ -172,7 +154,7 @@ fn material_group(
         .on_hover_text("Poisson's ratio: towards 0.5 the volume barely changes");
     });
     if material != settings.material && material.check().is_ok() {
-        settings.set_material(material);
+        settings.material = material;
     }
 }
 

@@ -24,26 +24,7 @@ impl Program {
     /// Adds the instructions of ∇C, C being output `c` (a scalar), and one output per particle,
     /// its gradient (a vector; the zero vector for a particle C does not depend on). Returns
     /// those outputs, p0's first.
-    ///
-    /// ```
-    /// use tetlab_core::constraint_file::expression::parse_expression;
-    /// use tetlab_core::constraint_file::program::{Inputs, Program, Type};
-    /// // C = |p0 − p1| − rest: ∇p0 C is the unit vector from p1 to p0, ∇p1 C its negative.
-    /// let mut program = Program::new(2, true);
-    /// let c = program.output(&parse_expression("length(p0 - p1) - rest").unwrap(), Type::Scalar, "value").unwrap();
-    /// let gradient = program.differentiate(c).unwrap();
-    /// let mut outputs = vec![c];
-    /// outputs.extend(&gradient);
-    /// let tape = program.tape(&outputs);
-    /// let points: [[f64; 3]; 2] = [[3.0, 0.0, 4.0], [0.0; 3]];
-    /// tape.run(&Inputs::of(&points, 1.0), |r| {
-    ///     assert_eq!(r.scalar(0), 4.0);
-    ///     let (g0, g1) = (r.vector(1), r.vector(2));
-    ///     assert!((g0[0] - 0.6).abs() < 1e-15 && g0[1] == 0.0 && (g0[2] - 0.8).abs() < 1e-15);
-    ///     assert_eq!(g1, g0.map(|x| -x));
-    /// });
-    /// ```
-    pub fn differentiate(&mut self, c: usize) -> Result<Vec<usize>, CompileError> {
+    pub(crate) fn differentiate(&mut self, c: usize) -> Result<Vec<usize>, CompileError> {
         let c = self.outputs[c] as usize;
         // Which instructions depend on a particle: only they carry an adjoint.
         let mut varies = vec![false; self.ops.len()];
@@ -373,5 +354,38 @@ impl Rule<'_> {
         self.add(t, |r| r.emit(choose(true)))?;
         self.add(e, |r| r.emit(choose(false)))?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `differentiate`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn differentiate_example() {
+        use crate::constraint_file::expression::parse_expression;
+        use crate::constraint_file::program::{Inputs, Program, Type};
+        // C = |p0 − p1| − rest: ∇p0 C is the unit vector from p1 to p0, ∇p1 C its negative.
+        let mut program = Program::new(2, true);
+        let c = program
+            .output(
+                &parse_expression("length(p0 - p1) - rest").unwrap(),
+                Type::Scalar,
+                "value",
+            )
+            .unwrap();
+        let gradient = program.differentiate(c).unwrap();
+        let mut outputs = vec![c];
+        outputs.extend(&gradient);
+        let tape = program.tape(&outputs);
+        let points: [[f64; 3]; 2] = [[3.0, 0.0, 4.0], [0.0; 3]];
+        tape.run(&Inputs::of(&points, 1.0), |r| {
+            assert_eq!(r.scalar(0), 4.0);
+            let (g0, g1) = (r.vector(1), r.vector(2));
+            assert!((g0[0] - 0.6).abs() < 1e-15 && g0[1] == 0.0 && (g0[2] - 0.8).abs() < 1e-15);
+            assert_eq!(g1, g0.map(|x| -x));
+        });
     }
 }

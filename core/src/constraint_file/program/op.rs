@@ -13,17 +13,17 @@ use arrayvec::ArrayVec;
 pub(super) type Reg = u16;
 
 /// The most operations the expressions of a file may take in all.
-pub const MAX_WRITTEN: usize = 160;
+pub(crate) const MAX_WRITTEN: usize = 160;
 
 /// The most registers (instructions) a program may have, its gradient's included
 /// ([`super::Program::differentiate`]): tapes keep their registers on the stack, so that an
 /// evaluation allocates nothing.
-pub const MAX_REGISTERS: usize = 4 * MAX_WRITTEN;
+pub(crate) const MAX_REGISTERS: usize = 4 * MAX_WRITTEN;
 
-pub use crate::constraints::MAX_STORED;
+pub(crate) use crate::constraints::MAX_STORED;
 
 /// The most numbers a tape's registers hold: three for each vector.
-pub const MAX_SLOTS: usize = 3 * MAX_REGISTERS;
+pub(super) const MAX_SLOTS: usize = 3 * MAX_REGISTERS;
 
 /// One instruction; it defines the register of its own index from the registers it names.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -301,7 +301,7 @@ impl Op {
 /// What a tape reads besides its instructions: the particles, their rest positions, the rest
 /// value, the material (μ, λ, γ) and the numbers stored for the element.
 #[derive(Clone, Copy, Debug)]
-pub struct Inputs<'a, T> {
+pub(crate) struct Inputs<'a, T> {
     /// p0, p1, …
     pub points: &'a [[T; 3]],
     /// q0, q1, …: the rest positions (the points again, for a tape that reads none).
@@ -316,7 +316,7 @@ pub struct Inputs<'a, T> {
 
 impl<'a, T: Real> Inputs<'a, T> {
     /// The inputs of a tape that reads only the particles and `rest`.
-    pub fn of(points: &'a [[T; 3]], rest: T) -> Self {
+    pub(crate) fn of(points: &'a [[T; 3]], rest: T) -> Self {
         Inputs {
             points,
             shape: points,

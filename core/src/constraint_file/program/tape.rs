@@ -17,7 +17,7 @@ use arrayvec::ArrayVec;
 /// the stored numbers the tape reads ([`Op`] has no instruction for them, so that reading an input
 /// costs no dispatch). Instruction k then defines the next register from earlier ones.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Tape {
+pub(crate) struct Tape {
     /// How many particles the inputs begin with.
     arity: usize,
     /// Per stored number the tape reads, in the order of its registers, where it is among the
@@ -44,7 +44,7 @@ pub struct Tape {
 }
 
 /// The registers of a tape after [`Tape::run`]: read its outputs.
-pub struct Registers<'a, T> {
+pub(crate) struct Registers<'a, T> {
     registers: &'a [T],
     outputs: &'a [Reg],
     widths: &'a [bool],
@@ -52,12 +52,12 @@ pub struct Registers<'a, T> {
 
 impl<T: Copy> Registers<'_, T> {
     /// Output `i` of the tape as a scalar.
-    pub fn scalar(&self, i: usize) -> T {
+    pub(crate) fn scalar(&self, i: usize) -> T {
         self.registers[self.outputs[i] as usize]
     }
 
     /// Output `i` of the tape as a vector.
-    pub fn vector(&self, i: usize) -> [T; 3] {
+    pub(crate) fn vector(&self, i: usize) -> [T; 3] {
         let at = self.outputs[i] as usize;
         [
             self.registers[at],
@@ -68,14 +68,14 @@ impl<T: Copy> Registers<'_, T> {
 
     /// Output `i` of the tape where it is: one number for a scalar, three for a vector (a caller
     /// that takes only part of each number reads only that part).
-    pub fn numbers(&self, i: usize, width: usize) -> &[T] {
+    pub(crate) fn numbers(&self, i: usize, width: usize) -> &[T] {
         let at = self.outputs[i] as usize;
         &self.registers[at..at + width]
     }
 
     /// A prelude's outputs, in order, into `out`: a scalar's one number, a vector's three
     /// ([`super::Compiled::stored`] of them in all).
-    pub fn write_all(&self, out: &mut [T]) {
+    pub(crate) fn write_all(&self, out: &mut [T]) {
         let mut at = 0;
         for (i, &vector) in self.widths.iter().enumerate() {
             let width = if vector { 3 } else { 1 };
@@ -88,7 +88,7 @@ impl<T: Copy> Registers<'_, T> {
 
 /// Where a tape's value stops being finite ([`Tape::undefined_at`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Undefined {
+pub(crate) struct Undefined {
     /// Where the text of the expression that gives the first non-finite value starts
     /// ([`Program::at`]).
     pub base: usize,
@@ -100,7 +100,7 @@ pub struct Undefined {
 
 /// A place where C may have a kink or a jump ([`Tape::switches_at`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Switch {
+pub(crate) struct Switch {
     /// Where the expression's text starts ([`Program::at`]).
     pub base: usize,
     /// The byte of that text.
@@ -164,29 +164,19 @@ impl Tape {
     }
 
     /// Whether it reads the rest shape (q0…).
-    pub fn reads_rest_shape(&self) -> bool {
+    pub(crate) fn reads_rest_shape(&self) -> bool {
         self.ops.iter().any(|op| matches!(op, Op::RestParticle(_)))
     }
 
     /// How many numbers its registers are, inputs included: what [`Tape::run_in`]'s slice must
     /// hold.
-    pub fn slots(&self) -> usize {
+    pub(crate) fn slots(&self) -> usize {
         self.slots
-    }
-
-    /// How many instructions it has.
-    pub fn len(&self) -> usize {
-        self.ops.len()
-    }
-
-    /// Whether it has none.
-    pub fn is_empty(&self) -> bool {
-        self.ops.is_empty()
     }
 
     /// Runs the tape on `inputs` and reads its outputs with `read`.
     #[inline(always)]
-    pub fn run<T: Real, R>(
+    pub(crate) fn run<T: Real, R>(
         &self,
         inputs: &Inputs<'_, T>,
         read: impl FnOnce(&Registers<'_, T>) -> R,
@@ -201,7 +191,7 @@ impl Tape {
     /// tape many times on wide numbers keeps them, rather than a stack frame of [`MAX_SLOTS`]
     /// of them for each run.
     #[inline(always)]
-    pub fn run_in<T: Real, R>(
+    pub(crate) fn run_in<T: Real, R>(
         &self,
         inputs: &Inputs<'_, T>,
         r: &mut [T],
@@ -229,7 +219,7 @@ impl Tape {
     /// When the tape reads the rest shape or the material (a tape that runs at each projection
     /// reads them from what is stored), or `r` is shorter than [`Tape::slots`].
     #[inline(always)]
-    pub fn run_placed<T: Real, R>(
+    pub(crate) fn run_placed<T: Real, R>(
         &self,
         r: &mut [T],
         place: impl FnOnce(&mut [T], &[u8]),
@@ -255,7 +245,7 @@ impl Tape {
     /// The first instruction, in evaluation order, whose value is not finite while what it reads
     /// is, at `points` with `rest`: where and why C is undefined there. `None` where every value
     /// is finite.
-    pub fn undefined_at(&self, inputs: &Inputs<'_, f64>) -> Option<Undefined> {
+    pub(crate) fn undefined_at(&self, inputs: &Inputs<'_, f64>) -> Option<Undefined> {
         let mut r = vec![0.0; self.slots()];
         self.load(inputs, &mut r);
         // A stored number is not finite where the rest shape makes it so (a flat rest tet's
@@ -306,7 +296,7 @@ impl Tape {
     /// `if` on C's path, where it is (as [`Undefined`] says) and what it is, with the value at
     /// `points` of what decides it (the argument of `abs`, the difference of `min`'s two, the
     /// two sides of a condition): the kink is where that value is 0.
-    pub fn switches_at(&self, inputs: &Inputs<'_, f64>) -> Vec<Switch> {
+    pub(crate) fn switches_at(&self, inputs: &Inputs<'_, f64>) -> Vec<Switch> {
         let mut r = vec![0.0; self.slots()];
         self.load(inputs, &mut r);
         let mut out = Vec::new();

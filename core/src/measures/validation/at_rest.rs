@@ -14,7 +14,7 @@ use crate::simulation::{DENSITY, Method, Settings, Simulation};
 
 /// A static run's protocol.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AtRest {
+pub(super) struct AtRest {
     /// Substeps per frame (at least the material's stable count, [`AtRest::settings`]).
     pub substeps: u32,
     /// XPBD iterations per substep, at least 4.
@@ -32,7 +32,12 @@ impl AtRest {
     /// `material`, gravity `gravity` (the ground with it), and at least the substeps that keep
     /// the material stable on a mesh whose shortest edge is `shortest_edge`
     /// ([`Material::substeps_needed`]).
-    pub fn settings(&self, material: Material, gravity: f64, shortest_edge: f64) -> Settings {
+    pub(super) fn settings(
+        &self,
+        material: Material,
+        gravity: f64,
+        shortest_edge: f64,
+    ) -> Settings {
         assert!(
             self.iterations >= 4,
             "a static case runs at least 4 iterations"
@@ -44,7 +49,7 @@ impl AtRest {
             damping: self.damping,
             ..Settings::default()
         };
-        settings.set_material(material);
+        settings.material = material;
         settings.set_gravity(gravity);
         let needed = material.substeps_needed(settings.dt, shortest_edge, DENSITY);
         settings.substeps = self.substeps.max(needed.min(u32::MAX as u64) as u32);
@@ -52,7 +57,7 @@ impl AtRest {
     }
 
     /// "XPBD 100 × 4, damping 10/s".
-    pub fn describe(&self, settings: &Settings) -> String {
+    pub(super) fn describe(&self, settings: &Settings) -> String {
         format!(
             "XPBD {} × {}, damping {}/s",
             settings.substeps, settings.iterations, self.damping
@@ -68,12 +73,12 @@ impl AtRest {
     /// jitter does not add up, and its floor is an ulp / Δt, 4·10⁻⁶ m/s.
     ///
     /// That floor is why the stop speed is at least [`AtRest::stop_speed_for`]'s.
-    pub fn run(&self, trial: &mut Trial, simulation: &mut Simulation) -> Result<Rest, Stop> {
+    pub(super) fn run(&self, trial: &mut Trial, simulation: &mut Simulation) -> Result<Rest, Stop> {
         self.run_watching(trial, simulation, |_| {})
     }
 
     /// [`AtRest::run`], with `on_frame` shown the simulation after every frame.
-    pub fn run_watching(
+    pub(super) fn run_watching(
         &self,
         trial: &mut Trial,
         simulation: &mut Simulation,
@@ -107,9 +112,9 @@ impl AtRest {
     /// The stop speed on `simulation`'s engine: [`AtRest::stop_speed`], or what its precision
     /// can resolve if that is more, 4 ε X / Δt with ε the machine epsilon of its positions
     /// (f32's 1.2·10⁻⁷ on the fast engine) and X the largest coordinate: four ulps a frame.
-    pub fn stop_speed_for(&self, simulation: &Simulation) -> f64 {
+    pub(super) fn stop_speed_for(&self, simulation: &Simulation) -> f64 {
         let epsilon = match simulation.engine() {
-            crate::simulation::Engine::Fast => f32::EPSILON as f64,
+            crate::simulation::EngineChoice::Fast => f32::EPSILON as f64,
             _ => f64::EPSILON,
         };
         let extent = simulation
@@ -124,7 +129,7 @@ impl AtRest {
 
 /// How a static run ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Rest {
+pub(super) struct Rest {
     /// Frames stepped.
     pub frames: u32,
     /// The largest frame speed at the end, m/s ([`frame_speed`]).
@@ -137,7 +142,7 @@ pub struct Rest {
 
 impl Rest {
     /// The check that the run came to rest, labelled with `what` and the protocol.
-    pub fn check(&self, what: &str, protocol: &AtRest, settings: &Settings) -> Check {
+    pub(super) fn check(&self, what: &str, protocol: &AtRest, settings: &Settings) -> Check {
         Check {
             criterion: format!("at rest within {} frames", protocol.max_frames),
             ..Check::at_most(
@@ -155,14 +160,14 @@ impl Rest {
 }
 
 /// The neo-Hookean pair, and nothing else.
-pub fn neohookean() -> PerFamily<bool> {
+pub(super) fn neohookean() -> PerFamily<bool> {
     PerFamily::builtin_from_fn(|f| {
         f == Family::NEOHOOKEAN_DEVIATORIC || f == Family::NEOHOOKEAN_HYDROSTATIC
     })
 }
 
 /// The largest distance a particle moved since `before`, over one frame's length: m/s.
-pub fn frame_speed(simulation: &Simulation, before: &[glam::DVec3]) -> f64 {
+pub(super) fn frame_speed(simulation: &Simulation, before: &[glam::DVec3]) -> f64 {
     simulation
         .positions()
         .iter()
@@ -173,14 +178,14 @@ pub fn frame_speed(simulation: &Simulation, before: &[glam::DVec3]) -> f64 {
 }
 
 /// The number of particle (i, j, k) of a [`crate::scene::lattice`] of `cells`.
-pub fn lattice_index(cells: [usize; 3], i: usize, j: usize, k: usize) -> usize {
+pub(super) fn lattice_index(cells: [usize; 3], i: usize, j: usize, k: usize) -> usize {
     let [_, ny, nz] = cells;
     (i * (ny + 1) + j) * (nz + 1) + k
 }
 
 /// The particles of the plane `axis` = `index` of a [`crate::scene::lattice`] of `cells`
 /// (axis 0, 1, 2 for x, y, z), in lattice order.
-pub fn lattice_plane(cells: [usize; 3], axis: usize, index: usize) -> Vec<usize> {
+pub(super) fn lattice_plane(cells: [usize; 3], axis: usize, index: usize) -> Vec<usize> {
     let mut plane = Vec::new();
     for i in 0..=cells[0] {
         for j in 0..=cells[1] {
@@ -195,7 +200,7 @@ pub fn lattice_plane(cells: [usize; 3], axis: usize, index: usize) -> Vec<usize>
 }
 
 /// The mean of `values` (NaN when there are none).
-pub fn mean(values: impl Iterator<Item = f64>) -> f64 {
+pub(super) fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     sum / n as f64
 }

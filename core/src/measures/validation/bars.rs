@@ -22,7 +22,7 @@ use crate::simulation::DENSITY;
 use glam::DVec3;
 
 /// The hanging bar.
-pub const HANGING_BAR: Case = Case {
+pub(super) const HANGING_BAR: Case = Case {
     name: "hanging-bar",
     summary: "a bar hanging under its weight, ν = 0, against ρ g L² / (2E), refined",
     quick: true,
@@ -30,7 +30,7 @@ pub const HANGING_BAR: Case = Case {
 };
 
 /// The cantilever.
-pub const CANTILEVER: Case = Case {
+pub(super) const CANTILEVER: Case = Case {
     name: "cantilever",
     summary: "the beam under gravity against Euler–Bernoulli and Timoshenko, refined",
     quick: true,

@@ -27,7 +27,7 @@ use crate::scene::{Scene, lattice};
 use glam::DVec3;
 
 /// The case.
-pub const CASE: Case = Case {
+pub(super) const CASE: Case = Case {
     name: "cook",
     summary: "Cook's membrane, plane strain, neo-Hookean, against 23.96 (Cook et al. 1989), refined",
     quick: false,

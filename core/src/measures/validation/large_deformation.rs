@@ -20,7 +20,7 @@ use crate::simulation::Simulation;
 use glam::{DQuat, DVec3};
 
 /// The twist.
-pub const TWIST: Case = Case {
+pub(super) const TWIST: Case = Case {
     name: "twist",
     summary: "a 5:1 bar twisted through 360° and let go: finite, recovers its rest shape",
     quick: true,
@@ -28,7 +28,7 @@ pub const TWIST: Case = Case {
 };
 
 /// The compression.
-pub const COMPRESSION: Case = Case {
+pub(super) const COMPRESSION: Case = Case {
     name: "compression",
     summary: "a cube squashed to 10 % of its height and let go: finite, recovers",
     quick: true,
@@ -36,7 +36,7 @@ pub const COMPRESSION: Case = Case {
 };
 
 /// The slivers.
-pub const SLIVERS: Case = Case {
+pub(super) const SLIVERS: Case = Case {
     name: "slivers",
     summary: "a block of 10:1 sliver tets dropped on the ground: no energy gained, no blow-up",
     quick: true,

@@ -6,28 +6,28 @@
 //!
 //! | case | what theory says | file |
 //! | --- | --- | --- |
-//! | `patch` | boundary on an affine map x ↦ Ax + b: every interior particle ends at Ax + b | [`patch`] |
-//! | `hanging-bar` | a bar hanging under its weight (ν = 0) stretches by ρ g L² / (2E) | [`bars`] |
-//! | `cantilever` | Euler–Bernoulli q L⁴ / (8EI), under refinement | [`bars`] |
-//! | `stretch` | uniaxial stretch: lateral contraction −ν ε, then V/V₀ of the energy | [`stretch`] |
-//! | `twist`, `compression`, `slivers` | large deformations: finite, no energy gained, recovered | [`large_deformation`] |
-//! | `cook` | Cook's membrane: 23.96 at the tip (plane stress, E = 1, ν = 1/3, F = 1) | [`cook`] |
+//! | `patch` | boundary on an affine map x ↦ Ax + b: every interior particle ends at Ax + b | `patch` |
+//! | `hanging-bar` | a bar hanging under its weight (ν = 0) stretches by ρ g L² / (2E) | `bars` |
+//! | `cantilever` | Euler–Bernoulli q L⁴ / (8EI), under refinement | `bars` |
+//! | `stretch` | uniaxial stretch: lateral contraction −ν ε, then V/V₀ of the energy | `stretch` |
+//! | `twist`, `compression`, `slivers` | large deformations: finite, no energy gained, recovered | `large_deformation` |
+//! | `cook` | Cook's membrane: 23.96 at the tip (plane stress, E = 1, ν = 1/3, F = 1) | `cook` |
 //!
 //! Every static case runs XPBD with at least 4 iterations to rest under the protocol of
-//! [`at_rest`], which states its damping and its stop speed. [`Case::quick`] cases form the
+//! `at_rest`, which states its damping and its stop speed. [`Case::quick`] cases form the
 //! subset the test command runs; the others (finer meshes, Cook's membrane) only the full suite.
 
-pub mod at_rest;
-pub mod bars;
-pub mod cook;
-pub mod large_deformation;
-pub mod patch;
-pub mod stretch;
+mod at_rest;
+mod bars;
+mod cook;
+mod large_deformation;
+mod patch;
+mod stretch;
 
 use crate::measures::metrics::Metrics;
 use crate::scene::Scene;
 use crate::simulation::divergence::Divergence;
-use crate::simulation::{Engine, Settings, Simulation};
+use crate::simulation::{EngineChoice, Settings, Simulation};
 
 /// One comparison with theory.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -115,7 +115,7 @@ impl Check {
 
     /// Passes when `measured` is at most `limit` (an upper bound theory gives: no energy
     /// gained, no tet left inverted).
-    pub fn at_most(
+    pub(crate) fn at_most(
         quantity: impl Into<String>,
         limit: f64,
         source: impl Into<String>,
@@ -210,8 +210,8 @@ impl Watch for Unwatched {}
 
 /// What a case runs with: the engine, the fast engine's threads, and who watches.
 pub struct Trial<'w> {
-    /// [`Engine::Reference`] or [`Engine::Fast`].
-    pub engine: Engine,
+    /// [`EngineChoice::Reference`] or [`EngineChoice::Fast`].
+    pub engine: EngineChoice,
     /// Threads for the fast engine (the results are the same bits for any count).
     pub threads: usize,
     /// Whether to run the full suite's version of the case (finer meshes).
@@ -223,7 +223,12 @@ pub struct Trial<'w> {
 
 impl<'w> Trial<'w> {
     /// A trial on `engine`; `watch` sees every run.
-    pub fn new(engine: Engine, threads: usize, full: bool, watch: &'w mut dyn Watch) -> Trial<'w> {
+    pub fn new(
+        engine: EngineChoice,
+        threads: usize,
+        full: bool,
+        watch: &'w mut dyn Watch,
+    ) -> Trial<'w> {
         Trial {
             engine,
             threads,
@@ -338,12 +343,20 @@ pub fn run(case: &'static Case, trial: &mut Trial) -> Option<Vec<Check>> {
 
 /// The observed order of convergence between two refinements by `ratio` (2 when the cell size
 /// halves): p = log(e_coarse / e_fine) / log(ratio). Positive when the error falls.
-///
-/// ```
-/// use tetlab_core::measures::validation::observed_order;
-/// // An error that falls as h²: a quarter for half the cells' size.
-/// assert!((observed_order(0.08, 0.02, 2.0) - 2.0).abs() < 1e-12);
-/// ```
-pub fn observed_order(coarse_error: f64, fine_error: f64, ratio: f64) -> f64 {
+pub(crate) fn observed_order(coarse_error: f64, fine_error: f64, ratio: f64) -> f64 {
     (coarse_error / fine_error).ln() / ratio.ln()
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `observed_order`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn observed_order_example() {
+        use crate::measures::validation::observed_order;
+        // An error that falls as h²: a quarter for half the cells' size.
+        assert!((observed_order(0.08, 0.02, 2.0) - 2.0).abs() < 1e-12);
+    }
 }

@@ -12,7 +12,7 @@ use crate::scene::{Scene, lattice};
 use glam::{DMat3, DVec3};
 
 /// The case.
-pub const CASE: Case = Case {
+pub(super) const CASE: Case = Case {
     name: "patch",
     summary: "neo-Hookean patch test: boundary pinned on x ↦ Ax + b, interior ends on the map",
     quick: true,

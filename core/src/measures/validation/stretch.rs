@@ -18,7 +18,7 @@ use crate::simulation::Simulation;
 use glam::DVec3;
 
 /// The case.
-pub const CASE: Case = Case {
+pub(super) const CASE: Case = Case {
     name: "stretch",
     summary: "uniaxial stretch of a 5:1 bar: lateral contraction against ν at 1 %, V/V₀ at 50 %",
     quick: true,

@@ -1,6 +1,6 @@
 //! Tetrahedral meshes: positions, tets, and what is derived from them (edges, surface faces).
 //!
-//! Loaders for TetGen (`.node`/`.ele`) and Gmsh (`.msh`, ASCII 2.2 and 4.1) live in [`tetgen`] and
+//! Loaders for TetGen (`.node`/`.ele`) and Gmsh (`.msh`, ASCII 2.2 and 4.1) live in `tetgen` and
 //! [`gmsh`]; both hand their raw tets to [`TetMesh::new`], which checks and cleans them the same way.
 
 pub mod gmsh;
@@ -146,7 +146,7 @@ impl TetMesh {
     }
 
     /// [`TetMesh::surface_faces`], each with the tet it belongs to.
-    pub fn surface_faces_with_tets(&self) -> Vec<([u32; 3], u32)> {
+    pub(crate) fn surface_faces_with_tets(&self) -> Vec<([u32; 3], u32)> {
         let mut uses: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
         for tet in &self.tets {
             for face in tet_faces(tet) {
@@ -217,7 +217,7 @@ pub const TET_EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 
 /// The four faces of a positively oriented tet (a, b, c, d), face k opposite corner k, each wound
 /// so that its normal points away from that corner (out of the tet).
 #[inline]
-pub fn tet_faces(t: &[u32; 4]) -> [[u32; 3]; 4] {
+pub(crate) fn tet_faces(t: &[u32; 4]) -> [[u32; 3]; 4] {
     let [a, b, c, d] = *t;
     [[b, c, d], [a, d, c], [a, b, d], [a, c, b]]
 }

@@ -12,7 +12,7 @@ use glam::DVec3;
 use std::path::Path;
 
 /// Loads `stem.node` and `stem.ele`, given either of the two paths.
-pub fn load(path: &Path) -> Result<(TetMesh, LoadReport), MeshError> {
+pub(super) fn load(path: &Path) -> Result<(TetMesh, LoadReport), MeshError> {
     let node_path = path.with_extension("node");
     let ele_path = path.with_extension("ele");
     let node_text = Lines::read(&node_path)?;

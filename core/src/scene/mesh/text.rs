@@ -26,7 +26,7 @@ impl MeshError {
     }
 
     /// An error about the file as a whole.
-    pub fn whole_file(path: &Path, message: impl Into<String>) -> Self {
+    pub(crate) fn whole_file(path: &Path, message: impl Into<String>) -> Self {
         Self {
             path: path.to_owned(),
             line: None,
@@ -47,7 +47,7 @@ impl fmt::Display for MeshError {
 impl std::error::Error for MeshError {}
 
 /// The most values (attributes, markers) a header may declare for each line that follows.
-pub const MAX_VALUES_PER_LINE: usize = 1 << 16;
+pub(super) const MAX_VALUES_PER_LINE: usize = 1 << 16;
 
 /// The non-blank lines of a text file, split into words, with `#` comments removed when asked.
 pub(crate) struct Lines<'a> {
@@ -67,7 +67,7 @@ pub(crate) struct Line<'a> {
 
 impl<'a> Lines<'a> {
     /// Reads `path` whole as text ([`crate::input::text_file::read`]) for [`Lines::new`].
-    pub fn read(path: &Path) -> Result<String, MeshError> {
+    pub(super) fn read(path: &Path) -> Result<String, MeshError> {
         crate::input::text_file::read(path).map_err(|e| MeshError {
             path: path.to_owned(),
             line: e.line,
@@ -76,7 +76,7 @@ impl<'a> Lines<'a> {
     }
 
     /// Lines of `text` read from `path`; `comments` removes everything from a `#` on.
-    pub fn new(path: &'a Path, text: &'a str, comments: bool) -> Self {
+    pub(super) fn new(path: &'a Path, text: &'a str, comments: bool) -> Self {
         Self {
             path,
             lines: crate::input::text_file::without_byte_order_mark(text)
@@ -88,7 +88,7 @@ impl<'a> Lines<'a> {
     }
 
     /// The next line with any words on it, or an error saying the file ended while `expecting`.
-    pub fn next_line(&mut self, expecting: &str) -> Result<Line<'a>, MeshError> {
+    pub(super) fn next_line(&mut self, expecting: &str) -> Result<Line<'a>, MeshError> {
         self.next_or_end().ok_or_else(|| {
             MeshError::at(
                 self.path,
@@ -99,7 +99,7 @@ impl<'a> Lines<'a> {
     }
 
     /// The next line with any words on it, or `None` at the end of the file.
-    pub fn next_or_end(&mut self) -> Option<Line<'a>> {
+    pub(super) fn next_or_end(&mut self) -> Option<Line<'a>> {
         for (index, raw) in self.lines.by_ref() {
             let content = if self.comments {
                 raw.split('#').next().unwrap_or_default()
@@ -122,12 +122,12 @@ impl<'a> Lines<'a> {
 
 impl Line<'_> {
     /// An error about this line.
-    pub fn error(&self, message: impl Into<String>) -> MeshError {
+    pub(super) fn error(&self, message: impl Into<String>) -> MeshError {
         MeshError::at(self.path, self.number, message)
     }
 
     /// Requires at least `n` words, naming what they are.
-    pub fn expect_at_least(&self, n: usize, what: &str) -> Result<(), MeshError> {
+    pub(super) fn expect_at_least(&self, n: usize, what: &str) -> Result<(), MeshError> {
         if self.words.len() < n {
             Err(self.error(format!(
                 "expected {what} ({n} values), found {}",
@@ -139,7 +139,7 @@ impl Line<'_> {
     }
 
     /// Word `i` as an integer, naming what it is in the error.
-    pub fn integer<T: FromStr>(&self, i: usize, what: &str) -> Result<T, MeshError> {
+    pub(super) fn integer<T: FromStr>(&self, i: usize, what: &str) -> Result<T, MeshError> {
         let word = self.word(i, what)?;
         word.parse().map_err(|_| {
             self.error(format!(
@@ -149,7 +149,7 @@ impl Line<'_> {
     }
 
     /// Word `i` as a finite number, naming what it is in the error.
-    pub fn number(&self, i: usize, what: &str) -> Result<f64, MeshError> {
+    pub(super) fn number(&self, i: usize, what: &str) -> Result<f64, MeshError> {
         let word = self.word(i, what)?;
         match word.parse::<f64>() {
             Ok(x) if x.is_finite() => Ok(x),
@@ -159,21 +159,21 @@ impl Line<'_> {
     }
 
     /// Word `i` as a coordinate within [`crate::input::limits::MAX_COORDINATE`].
-    pub fn coordinate(&self, i: usize, what: &str) -> Result<f64, MeshError> {
+    pub(super) fn coordinate(&self, i: usize, what: &str) -> Result<f64, MeshError> {
         let x = self.number(i, what)?;
         crate::input::limits::coordinate(x).map_err(|e| self.error(format!("{what}: {e}")))
     }
 
     /// Word `i` as a count of tets (or of elements that may be tets), at most
     /// [`crate::input::limits::MAX_TETS`].
-    pub fn tet_count(&self, i: usize, what: &str) -> Result<usize, MeshError> {
+    pub(super) fn tet_count(&self, i: usize, what: &str) -> Result<usize, MeshError> {
         let count: usize = self.integer(i, what)?;
         crate::input::limits::tet_count(count).map_err(|e| self.error(format!("{what}: {e}")))
     }
 
     /// Word `i` as a count of values per line (attributes, markers), at most
     /// [`MAX_VALUES_PER_LINE`]: more than any line of a mesh holds.
-    pub fn per_line(&self, i: usize, what: &str) -> Result<usize, MeshError> {
+    pub(super) fn per_line(&self, i: usize, what: &str) -> Result<usize, MeshError> {
         let count: usize = self.integer(i, what)?;
         if count <= MAX_VALUES_PER_LINE {
             Ok(count)

@@ -41,34 +41,28 @@
 //! role by role ([`Layout::new_visiting`]): visited tet by tet, a tet's four heights took four
 //! colours in a row, and the colour order projected them back to back after all.
 
+use crate::constraints::GROUP;
 use crate::numbers::lanes::{F32x8, LANES};
 use crate::numbers::vector::Real;
 use std::ops::Range;
 
 /// The fewest particles a region has: a body is cut into as many regions as this allows, a power
 /// of two up to [`MAX_REGIONS`].
-pub const PARTICLES_PER_REGION: usize = 2048;
+pub(super) const PARTICLES_PER_REGION: usize = 2048;
 
 /// Colours with fewer elements than this are projected on one thread even when several are
 /// available: below it, handing out the work costs more than it saves.
 pub const PARALLEL_MIN: usize = 256;
 
 /// The most regions a body is cut into.
-pub const MAX_REGIONS: usize = 8;
+pub(super) const MAX_REGIONS: usize = 8;
 
 /// Particles a region boundary is a multiple of: four 16-byte particles fill a 64-byte cache line,
 /// so that no line holds particles of two regions. (16 for lines of 128 bytes, or 256 elsewhere.)
 const REGION_ALIGN: usize = 16;
 
 /// How many regions a body of `particles` particles is cut into (see the module).
-///
-/// ```
-/// use tetlab_core::simulation::fast::batches::regions_for;
-/// assert_eq!(regions_for(333), 1); // the bunny: one region, colour after colour
-/// assert_eq!(regions_for(4096), 2);
-/// assert_eq!(regions_for(1_000_000), 8);
-/// ```
-pub fn regions_for(particles: usize) -> usize {
+pub(super) fn regions_for(particles: usize) -> usize {
     let most = (particles / PARTICLES_PER_REGION).clamp(1, MAX_REGIONS);
     1 << most.ilog2()
 }
@@ -84,21 +78,14 @@ fn region_of(i: usize, particles: usize, regions: usize) -> usize {
 /// The level and group (see the module) of an element whose particles lie in regions `lo` to
 /// `hi`: the level is the highest bit in which the two differ, plus one (0 when they are the
 /// same region), and the group the regions' number above it.
-///
-/// ```
-/// use tetlab_core::simulation::fast::batches::level_and_group;
-/// assert_eq!(level_and_group(5, 5), (0, 5)); // inside region 5
-/// assert_eq!(level_and_group(4, 5), (1, 2)); // across the cut of regions 4–5
-/// assert_eq!(level_and_group(1, 2), (2, 0)); // regions 0–3 hold it
-/// ```
-pub fn level_and_group(lo: usize, hi: usize) -> (usize, usize) {
+pub(super) fn level_and_group(lo: usize, hi: usize) -> (usize, usize) {
     let level = (usize::BITS - (lo ^ hi).leading_zeros()) as usize;
     (level, lo >> level)
 }
 
 /// Where group `group` of level `level` is among the groups of a body of `regions` regions:
 /// the R regions first, then level 1's R / 2 groups, and so on.
-pub fn group_index(regions: usize, level: usize, group: usize) -> usize {
+pub(super) fn group_index(regions: usize, level: usize, group: usize) -> usize {
     2 * regions - 2 * (regions >> level) + group
 }
 
@@ -126,7 +113,7 @@ pub struct Layout {
     size: Vec<F32x8>,
     /// Elements of one entry share no particle. Entry s·C + c (C = [`Layout::colour_count`]) is
     /// colour c of group s: the R regions (level 0), the R / 2 groups of level 1, …, the one group
-    /// of the last level ([`Layout::group`]). An entry may be empty.
+    /// of the last level ([`Layout::groups`] per level). An entry may be empty.
     pub colours: Vec<Colour>,
     /// How many regions: R, a power of two (see the module).
     regions: usize,
@@ -175,6 +162,17 @@ impl<'a> RestRows<'a> {
             self.values[b],
             &self.stored[b * self.len..(b + 1) * self.len],
         )
+    }
+
+    /// [`RestRows::of`] batches `b..b + GROUP`.
+    #[inline(always)]
+    pub(crate) fn group(self, b: usize) -> ([F32x8; GROUP], [&'a [F32x8]; GROUP]) {
+        let mut rest = [F32x8::ZERO; GROUP];
+        let mut stored: [&[F32x8]; GROUP] = [&[]; GROUP];
+        for j in 0..GROUP {
+            (rest[j], stored[j]) = self.of(b + j);
+        }
+        (rest, stored)
     }
 }
 
@@ -302,7 +300,7 @@ impl Layout {
     }
 
     /// How many levels of groups: log₂ R + 1 (see the module).
-    pub fn levels(&self) -> usize {
+    pub(crate) fn levels(&self) -> usize {
         self.regions().ilog2() as usize + 1
     }
 
@@ -448,7 +446,7 @@ impl Layout {
     }
 
     /// The number of batches.
-    pub fn batch_count(&self) -> usize {
+    pub(crate) fn batch_count(&self) -> usize {
         self.elements.len()
     }
 
@@ -586,4 +584,28 @@ impl Batches {
 #[inline]
 fn in_order(order: &[u32], k: usize) -> usize {
     order.get(k).map_or(k, |&c| c as usize)
+}
+
+#[cfg(test)]
+mod examples {
+    #[allow(unused_imports)]
+    use super::*;
+
+    /// The example of `level_and_group`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn level_and_group_example() {
+        use crate::simulation::fast::batches::level_and_group;
+        assert_eq!(level_and_group(5, 5), (0, 5)); // inside region 5
+        assert_eq!(level_and_group(4, 5), (1, 2)); // across the cut of regions 4–5
+        assert_eq!(level_and_group(1, 2), (2, 0)); // regions 0–3 hold it
+    }
+
+    /// The example of `regions_for`'s documentation (a unit test: the item is not exported).
+    #[test]
+    fn regions_for_example() {
+        use crate::simulation::fast::batches::regions_for;
+        assert_eq!(regions_for(333), 1); // the bunny: one region, colour after colour
+        assert_eq!(regions_for(4096), 2);
+        assert_eq!(regions_for(1_000_000), 8);
+    }
 }

@@ -1,57 +1,70 @@
-//! The fast solver: the substep of [`crate::simulation`] in f32, on flat arrays laid out for speed, on
-//! one thread or several. For big meshes, headless runs and `tetlab bench`; the interactive f64
-//! solver stays the reference and the teaching path.
+//! The fast engine: the substep of [`crate::simulation::substep`] in f32, on flat arrays laid out
+//! for speed, on one thread or several. For big meshes, headless runs and `tetlab bench`; the
+//! reference engine stays the exact path and the one step-by-step mode walks.
 //!
-//! What is the same: the constraint formulas (the [`crate::constraints::Constraint`] types of
-//! the family table), the projection rule ([`crate::simulation::projection`]), the integration
-//! (`integrate`), rest values, masses and pins (taken from a simulation, [`Start`]); grabs and settling edits too
-//! ([`FrameInputs`]).
+//! What is the same: the substep's stages and their order ([`crate::simulation::substep`]), the
+//! constraint formulas (the [`crate::constraints::Constraint`] types of the family table), the
+//! projection rule ([`crate::simulation::projection`]), the integration (`integrate`), rest
+//! values, masses, pins, grabs and settling edits (from the simulation's body and state,
+//! [`crate::simulation::Start`]).
 //!
 //! What differs, for speed:
-//! - particles are renumbered along a Morton (Z-order) curve ([`morton`]), so that particles close
+//! - particles are renumbered along a Morton (Z-order) curve (`morton`), so that particles close
 //!   in space are close in memory; [`FastSimulation::positions`] gives them back in the scene's
 //!   numbering;
 //! - each family's constraints are coloured so that no two of one colour share a particle, and
-//!   projected colour by colour (Gauss–Seidel across colours) ([`batches`]). Within a colour the
+//!   projected colour by colour (Gauss–Seidel across colours) (`batches`). Within a colour the
 //!   order does not matter, so several threads can share a colour and the result is the same bits
 //!   whatever the thread count. A large body is first cut into regions of space, each projected
-//!   through all its colours before the elements across the cuts ([`batches`], "Regions";
+//!   through all its colours before the elements across the cuts (`batches`, "Regions";
 //!   `schedule`), so that threads take whole regions and meet at the cuts only;
-//! - within a colour, [`crate::numbers::lanes::LANES`] constraints are projected at once ([`kernel`]): the formulas run
-//!   on [`crate::numbers::lanes::Vec3x8`], eight x, eight y and eight z in SIMD registers; a batch's
-//!   particles are loaded as padded 3-vectors and transposed, its inverse masses, rest values and
-//!   multipliers are stored lane by lane beside it; the loads skip their bounds checks
-//!   ([`particles`], one of the two `unsafe` modules, with [`team`]);
-//! - f32 instead of f64;
+//! - within a colour, [`crate::numbers::lanes::LANES`] constraints are projected at once
+//!   (`kernel`): the formulas run on [`crate::numbers::lanes::Vec3x8`], eight x, eight y and
+//!   eight z in SIMD registers; a batch's particles are loaded as padded 3-vectors and
+//!   transposed, its inverse masses, rest values and multipliers are stored lane by lane beside
+//!   it; the loads skip their bounds checks (`particles`, one of the two `unsafe` modules, with
+//!   `team`);
+//! - f32 instead of f64, each position kept with the residual its rounding left out;
 //! - optionally the [`Order::Jacobi`] order, for comparison;
 //! - regions, large colours and the per-particle passes of a large body shared by a [`Team`] of
 //!   threads kept for the simulation's life.
+//!
+//! As an [`Engine`], it keeps its own copy of the state: each frame it compares the simulation's
+//! [`crate::simulation::Revision`] with the one it last saw, takes the state up again after an
+//! edit ([`FastSimulation::load`]) and builds itself again after an edit of the body or a change
+//! of what it was built for (the active families, the material, the threads), then writes
+//! positions, velocities and Δp back ([`FastSimulation::store`]).
 
-pub mod batches;
+mod batches;
+mod family_batches;
 mod kernel;
+mod layouts;
 mod morton;
 mod particles;
+mod readers;
 mod schedule;
 mod share_timers;
+mod substeps;
 mod team;
 
 pub use batches::{Batches, Colour, Layout, PARALLEL_MIN};
+pub use family_batches::{FamilyBatches, Order};
 pub use team::Team;
 
-use super::constraint_set::ConstraintSet;
-use super::settings::Settings;
-use crate::constraints::{Binding, Constraint, Families, Family, PerFamily, Visit, VisitPair};
-use crate::input::limits::SOUND_LIMIT;
-use crate::simulation::divergence::Divergence;
-use crate::simulation::integrate;
-use crate::simulation::projection::{Rule, SkipCounts};
+use crate::constraints::material::Material;
+use crate::constraints::{Families, Family, PerFamily};
+use crate::simulation::engine::{Engine, Frame, Start};
+use crate::simulation::projection::SkipCounts;
+use crate::simulation::substep::{self, Plan};
+use crate::simulation::{Divergence, Resolved};
+use family_batches::Jacobi;
 use glam::{DVec3, Vec3A};
+use layouts::Layouts;
 use std::time::Duration;
-use web_time::Instant;
 
 /// The largest coordinate (m) the f32 engine holds: an edge of twice this, raised to the fourth
 /// power (the squared gradient of a volume), stays below f32's 3.4·10³⁸. Velocities are held up
-/// to [`SOUND_LIMIT`], as in f64 (they are only ever multiplied by a substep).
+/// to [`crate::simulation::SOUND_LIMIT`], as in f64 (they are only ever multiplied by a substep).
 pub const POSITION_LIMIT: f64 = 1e9;
 
 /// A body whose centre is further than this many times its own size from the origin of the
@@ -73,11 +86,29 @@ fn residual(p: DVec3) -> Vec3A {
     (p - p.as_vec3a().as_dvec3()).as_vec3a()
 }
 
+/// What the engine was built for: when one of these changes, it builds itself again.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct BuiltFor {
+    /// The body's revision.
+    body: u64,
+    /// The active families, whose layouts and batches it built.
+    active: PerFamily<bool>,
+    /// The material the batches' rest values were measured with.
+    material: Material,
+    /// Its threads.
+    threads: usize,
+}
+
 /// The soft body, fast. See the module documentation.
 pub struct FastSimulation {
     /// The table of families it projects.
     families: Families,
-    settings: Settings,
+    /// The settings in force, resolved against the table.
+    resolved: Resolved,
+    /// What it was built for.
+    built_for: BuiltFor,
+    /// The revision of the simulation's state it holds.
+    synced: u64,
     /// Where the positions are measured from, in the scene's frame: a particle is at
     /// `origin + positions[i]`. It follows a body that travels far (thrown, falling), so that
     /// its f32 coordinates stay about its own size, and their precision its size's
@@ -98,45 +129,29 @@ pub struct FastSimulation {
     original: Vec<u32>,
     /// The new number of each particle, by the scene's number.
     renumber: Vec<u32>,
-    /// The edges, the tets and the (tet, vertex) pairs of the body, coloured and in batches;
-    /// every family of a binding shares that binding's (each is empty when no active family
-    /// uses it).
+    /// The elements the active families bind to, coloured and in batches.
     layouts: Layouts,
     /// The rest values and multipliers of each active family (the others are left empty).
     sets: PerFamily<Batches>,
     /// The order each family's colours are projected in: empty for the layout's order,
-    /// otherwise a permutation drawn from [`Settings::order_seed`].
+    /// otherwise a permutation drawn from [`crate::simulation::Settings::order_seed`].
     colour_orders: PerFamily<Vec<u32>>,
     tets: usize,
     jacobi: Option<Jacobi>,
     /// The threads large colours are shared with, kept for the simulation's life (none: one).
     team: Option<Team>,
     timings: Timings,
-    /// Projections skipped for a counted reason since the last [`FastSimulation::take_skipped`].
+    /// Projections skipped for a counted reason since the last [`Engine::step`].
     skipped: PerFamily<SkipCounts>,
     frame: u64,
-    /// Δp of the last substep and its sum over the frame, when a frame asks for them
-    /// ([`FrameInputs`]); the predicted positions they are measured from. Empty until then.
+    /// Δp of the last substep and its sum over the frame, when a frame asks for them; the
+    /// predicted positions they are measured from. Empty until then.
     corrections: Corrections,
-    /// The external forces in N by new number ([`crate::simulation::Simulation::set_forces`]); empty: none.
+    /// The external forces in N by new number ([`crate::simulation::Simulation::set_forces`]);
+    /// empty: none.
     forces: Vec<Vec3A>,
     /// Whether every particle keeps its z ([`crate::simulation::Simulation::set_plane_strain`]).
     plane_strain: bool,
-}
-
-/// What a frame of the fast solver is asked to do beyond the settings: hold a grabbed particle,
-/// settle an edit, keep Δp. The reference solver ([`crate::simulation::Simulation`]) passes them when it steps
-/// on the fast engine.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct FrameInputs {
-    /// A particle held by the user: its number in the scene, where it is held, and the grab's
-    /// compliance (0: it follows the target exactly, and its inverse mass must be 0).
-    pub grab: Option<(usize, DVec3, f64)>,
-    /// Whether an edit settles: corrections may move particles but not speed them up, and Δp is
-    /// summed over the frame.
-    pub settling: bool,
-    /// Whether to keep Δp of the frame's last substep ([`FastSimulation::store`]).
-    pub corrections: bool,
 }
 
 /// Δp per particle (new numbering), kept on request.
@@ -147,172 +162,14 @@ struct Corrections {
     frame: Vec<Vec3A>,
 }
 
-/// The layouts of the elements families bind to: edges, tets, and (tet, vertex) pairs.
-#[derive(Default)]
-struct Layouts {
-    edges: Layout,
-    tets: Layout,
-    tet_vertices: Layout,
-    triangles: Layout,
-    hinges: Layout,
-}
-
-impl Layouts {
-    /// The layout a family of `binding` uses.
-    fn of(&self, binding: Binding) -> &Layout {
-        match binding {
-            Binding::Edges => &self.edges,
-            Binding::Tets => &self.tets,
-            Binding::TetVertices => &self.tet_vertices,
-            Binding::Triangles => &self.triangles,
-            Binding::Hinges => &self.hinges,
-        }
-    }
-
-    /// Every one, for the families' weights and the memory.
-    fn all_mut(&mut self) -> [&mut Layout; 5] {
-        [
-            &mut self.edges,
-            &mut self.tets,
-            &mut self.tet_vertices,
-            &mut self.triangles,
-            &mut self.hinges,
-        ]
-    }
-}
-
-/// One family's constraints as the fast solver holds them: on its layout, one per element.
-#[derive(Clone, Copy)]
-pub struct FamilyBatches<'a> {
-    layout: &'a Layout,
-    batches: &'a Batches,
-}
-
-impl<'a> FamilyBatches<'a> {
-    /// The entries of the family's layout: its colours, segment by segment (the regions, then
-    /// the border: [`Layout::colours`]; none for a family that is not active).
-    pub fn colours(&self) -> &'a [Colour] {
-        if self.batches.is_empty() {
-            &[]
-        } else {
-            &self.layout.colours
-        }
-    }
-
-    /// How many colours each segment of the layout has (none for a family that is not active):
-    /// what [`FastSimulation::colour_order`] permutes ([`Layout::colour_count`]).
-    pub fn colour_count(&self) -> usize {
-        if self.batches.is_empty() {
-            0
-        } else {
-            self.layout.colour_count()
-        }
-    }
-
-    /// The layout's regions ([`Layout::regions`]).
-    pub fn regions(&self) -> usize {
-        self.layout.regions()
-    }
-
-    /// The number of constraints, padding not counted.
-    pub fn len(&self) -> usize {
-        self.colours().iter().map(|c| c.elements).sum::<usize>()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The particles (the first arity of four, in the constraint's order) and rest value of each
-    /// constraint, colour by colour, padding left out.
-    pub fn constraints(&self) -> impl Iterator<Item = ([u32; 4], f32)> + 'a {
-        self.constraints_storing()
-            .map(|(particles, rest, _)| (particles, rest))
-    }
-
-    /// [`FamilyBatches::constraints`] with what each stores.
-    pub fn constraints_storing(&self) -> impl Iterator<Item = ([u32; 4], f32, Vec<f32>)> + 'a {
-        let batches = self.batches;
-        let elements = (!batches.is_empty()).then(|| self.layout.elements());
-        elements
-            .into_iter()
-            .flatten()
-            .map(move |(_, particles, at)| (particles, batches.rest_at(at), batches.stored_at(at)))
-    }
-
-    /// Whether every colour of its layout really shares no particle.
-    pub fn colouring_is_valid(&self, particle_count: usize) -> bool {
-        self.layout.colouring_is_valid(particle_count)
-    }
-
-    /// How many of its constraints each particle is in.
-    fn constraints_per_particle(&self, particle_count: usize) -> Vec<u32> {
-        let mut count = vec![0; particle_count];
-        for (particles, _) in self.constraints() {
-            for &i in &particles[..self.layout.arity()] {
-                count[i as usize] += 1;
-            }
-        }
-        count
-    }
-}
-
-/// How a sweep applies the corrections of a family's constraints.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Order {
-    /// Gauss–Seidel: each colour starts from the positions the colours before it left.
-    GaussSeidel,
-    /// Jacobi: every constraint of a family is projected from the same positions, and then each
-    /// particle moves by `relaxation` × the mean of the corrections it got (ω/nᵢ Σ Δxᵢ).
-    Jacobi {
-        /// ω: 1 moves by the mean; larger values overrelax.
-        relaxation: f32,
-    },
-}
-
-/// What the Jacobi order needs: the corrections summed per particle, and per family the factor
-/// ω/nᵢ each particle's sum is applied with (nᵢ: the family's constraints on particle i).
-struct Jacobi {
-    relaxation: f32,
-    sums: Vec<Vec3A>,
-    factors: PerFamily<Vec<f32>>,
-}
-
-/// What a fast solver starts from: a simulation's state and constraints, in the scene's
-/// numbering ([`crate::simulation::Simulation::fast_start`]).
-#[derive(Clone, Copy)]
-pub struct Start<'a> {
-    /// The settings it runs with; the active families and the material are fixed for its life.
-    pub settings: &'a Settings,
-    /// Positions, velocities and inverse masses (0 where pinned or rigidly grabbed).
-    pub positions: &'a [DVec3],
-    /// See [`Start::positions`].
-    pub velocities: &'a [DVec3],
-    /// See [`Start::positions`].
-    pub inverse_masses: &'a [f64],
-    /// The rest positions, which the batches' weights and rest values come from.
-    pub rest_positions: &'a [DVec3],
-    /// External forces in N per particle; empty: none.
-    pub forces: &'a [DVec3],
-    /// The mesh's tets.
-    pub tets: &'a [[u32; 4]],
-    /// The table of families the constraints are of.
-    pub families: &'a Families,
-    /// The constraints of each family, as the binding makes them (with their rest values).
-    pub constraints: &'a PerFamily<ConstraintSet>,
-    /// Whether every particle keeps its z.
-    pub plane_strain: bool,
-}
-
 impl FastSimulation {
-    /// The fast solver for a simulation's state and constraints (`start`, in the scene's
-    /// numbering: [`crate::simulation::Simulation::fast_start`]), on `threads` threads (1 without
-    /// the `parallel` feature).
-    pub fn new(start: Start<'_>, threads: usize) -> FastSimulation {
-        let simulation = start;
-        let n = simulation.positions.len();
-        let original = morton::morton_order(simulation.positions);
+    /// The fast engine for a simulation's body and state (`start`, in the scene's numbering:
+    /// [`crate::simulation::Simulation::start`]), on `start.threads` threads (1 without the
+    /// `parallel` feature).
+    pub fn new(start: Start<'_>) -> FastSimulation {
+        let (body, state) = (start.body, start.state);
+        let n = state.positions.len();
+        let original = morton::morton_order(&state.positions);
         let mut renumber = vec![0u32; n];
         for (new, &old) in original.iter().enumerate() {
             renumber[old as usize] = new as u32;
@@ -325,92 +182,31 @@ impl FastSimulation {
         };
         let residuals: Vec<Vec3A> = original
             .iter()
-            .map(|&i| residual(simulation.positions[i as usize]))
+            .map(|&i| residual(state.positions[i as usize]))
             .collect();
         let inverse_masses: Vec<f32> = original
             .iter()
-            .map(|&i| simulation.inverse_masses[i as usize] as f32)
+            .map(|&i| state.inverse_masses[i as usize] as f32)
             .collect();
-        let rest_positions = take(simulation.rest_positions);
-        let forces = if simulation.forces.is_empty() {
+        let rest_positions = take(&body.rest_positions);
+        let forces = if body.forces.is_empty() {
             Vec::new()
         } else {
-            take(simulation.forces)
+            take(&body.forces)
         };
-        // Only the families in use are built: the settings do not change after this.
-        let active = simulation.settings.active;
-        let uses = |binding: &dyn Fn(Binding) -> bool| {
-            active
-                .families()
-                .any(|f| binding(simulation.families.binding(f)))
-        };
-        let mut layouts = Layouts::default();
-        if uses(&|b| b == Binding::Edges) {
-            // In the order of the edge binding ([`Binding::particles`]), whose rest values they
-            // are: the built-in edge family's, always built.
-            let (pairs, _) = simulation.constraints[Family::EDGES]
-                .all_particles()
-                .as_chunks::<2>();
-            let edges: Vec<[u32; 2]> = pairs
-                .iter()
-                .map(|edge| edge.map(|i| renumber[i as usize]))
-                .collect();
-            layouts.edges = Layout::new(&edges, &inverse_masses, &rest_positions);
-        }
-        let renumbered = |tets: &[[u32; 4]]| -> Vec<[u32; 4]> {
-            tets.iter()
-                .map(|tet| tet.map(|i| renumber[i as usize]))
-                .collect()
-        };
-        if uses(&|b| b == Binding::Tets) {
-            let tets = renumbered(simulation.tets);
-            layouts.tets = Layout::new(&tets, &inverse_masses, &rest_positions);
-        }
-        if uses(&|b| b == Binding::TetVertices) {
-            // Each (tet, vertex) constraint is an element of its own, its particles in the
-            // constraint's order ([`Binding::particles`]), coloured apart from its tet's others.
-            let mesh = crate::scene::mesh::TetMesh {
-                positions: Vec::new(),
-                tets: simulation.tets.to_vec(),
-            };
-            let flat = Binding::TetVertices.particles(&mesh);
-            let (constraints, _) = flat.as_chunks::<4>();
-            let constraints = renumbered(constraints);
-            // Role by role: every tet's first height, then every tet's second, …, so that a
-            // tet's four heights take colours far apart (see `batches`).
-            let n = constraints.len();
-            let visit: Vec<usize> = (0..4).flat_map(|k| (k..n).step_by(4)).collect();
-            layouts.tet_vertices =
-                Layout::new_visiting(&constraints, visit, &inverse_masses, &rest_positions);
-        }
-        // The surface's triangles and hinges, in the order of their binding, as the sets of the
-        // active families that bind to them hold them (whose rest values they are).
-        let of_binding = |binding: Binding| {
-            active
-                .families()
-                .find(|&f| simulation.families.binding(f) == binding)
-                .map(|f| simulation.constraints[f].all_particles())
-        };
-        if let Some(flat) = of_binding(Binding::Triangles) {
-            let (triangles, _) = flat.as_chunks::<3>();
-            let triangles: Vec<[u32; 3]> = triangles
-                .iter()
-                .map(|t| t.map(|i| renumber[i as usize]))
-                .collect();
-            layouts.triangles = Layout::new(&triangles, &inverse_masses, &rest_positions);
-        }
-        if let Some(flat) = of_binding(Binding::Hinges) {
-            let (hinges, _) = flat.as_chunks::<4>();
-            layouts.hinges = Layout::new(&renumbered(hinges), &inverse_masses, &rest_positions);
-        }
-        let sets = simulation.families.per_family(|family| {
+        // Only the families in use are built: a change of them builds the engine again.
+        let (families, resolved) = (start.families, start.resolved);
+        let active = resolved.active;
+        let masses = (&inverse_masses[..], &rest_positions[..]);
+        let layouts = Layouts::new(families, &active, body, &renumber, masses);
+        let sets = families.per_family(|family| {
             if !active[family] {
                 return Batches::default();
             }
-            let set = &simulation.constraints[family];
+            let set = &body.sets[family];
             let rest = set.rest();
             Batches::new(
-                layouts.of(simulation.families.binding(family)),
+                layouts.of(families.binding(family)),
                 |element| rest[element as usize] as f32,
                 set.stored_len(),
                 |element| {
@@ -421,33 +217,38 @@ impl FastSimulation {
                 },
             )
         });
-        debug_assert!(
-            layouts.edges.colouring_is_valid(n)
-                && layouts.tets.colouring_is_valid(n)
-                && layouts.tet_vertices.colouring_is_valid(n)
-        );
-        let positions = take(simulation.positions);
+        debug_assert!(layouts.all().iter().all(|l| l.colouring_is_valid(n)));
+        let positions = take(&state.positions);
         // Without the feature (the page), one thread.
         #[cfg(not(feature = "parallel"))]
-        let threads = threads.min(1);
-        let colour_orders = colour_orders(simulation.families, simulation.settings, &layouts);
+        let threads = start.threads.min(1);
+        #[cfg(feature = "parallel")]
+        let threads = start.threads;
+        let colour_orders = layouts.colour_orders(families, resolved);
         FastSimulation {
-            families: simulation.families.clone(),
+            families: families.clone(),
+            resolved: *resolved,
+            built_for: BuiltFor {
+                body: start.revision.body,
+                active,
+                material: resolved.settings.material,
+                threads: start.threads,
+            },
+            synced: start.revision.state,
             colour_orders,
             origin: DVec3::ZERO,
-            settings: *simulation.settings,
             previous: positions.clone(),
             positions,
             previous_residuals: residuals.clone(),
             residuals,
-            velocities: take(simulation.velocities),
+            velocities: take(&state.velocities),
             rest_positions,
             inverse_masses,
             original,
             renumber,
             layouts,
             sets,
-            tets: simulation.tets.len(),
+            tets: body.tets.len(),
             jacobi: None,
             team: (threads > 1).then(|| Team::new(threads)),
             timings: Timings::default(),
@@ -455,13 +256,35 @@ impl FastSimulation {
             frame: 0,
             corrections: Corrections::default(),
             forces,
-            plane_strain: simulation.plane_strain,
+            plane_strain: body.plane_strain,
         }
     }
 
-    /// The scene's number of each particle, in the fast engine's (Morton) order.
-    pub fn original(&self) -> &[u32] {
-        &self.original
+    /// Brings the engine up to `frame`: built again when the body or what it was built for
+    /// changed, the state taken up again when it was edited, and the settings of the frame in
+    /// force (a new order seed puts the colours in its order).
+    fn prepare(&mut self, frame: &Frame<'_>) {
+        let wanted = BuiltFor {
+            body: frame.revision.body,
+            active: frame.resolved.active,
+            material: frame.resolved.settings.material,
+            threads: frame.threads,
+        };
+        if wanted != self.built_for {
+            let jacobi = self.order();
+            *self = FastSimulation::new(frame.start());
+            self.set_order(jacobi);
+            return;
+        }
+        if frame.revision.state != self.synced {
+            let state = &*frame.state;
+            self.load(&state.positions, &state.velocities, &state.inverse_masses);
+            self.synced = frame.revision.state;
+        }
+        if frame.resolved.settings.order_seed != self.resolved.settings.order_seed {
+            self.colour_orders = self.layouts.colour_orders(&self.families, frame.resolved);
+        }
+        self.resolved = *frame.resolved;
     }
 
     /// Takes up a state given in the scene's numbering: positions, velocities and inverse
@@ -488,7 +311,7 @@ impl FastSimulation {
 
     /// Writes the state back in the scene's numbering: positions and velocities, and with
     /// `corrections`, Δp of the last substep and its sum over the frame (zero where the frame
-    /// did not keep them, [`FrameInputs`]). Allocates nothing.
+    /// did not keep them). Allocates nothing.
     ///
     /// # Panics
     /// If the slices are not one per particle.
@@ -513,45 +336,32 @@ impl FastSimulation {
         }
     }
 
-    /// Replaces the settings; the active families and the material must stay as they were (a
-    /// change of either needs a new [`FastSimulation`], whose constraints are built for them).
-    pub fn set_settings(&mut self, settings: Settings) {
-        debug_assert!(settings.active == self.settings.active);
-        if settings.order_seed != self.settings.order_seed {
-            self.colour_orders = colour_orders(&self.families, &settings, &self.layouts);
-        }
-        self.settings = settings;
+    /// Advances one frame on its own arrays, with no grab, no edit settling and no Δp kept: the
+    /// engine alone, as `tetlab bench` and the tests time and compare it.
+    pub fn step(&mut self) {
+        let mut plan = Plan::new(
+            &self.families,
+            &self.resolved,
+            self.plane_strain,
+            None,
+            false,
+        );
+        plan.keep_corrections = false;
+        self.run(&plan);
     }
 
-    /// The order `family`'s colours are projected in, in each segment of its layout: colour
-    /// numbers, below [`FamilyBatches::colour_count`].
-    pub fn colour_order(&self, family: Family) -> Vec<usize> {
-        let colours = self.batches(family).colour_count();
-        let order = &self.colour_orders[family];
-        (0..colours)
-            .map(|k| order.get(k).map_or(k, |&c| c as usize))
-            .collect()
-    }
-
-    /// The threads the projections run on.
-    pub fn threads(&self) -> usize {
-        self.team.as_ref().map_or(1, Team::threads)
-    }
-
-    /// The constraints of `family`, coloured and in batches (empty when it is not active).
-    pub fn batches(&self, family: Family) -> FamilyBatches<'_> {
-        FamilyBatches {
-            layout: self.layouts.of(self.families.binding(family)),
-            batches: &self.sets[family],
-        }
-    }
-
-    /// How far `threads` threads would keep to their own particles on `family`'s colours:
-    /// (lines from another thread, lines) over one sweep ([`Layout::lines_from_other_threads`]).
-    pub fn lines_from_other_threads(&self, family: Family, threads: usize) -> (usize, usize) {
-        self.layouts
-            .of(self.families.binding(family))
-            .lines_from_other_threads(&self.colour_orders[family], threads)
+    /// One frame of `plan` on its own arrays; large colours are shared with its team's threads,
+    /// which wait for the next colour spinning, not asleep, while a frame is under way.
+    fn run(&mut self, plan: &Plan) {
+        let team = self.team.take();
+        let mut on = substeps::OnArrays {
+            simulation: self,
+            team: team.as_ref(),
+            grab_lambda: 0.0,
+        };
+        substep::frame(&mut on, plan);
+        self.team = team;
+        self.frame += 1;
     }
 
     /// Projects in `order` from now on (Gauss–Seidel unless set).
@@ -585,65 +395,6 @@ impl FastSimulation {
                 relaxation: jacobi.relaxation,
             },
         }
-    }
-
-    /// Per active family, how far its constraints are from holding now: √(mean (C / rest)²) (a
-    /// rest value of zero counts as one).
-    pub fn relative_error(&self) -> PerFamily<Option<f64>> {
-        struct RelativeError<'a> {
-            batches: FamilyBatches<'a>,
-            positions: &'a [Vec3A],
-            rest_positions: &'a [Vec3A],
-        }
-        impl Visit for RelativeError<'_> {
-            type Output = f64;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> f64 {
-                let mut sum = 0.0;
-                for (particles, rest, stored) in self.batches.constraints_storing() {
-                    let at = |positions: &[Vec3A]| -> [Vec3A; N] {
-                        std::array::from_fn(|k| positions[particles[k] as usize])
-                    };
-                    let value = c
-                        .evaluate_stored(
-                            &at(self.positions),
-                            rest,
-                            &at(self.rest_positions),
-                            &stored,
-                        )
-                        .value;
-                    let scale = if rest == 0.0 { 1.0 } else { rest.abs() };
-                    sum += (f64::from(value) / f64::from(scale)).powi(2);
-                }
-                (sum / self.batches.len().max(1) as f64).sqrt()
-            }
-        }
-        let active = self.settings.active;
-        self.families.per_family(|family| {
-            active[family].then(|| {
-                self.families.visit(
-                    family,
-                    RelativeError {
-                        batches: self.batches(family),
-                        positions: &self.positions,
-                        rest_positions: &self.rest_positions,
-                    },
-                )
-            })
-        })
-    }
-
-    /// The settings in force.
-    pub fn settings(&self) -> &Settings {
-        &self.settings
-    }
-
-    /// Positions in the scene's particle numbering.
-    pub fn positions(&self) -> Vec<DVec3> {
-        let mut positions = self.in_scene_order(&self.positions);
-        for (new, &old) in self.original.iter().enumerate() {
-            positions[old as usize] += self.origin + self.residuals[new].as_dvec3();
-        }
-        positions
     }
 
     /// Moves the origin of the f32 coordinates to the body when the body has travelled from it
@@ -681,242 +432,6 @@ impl FastSimulation {
         self.origin += shift.as_dvec3();
     }
 
-    /// Where the ground (y = 0) is in the f32 coordinates.
-    fn ground(&self) -> Option<f64> {
-        self.settings.ground.then_some(-self.origin.y)
-    }
-
-    /// Velocities in the scene's particle numbering.
-    pub fn velocities(&self) -> Vec<DVec3> {
-        self.in_scene_order(&self.velocities)
-    }
-
-    fn in_scene_order(&self, values: &[Vec3A]) -> Vec<DVec3> {
-        let mut out = vec![DVec3::ZERO; values.len()];
-        for (v, &i) in values.iter().zip(&self.original) {
-            out[i as usize] = v.as_dvec3();
-        }
-        out
-    }
-
-    /// Ok while every f32 coordinate (measured from the engine's origin, which follows the
-    /// body) is finite and below [`POSITION_LIMIT`] in size, every position below
-    /// [`SOUND_LIMIT`], and every velocity component below that too; otherwise
-    /// the first that is not (particles in the scene's numbering).
-    pub fn check(&self) -> Result<(), Divergence> {
-        let f64s = |v: &Vec3A| v.as_dvec3().to_array();
-        let original = |i: usize| self.original[i] as usize;
-        Divergence::find(
-            self.frame,
-            (POSITION_LIMIT, SOUND_LIMIT),
-            self.positions.iter().map(f64s),
-            self.velocities.iter().map(f64s),
-            original,
-        )?;
-        let global = |v: &Vec3A| (self.origin + v.as_dvec3()).to_array();
-        Divergence::find(
-            self.frame,
-            (SOUND_LIMIT, SOUND_LIMIT),
-            self.positions.iter().map(global),
-            std::iter::empty(),
-            original,
-        )
-    }
-
-    /// Whether [`FastSimulation::check`] finds nothing.
-    pub fn is_sound(&self) -> bool {
-        self.check().is_ok()
-    }
-
-    /// Frames stepped.
-    pub fn frame(&self) -> u64 {
-        self.frame
-    }
-
-    /// The tets in the scene.
-    pub fn tet_count(&self) -> usize {
-        self.tets
-    }
-
-    /// Constraint projections one frame makes with the current settings.
-    pub fn projections_per_frame(&self) -> u64 {
-        self.settings
-            .projections_per_frame(self.families.per_family(|f| self.batches(f).len()))
-    }
-
-    /// The bytes of memory the solver's arrays take.
-    pub fn heap_bytes(&self) -> usize {
-        (self.positions.capacity()
-            + self.previous.capacity()
-            + self.residuals.capacity()
-            + self.previous_residuals.capacity()
-            + self.velocities.capacity()
-            + self.rest_positions.capacity())
-            * size_of::<Vec3A>()
-            + self.inverse_masses.capacity() * size_of::<f32>()
-            + (self.original.capacity() + self.renumber.capacity()) * size_of::<u32>()
-            + self.layouts.edges.heap_bytes()
-            + self.layouts.tets.heap_bytes()
-            + self.layouts.tet_vertices.heap_bytes()
-            + self
-                .sets
-                .every_place()
-                .map(Batches::heap_bytes)
-                .sum::<usize>()
-            + (self.corrections.predicted.capacity()
-                + self.corrections.last.capacity()
-                + self.corrections.frame.capacity())
-                * size_of::<Vec3A>()
-            + self.jacobi.as_ref().map_or(0, |j| {
-                j.sums.capacity() * size_of::<Vec3A>()
-                    + j.factors.every_place().map(Vec::capacity).sum::<usize>() * size_of::<f32>()
-            })
-    }
-
-    /// Time and projections per family since the last [`FastSimulation::reset_timings`].
-    pub fn timings(&self) -> Timings {
-        self.timings
-    }
-
-    /// The projections skipped for a counted reason (∇C undefined, or a step beyond
-    /// [`crate::simulation::projection::DEFAULT_REACH`]) since the last call, per family; the count starts again.
-    pub fn take_skipped(&mut self) -> PerFamily<SkipCounts> {
-        std::mem::take(&mut self.skipped)
-    }
-
-    /// Starts the timings afresh.
-    pub fn reset_timings(&mut self) {
-        self.timings = Timings::default();
-        share_timers::reset();
-    }
-
-    /// With the feature `share-timers`, the mean time of a colour large enough to share and of
-    /// each thread's share of one, since [`FastSimulation::reset_timings`] (process-wide: one
-    /// simulation at a time); `None` without it.
-    pub fn share_timings(&self) -> Option<String> {
-        share_timers::report()
-    }
-
-    /// Advances one frame: `substeps` substeps of predict, sweeps, velocities. With several
-    /// threads, large colours are shared with the simulation's [`Team`], whose threads wait for
-    /// the next colour spinning, not asleep, while a frame is under way.
-    pub fn step(&mut self) {
-        self.step_frame(&FrameInputs::default());
-    }
-
-    /// [`FastSimulation::step`], holding a grabbed particle, settling an edit or keeping Δp as
-    /// `inputs` ask. Allocates nothing once Δp has been kept once.
-    pub fn step_frame(&mut self, inputs: &FrameInputs) {
-        let team = self.team.take();
-        self.step_on(team.as_ref(), inputs);
-        self.team = team;
-        self.frame += 1;
-    }
-
-    /// One frame; large colours are shared with `team`'s threads, when there is one.
-    fn step_on(&mut self, team: Option<&Team>, inputs: &FrameInputs) {
-        self.recentre();
-        let settings = self.settings;
-        let h = settings.dt / settings.substeps.max(1) as f64;
-        let substeps = settings.substeps.max(1);
-        let ground = self.ground();
-        let grab = inputs.grab.map(|(particle, target, compliance)| {
-            (
-                self.renumber[particle] as usize,
-                (target - self.origin).as_vec3a(),
-                compliance,
-            )
-        });
-        let keep = inputs.settling || inputs.corrections;
-        if keep && self.corrections.predicted.len() != self.positions.len() {
-            let n = self.positions.len();
-            self.corrections = Corrections {
-                predicted: vec![Vec3A::ZERO; n],
-                last: vec![Vec3A::ZERO; n],
-                frame: vec![Vec3A::ZERO; n],
-            };
-        }
-        if keep {
-            self.corrections.frame.fill(Vec3A::ZERO);
-        }
-        let motion = integrate::Substep {
-            gravity: settings.gravity,
-            h,
-            ground,
-            plane_strain: self.plane_strain,
-        };
-        for substep in 0..substeps {
-            let (arrays, inverse_masses, forces) = self.particle_arrays();
-            schedule::by_particles(
-                team,
-                arrays,
-                |range, [positions, previous, velocities, now, before]| {
-                    let forces = forces.get(range.clone()).unwrap_or_default();
-                    integrate::predict(
-                        positions,
-                        previous,
-                        velocities,
-                        &inverse_masses[range],
-                        forces,
-                        motion,
-                        Some(integrate::Residuals {
-                            now,
-                            previous: before,
-                        }),
-                    );
-                },
-            );
-            if let Some((i, target, compliance)) = grab
-                && compliance <= 0.0
-            {
-                self.positions[i] = target;
-                self.residuals[i] = Vec3A::ZERO;
-            }
-            let track = inputs.settling || (inputs.corrections && substep + 1 == substeps);
-            if track {
-                self.corrections.predicted.copy_from_slice(&self.positions);
-            }
-            for family in settings.active.families() {
-                self.sets[family].reset_lambda();
-            }
-            let mut grab_lambda = 0.0;
-            for _ in 0..settings.iterations.max(1) {
-                self.sweep(h, team, grab, &mut grab_lambda);
-            }
-            if track {
-                let c = &mut self.corrections;
-                for (((last, sum), p), predicted) in c
-                    .last
-                    .iter_mut()
-                    .zip(&mut c.frame)
-                    .zip(&self.positions)
-                    .zip(&c.predicted)
-                {
-                    *last = *p - *predicted;
-                    *sum += *last;
-                }
-            }
-            schedule::by_particles(
-                team,
-                self.particle_arrays().0,
-                |_, [positions, previous, velocities, now, before]| {
-                    integrate::update_velocities(
-                        positions,
-                        previous,
-                        velocities,
-                        h,
-                        settings.damping,
-                        inputs.settling,
-                        Some(&integrate::Residuals {
-                            now,
-                            previous: before,
-                        }),
-                    );
-                },
-            );
-        }
-    }
-
     /// What the per-particle passes write (positions, their values at the start of the substep,
     /// velocities, residuals and theirs at the start of the substep) and read (inverse masses,
     /// forces).
@@ -947,184 +462,44 @@ impl FastSimulation {
             }
         }
     }
-
-    /// One sweep over the active families, then the grab (when it is compliant: a rigid one
-    /// holds its particle at the target with inverse mass 0), then the ground.
-    fn sweep(
-        &mut self,
-        h: f64,
-        team: Option<&Team>,
-        grab: Option<(usize, Vec3A, f64)>,
-        grab_lambda: &mut f32,
-    ) {
-        let active = self.settings.active;
-        for family in active.families() {
-            if self.families.projected_by_partner(family, &active) {
-                continue;
-            }
-            let rule = Rule::for_settings(&self.settings, family, h);
-            let started = Instant::now();
-            let sums = self.jacobi.as_mut().map(|j| &mut j.sums[..]);
-            if let Some(partner) = self.families.partner_in(family, &active) {
-                struct ProjectPair<'a> {
-                    layout: &'a Layout,
-                    order: &'a [u32],
-                    batches: (&'a mut Batches, &'a mut Batches),
-                    positions: (&'a mut [Vec3A], &'a mut [Vec3A]),
-                    rest_positions: &'a mut [Vec3A],
-                    sums: Option<&'a mut [Vec3A]>,
-                    rules: [Rule<f64>; 2],
-                    reach: f64,
-                    team: Option<&'a Team>,
-                }
-                impl VisitPair for ProjectPair<'_> {
-                    type Output = (usize, [SkipCounts; 2]);
-                    #[inline]
-                    fn visit_pair<
-                        const N: usize,
-                        A: Constraint<N>,
-                        const M: usize,
-                        B: Constraint<M>,
-                    >(
-                        self,
-                        first: &A,
-                        second: &B,
-                    ) -> (usize, [SkipCounts; 2]) {
-                        kernel::project_pair::<N, A, M, B>(
-                            (first, second),
-                            self.layout,
-                            self.order,
-                            self.batches,
-                            self.positions,
-                            self.rest_positions,
-                            self.sums,
-                            (self.rules, self.reach),
-                            self.team,
-                        )
-                    }
-                }
-                let rules = [rule, Rule::for_settings(&self.settings, partner, h)];
-                let (count, skipped) = self.families.visit_pair(
-                    family,
-                    partner,
-                    ProjectPair {
-                        layout: self.layouts.of(self.families.binding(family)),
-                        order: &self.colour_orders[family],
-                        batches: self.sets.pair_mut(family, partner),
-                        positions: (&mut self.positions, &mut self.residuals),
-                        rest_positions: &mut self.rest_positions,
-                        sums,
-                        rules,
-                        reach: self.settings.reach,
-                        team,
-                    },
-                );
-                self.apply_jacobi(family);
-                // One pair projection is a projection of each: each family gets half the time.
-                let half = started.elapsed() / 2;
-                for (f, skipped) in [family, partner].into_iter().zip(skipped) {
-                    self.timings.time[f] += half;
-                    self.timings.projections[f] += count as u64;
-                    self.skipped[f] = self.skipped[f] + skipped;
-                }
-                continue;
-            }
-            struct Project<'a> {
-                layout: &'a Layout,
-                order: &'a [u32],
-                batches: &'a mut Batches,
-                positions: (&'a mut [Vec3A], &'a mut [Vec3A]),
-                rest_positions: &'a mut [Vec3A],
-                sums: Option<&'a mut [Vec3A]>,
-                rule: Rule<f64>,
-                reach: f64,
-                team: Option<&'a Team>,
-            }
-            impl Visit for Project<'_> {
-                type Output = (usize, SkipCounts);
-                #[inline]
-                fn visit<const N: usize, C: Constraint<N>>(
-                    self,
-                    _: Family,
-                    c: &C,
-                ) -> (usize, SkipCounts) {
-                    kernel::project_family::<N, C>(
-                        c,
-                        self.layout,
-                        self.order,
-                        self.batches,
-                        self.positions,
-                        self.rest_positions,
-                        self.sums,
-                        (self.rule, self.reach),
-                        self.team,
-                    )
-                }
-            }
-            let (count, skipped) = self.families.visit(
-                family,
-                Project {
-                    layout: self.layouts.of(self.families.binding(family)),
-                    order: &self.colour_orders[family],
-                    batches: &mut self.sets[family],
-                    positions: (&mut self.positions, &mut self.residuals),
-                    rest_positions: &mut self.rest_positions,
-                    sums,
-                    rule,
-                    reach: self.settings.reach,
-                    team,
-                },
-            );
-            self.apply_jacobi(family);
-            self.timings.time[family] += started.elapsed();
-            self.timings.projections[family] += count as u64;
-            self.skipped[family] = self.skipped[family] + skipped;
-        }
-        if let Some((i, target, compliance)) = grab
-            && compliance > 0.0
-        {
-            let evaluation =
-                crate::constraints::distance::evaluate(&[self.positions[i], target], 0.0);
-            let rule = Rule::Xpbd {
-                alpha_tilde: (compliance / (h * h)) as f32,
-            };
-            let weights = [self.inverse_masses[i], 0.0];
-            let unbounded = f32::INFINITY;
-            let correction = crate::simulation::projection::correction;
-            if let Some(c) = correction(evaluation, weights, *grab_lambda, rule, unbounded) {
-                *grab_lambda += c.delta_lambda;
-                self.positions[i] += c.delta_x[0];
-            }
-        }
-        let (ground, plane_strain) = (self.ground(), self.plane_strain);
-        if ground.is_some() || plane_strain {
-            let (inverse_masses, previous) = (&self.inverse_masses[..], &self.previous[..]);
-            schedule::by_particles(team, [&mut self.positions], |range, [positions]| {
-                if let Some(ground) = ground {
-                    integrate::project_ground(positions, &inverse_masses[range.clone()], ground);
-                }
-                if plane_strain {
-                    integrate::hold_plane(positions, &previous[range]);
-                }
-            });
-        }
-    }
 }
 
-/// The order of each active family's colours that `settings` ask for ([`Settings::order_seed`]):
-/// empty (the layout's order) without a seed.
-fn colour_orders(
-    families: &Families,
-    settings: &Settings,
-    layouts: &Layouts,
-) -> PerFamily<Vec<u32>> {
-    families.per_family(|family| {
-        if !settings.active[family] {
-            return Vec::new();
-        }
-        let colours = layouts.of(families.binding(family)).colour_count();
-        settings
-            .projection_order(family, colours)
-            .unwrap_or_default()
-    })
+impl Engine for FastSimulation {
+    fn step(&mut self, frame: Frame<'_>) -> PerFamily<SkipCounts> {
+        self.prepare(&frame);
+        let grab = frame.state.grab.map(|g| (g.particle, g.target));
+        let plane_strain = frame.body.plane_strain;
+        let plan = Plan::new(
+            frame.families,
+            frame.resolved,
+            plane_strain,
+            grab,
+            frame.settling,
+        );
+        self.run(&plan);
+        let state = frame.state;
+        let corrections = (&mut state.corrections[..], &mut state.frame_corrections[..]);
+        self.store(
+            &mut state.positions,
+            &mut state.velocities,
+            Some(corrections),
+        );
+        self.take_skipped()
+    }
+
+    fn describe(&self) -> String {
+        crate::simulation::EngineChoice::Fast.describe(self.threads())
+    }
+
+    fn check(&self) -> Result<(), Divergence> {
+        FastSimulation::check(self)
+    }
+
+    fn heap_bytes(&self) -> usize {
+        FastSimulation::heap_bytes(self)
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
+    }
 }

@@ -180,7 +180,7 @@ where
 
 /// Bodies of fewer particles than this have their per-particle passes (the prediction, the
 /// velocities) run on one thread: below it, handing out the work costs more than it saves.
-pub const PARALLEL_PARTICLES: usize = 4096;
+pub(super) const PARALLEL_PARTICLES: usize = 4096;
 
 /// Runs `pass(particles, parts)` over `slices` (one entry per particle each), in contiguous parts
 /// of whole cache lines (four 16-byte particles), one per thread of `team` for a body of

@@ -31,10 +31,10 @@ use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 
 /// A job: what each worker runs, given its number (0 is the caller).
-pub type Job<'a> = &'a (dyn Fn(usize) + Sync);
+pub(super) type Job<'a> = &'a (dyn Fn(usize) + Sync);
 
 /// The most threads a team has.
-pub const MAX_THREADS: usize = 64;
+pub(super) const MAX_THREADS: usize = 64;
 
 /// How many times a waiting thread checks for the next job before it starts to yield (a few
 /// microseconds: a colour's hand-over; longer spins cost other processes' time on a busy machine).
@@ -70,7 +70,7 @@ struct Shared {
 }
 
 impl Team {
-    /// A team of `threads` in all (at most [`MAX_THREADS`]): the caller and `threads − 1`
+    /// A team of `threads` in all (at most `MAX_THREADS`): the caller and `threads − 1`
     /// workers started now (none for 1).
     pub fn new(threads: usize) -> Team {
         let threads = threads.clamp(1, MAX_THREADS);
@@ -107,7 +107,8 @@ impl Team {
 
     /// How many of its workers are asleep, waiting for a job: all of them soon after the last
     /// job (a paused simulation's threads use no CPU).
-    pub fn sleeping(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn sleeping(&self) -> usize {
         self.shared.sleepers.load(Ordering::SeqCst)
     }
 

@@ -48,7 +48,7 @@ impl Action {
         };
         let family_value = |what: &str, bounds: &Bounds<f64>| -> Result<(Family, f64), String> {
             let argument = need(what)?;
-            crate::simulation::family_value(families, argument, bounds)
+            crate::simulation::settings::family_value(families, argument, bounds)
                 .map_err(|e| format!("{e} in '{text}'"))
         };
         let setting = |what: &str, bounds: &Bounds<u32>| -> Result<u32, String> {

@@ -131,7 +131,7 @@ impl Lesson {
             settings.method = Method::parse(solver.get_ref()).map_err(at(solver.span()))?;
         }
         if let Some(engine) = &s.engine {
-            settings.engine = Engine::parse(engine.get_ref()).map_err(at(engine.span()))?;
+            settings.engine = EngineChoice::parse(engine.get_ref()).map_err(at(engine.span()))?;
         }
         // Each setting checked against its range; a failure names the file and line of the value.
         fn checked<T: limits::Number>(
@@ -172,7 +172,7 @@ impl Lesson {
                     format!("in [settings] material: {e}"),
                 )
             })?;
-            settings.set_material(material);
+            settings.material = material;
         }
         for (table, bounds, values, per_family) in [
             (
@@ -281,7 +281,7 @@ impl Lesson {
     }
 
     /// The lesson's scene at rest, as it was built when the lesson was read (so a page that
-    /// fetched the lesson's mesh builds it once, [`Lesson::parse_with`]).
+    /// fetched the lesson's mesh builds it once, `Lesson::parse_with`).
     pub fn scene(&self) -> Scene {
         self.built.clone()
     }

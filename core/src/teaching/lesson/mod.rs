@@ -42,7 +42,7 @@ use crate::input::limits::{self, Bounds};
 use crate::measures::metrics::Metrics;
 use crate::scene::{Perturbation, Scene, SceneError, reflect_through_opposite_face};
 use crate::simulation::divergence::Divergence;
-use crate::simulation::{Engine, Method, Settings, Simulation};
+use crate::simulation::{EngineChoice, Method, Settings, Simulation};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::ops::ControlFlow;

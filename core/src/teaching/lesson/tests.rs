@@ -232,7 +232,7 @@ fn the_comparison_gets_the_same_edits_and_keeps_its_families() {
     assert_eq!(comparison.positions(), run.simulation.positions());
     // Every family of the table: a simulation keeps its active families to its table's.
     let every = comparison.families().per_family(|_| true);
-    assert_eq!(comparison.settings().active, every);
+    assert_eq!(*comparison.active(), every);
     assert_eq!(comparison.settings().substeps, 3);
     run.apply(Action::Compare(None));
     assert!(run.comparison.is_none());

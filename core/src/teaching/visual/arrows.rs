@@ -153,7 +153,7 @@ pub struct Arrow {
 }
 
 /// The longest gradient arrow of a family on a tet at gain 1, as a fraction of the tet's mean edge
-/// length ([`tet_size`]).
+/// length (`tet_size`).
 pub const GRADIENT_ARROW_LENGTH: f64 = 0.4;
 
 /// The gradient arrows of `family` on tet `tet`: ∇ₚC at each particle p of each of the family's
@@ -162,7 +162,7 @@ pub const GRADIENT_ARROW_LENGTH: f64 = 0.4;
 /// it differs ([`Quantity::Disagreeing`]). Degenerate constraints have no arrows. Gradients of different families have
 /// different units (1, 1 and m²), so each family is scaled on its own: its longest arrow on the tet
 /// is drawn `gain` × [`GRADIENT_ARROW_LENGTH`] × the tet's size long. Appends to `out`.
-pub fn tet_gradient_arrows(
+pub(crate) fn tet_gradient_arrows(
     simulation: &Simulation,
     tet: usize,
     family: Family,
@@ -261,7 +261,7 @@ fn correction_arrow(positions: &[DVec3], particle: u32, delta: DVec3, gain: f64)
 /// The correction arrows of `particles`: Δp of the last substep at each, drawn `gain` times its
 /// true length (Δp is a displacement, in the scene's units). Zero corrections have no arrow.
 /// Appends to `out`.
-pub fn correction_arrows(
+pub(crate) fn correction_arrows(
     simulation: &Simulation,
     particles: impl IntoIterator<Item = u32>,
     gain: f64,
@@ -326,9 +326,9 @@ pub enum ArrowSelection {
 }
 
 /// The arrows of `selection`, as the workbench draws them and the recorder logs them: the
-/// gradient arrows of every active family ([`tet_gradient_arrows`], scaled by
+/// gradient arrows of every active family (`tet_gradient_arrows`, scaled by
 /// `gradient_gain`; none when it is `None`), then Δp of the last substep at the particles
-/// ([`correction_arrows`], `correction_gain` times its length; none when it is `None`).
+/// (`correction_arrows`, `correction_gain` times its length; none when it is `None`).
 /// Appends to `out`.
 pub fn selected_arrows(
     simulation: &Simulation,
@@ -343,7 +343,7 @@ pub fn selected_arrows(
         ArrowSelection::AllTets => 0..simulation.tets().len(),
     };
     if let Some(gain) = gradient_gain {
-        let active = simulation.settings().active;
+        let active = *simulation.active();
         for family in active.families() {
             for tet in tets.clone() {
                 tet_gradient_arrows(simulation, tet, family, gain, out);

@@ -1,14 +1,13 @@
 //! What to draw, derived from a simulation once for every front end: the recorder logs it and
 //! the GUI paints it, so both show the same arrows in the same colours: the surface
-//! ([`surface`]), the arrows ([`arrows`]), and here the colours and the length scales they share.
+//! (`surface`), the arrows (`arrows`), and here the colours and the length scales they share.
 
 mod arrows;
 mod surface;
 
 pub use arrows::{
     Arrow, ArrowSelection, CORRECTION, DISAGREEMENT, GRADIENT_ARROW_LENGTH, MODE, Quantity,
-    along_mode, correction_arrows, mode_arrows, projection_arrows, selected_arrows,
-    tet_gradient_arrows,
+    along_mode, mode_arrows, projection_arrows, selected_arrows,
 };
 pub use surface::{
     ALL_FACES_UP_TO, display_edges, display_faces, edge_strips, faces_with_tets, inverted_tets,
@@ -59,7 +58,7 @@ pub fn body_size(positions: &[DVec3]) -> f64 {
 }
 
 /// The mean edge length of tet `tet`: the natural length scale for drawing on it.
-pub fn tet_size(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
+pub(crate) fn tet_size(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
     TET_EDGES
         .iter()
         .map(|&(a, b)| positions[tet[a] as usize].distance(positions[tet[b] as usize]))
@@ -72,6 +71,7 @@ mod tests {
     use super::*;
     use crate::scene::{Builtin, Perturbation, Scene};
     use crate::simulation::Settings;
+    use arrows::{correction_arrows, tet_gradient_arrows};
 
     #[test]
     fn an_inverted_tet_is_red_and_its_volume_arrows_point_back_through_the_face() {

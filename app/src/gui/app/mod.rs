@@ -1,5 +1,8 @@
-//! The workbench application: the panels drawn, the requests they add carried out in one loop,
-//! and the 3D view, on one [`super::workbench::Workbench`] or two side by side.
+//! The workbench application: what it holds (one [`super::workbench::Workbench`] or two side by
+//! side, the panels, the lesson, the link) and what each request the panels add does. One frame
+//! drawn is `frame.rs`.
+
+mod frame;
 
 #[cfg(not(target_arch = "wasm32"))]
 use super::browser;
@@ -18,16 +21,14 @@ use super::panels::modes::ModesPanel;
 use super::panels::readouts::Readouts;
 use super::panels::solver::SolverPanel;
 use super::panels::tools::Tools;
-use super::panels::{Context, Panel};
 use super::platform::{Desktop, Platform};
 use super::preferences::Preferences;
 use super::request::Request;
 use super::request::{LessonRequest, SceneRequest};
-use super::shortcuts::{Action, SHORTCUTS};
+use super::shortcuts::Action;
 use super::viewport::Viewport;
 use super::workbench::Workbench;
 use super::{files, render};
-use eframe::egui;
 use std::time::Duration;
 use tetlab_core::constraints::PerFamily;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
@@ -221,7 +222,7 @@ impl TetlabApp {
     }
 
     /// Replaces the scene; keeps settings and view (but particle handles and arrows, which
-    /// [`ViewOptions::fit_size`] sets for the scene's size); ends a comparison.
+    /// [`super::geometry::ViewOptions::fit_size`] sets for the scene's size); ends a comparison.
     pub fn load(&mut self, scene: Scene) {
         self.bench.load(scene);
         self.cache = SceneCache::new(&self.bench.scene.mesh);
@@ -295,7 +296,7 @@ impl TetlabApp {
     pub fn set_settings(&mut self, settings: Settings) {
         self.bench.set_settings(settings);
         if let Some(comparison) = &mut self.comparison {
-            let active = comparison.bench.simulation.settings().active;
+            let active = *comparison.bench.simulation.active();
             comparison
                 .bench
                 .set_settings(Settings { active, ..settings });
@@ -422,7 +423,7 @@ impl TetlabApp {
     }
 
     /// The whole link to the state shown: the page's address (in a browser, this page's;
-    /// on the desktop, [`link::page_url`]) and the fragment.
+    /// on the desktop, [`super::link::page_url`]) and the fragment.
     pub fn link_url(&self) -> String {
         let page = self.platform.page_address();
         format!("{page}#{}", self.link().fragment())
@@ -564,137 +565,6 @@ impl TetlabApp {
             }
         }
     }
-
-    fn handle_input(&mut self, ctx: &egui::Context) {
-        if !ctx.egui_wants_keyboard_input() {
-            let pressed: Vec<Action> = ctx.input(|i| {
-                SHORTCUTS
-                    .iter()
-                    .filter(|(key, _, _)| i.key_pressed(*key))
-                    .map(|(_, action, _)| *action)
-                    .collect()
-            });
-            for action in pressed {
-                self.act(action);
-            }
-        }
-        let dropped = ctx.input(|i| i.raw.dropped_files.clone());
-        for file in dropped {
-            #[cfg(not(target_arch = "wasm32"))]
-            self.opened(files::open_dropped(file.as_ref()));
-            #[cfg(target_arch = "wasm32")]
-            files::open_dropped(file, &self.inbox);
-        }
-        #[cfg(target_arch = "wasm32")]
-        for opened in self.inbox.take() {
-            self.opened(opened);
-        }
-    }
-
-    /// The "Open mesh file…" window, when open; opens what is chosen in it.
-    #[cfg(not(target_arch = "wasm32"))]
-    fn show_browser(&mut self, ctx: &egui::Context) {
-        let Some(browser) = &mut self.browser else {
-            return;
-        };
-        let mut open = true;
-        let chosen = browser.show(ctx, &mut open);
-        if !open {
-            self.browser = None;
-        }
-        if let Some(path) = chosen {
-            self.controls.scene.path = path.display().to_string();
-            self.opened(files::open_path(&path.to_string_lossy()));
-        }
-    }
-
-    /// Plays a frame of each simulation while playing, and counts down a lesson step's frames.
-    fn advance(&mut self, ctx: &egui::Context) {
-        if !self.bench.playing {
-            return;
-        }
-        let started = Instant::now();
-        self.bench.step_frame();
-        self.step_time = started.elapsed();
-        if let Some(comparison) = &mut self.comparison
-            && comparison.bench.playing
-        {
-            comparison.bench.step_frame();
-        }
-        if let Some(state) = &mut self.lesson
-            && state.frames_left > 0
-        {
-            state.frames_left -= 1;
-            if state.frames_left == 0 {
-                self.set_playing(false);
-            }
-        }
-        ctx.request_repaint();
-    }
-
-    /// A simulation that diverged (and went back to rest) is reported where errors are.
-    fn show_divergence(&mut self) {
-        let twin = self.comparison.as_mut().map(|c| &mut c.bench);
-        for (bench, which) in [(Some(&mut self.bench), ""), (twin, "right: ")] {
-            if let Some(divergence) = bench.and_then(|b| b.diverged.take()) {
-                self.error = Some(format!("{which}{divergence}; back to the rest shape"));
-            }
-        }
-    }
-
-    /// The 3D view, or two side by side when comparing, each titled with its families.
-    fn views(&mut self, ui: &mut egui::Ui) {
-        let view = self.display.options;
-        let Some(comparison) = &mut self.comparison else {
-            self.viewport.show(ui, &mut self.bench, &self.cache, &view);
-            return;
-        };
-        let size = if self.classroom { 20.0 } else { 14.0 };
-        ui.columns(2, |columns| {
-            let [left, right] = columns else {
-                unreachable!("two columns")
-            };
-            for (ui, bench, viewport) in [
-                (left, &mut self.bench, &mut self.viewport),
-                (right, &mut comparison.bench, &mut comparison.viewport),
-            ] {
-                let families =
-                    (bench.simulation.families()).describe(&bench.simulation.settings().active);
-                ui.add(
-                    egui::Label::new(egui::RichText::new(families).size(size).strong()).truncate(),
-                );
-                viewport.show(ui, bench, &self.cache, &view);
-            }
-        });
-    }
-}
-
-/// The top of the left panel: the name, the buttons that open what is not a side panel, and the
-/// last error.
-fn header(
-    ui: &mut egui::Ui,
-    error: Option<&str>,
-    notice: Option<&str>,
-    requests: &mut Vec<Request>,
-) {
-    ui.horizontal(|ui| {
-        ui.heading("tetlab");
-        for (label, action) in [
-            ("Help (H)", Action::Help),
-            ("Lessons (L)", Action::Lesson),
-            ("Classroom (F5)", Action::Classroom),
-        ] {
-            if ui.button(label).clicked() {
-                requests.push(Request::Act(action));
-            }
-        }
-    });
-    if let Some(error) = error {
-        ui.colored_label(egui::Color32::from_rgb(220, 60, 60), error);
-    }
-    if let Some(notice) = notice {
-        ui.small(notice);
-    }
 }
 
 /// Does a simulation action on one workbench.
@@ -715,266 +585,5 @@ fn act_on(bench: &mut Workbench, action: Action) {
     }
 }
 
-impl eframe::App for TetlabApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        let ctx = ui.ctx().clone();
-        let now = Instant::now();
-        if let Some(last) = self.last_frame {
-            // A running mean over about ten frames, so that the number can be read.
-            let elapsed = now - last;
-            self.frame_time = (self.frame_time * 9 + elapsed) / 10;
-        }
-        self.last_frame = Some(now);
-        self.handle_input(&ctx);
-        let zoom = if self.classroom { CLASSROOM_ZOOM } else { 1.0 };
-        if ctx.zoom_factor() != zoom {
-            ctx.set_zoom_factor(zoom);
-        }
-        self.advance(&ctx);
-        self.show_divergence();
-        let mut requests = Vec::new();
-        let context = Context {
-            bench: &self.bench,
-            comparison: self.comparison.as_ref().map(|c| &c.bench),
-            lesson: self.lesson.as_ref(),
-            step_time: self.frozen_timings.map_or(self.step_time, |t| t.0),
-            frame_time: self.frozen_timings.map_or(self.frame_time, |t| t.1),
-            classroom: self.classroom,
-        };
-        if self.classroom {
-            egui::Panel::right("classroom lesson")
-                .default_size(ui.available_width() * 0.36)
-                .show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| {
-                        self.lesson_panel.ui(ui, &context, &mut requests);
-                        ui.add_space(12.0);
-                        ui.label(
-                            "Left/Right: steps   Enter: do it   Space: play   F5: leave classroom",
-                        );
-                    });
-                });
-        } else {
-            egui::Panel::left("controls")
-                .default_size(300.0)
-                .show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| {
-                        header(
-                            ui,
-                            self.error.as_deref(),
-                            self.notice.as_deref(),
-                            &mut requests,
-                        );
-                        let panels: [&mut dyn Panel; 4] = [
-                            &mut self.controls,
-                            &mut self.solver,
-                            &mut self.tools,
-                            &mut self.compare,
-                        ];
-                        for (k, panel) in panels.into_iter().enumerate() {
-                            if k > 0 {
-                                ui.separator();
-                            }
-                            panel.ui(ui, &context, &mut requests);
-                        }
-                    });
-                });
-            egui::Panel::right("readouts")
-                .default_size(300.0)
-                .show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| {
-                        self.readouts.ui(ui, &context, &mut requests);
-                        ui.separator();
-                        self.display.ui(ui, &context, &mut requests);
-                    });
-                });
-            self.editor.ui(ui, &context, &mut requests);
-            if self.show_lesson {
-                egui::Panel::bottom("lesson")
-                    .resizable(true)
-                    .default_size(250.0)
-                    .min_size(120.0)
-                    .show(ui, |ui| {
-                        egui::ScrollArea::vertical()
-                            .auto_shrink([false, false])
-                            .show(ui, |ui| {
-                                ui.horizontal(|ui| {
-                                    ui.heading("Lesson");
-                                    if ui.button("Close (L)").clicked() {
-                                        requests.push(Request::Act(Action::Lesson));
-                                    }
-                                });
-                                self.lesson_panel.ui(ui, &context, &mut requests);
-                            });
-                    });
-            }
-            self.inspector.ui(ui, &context, &mut requests);
-            self.modes.ui(ui, &context, &mut requests);
-        }
-        self.help.ui(ui, &context, &mut requests);
-        egui::CentralPanel::default_margins().show(ui, |ui| self.views(ui));
-        #[cfg(not(target_arch = "wasm32"))]
-        self.show_browser(&ctx);
-        for request in requests {
-            self.apply(request);
-        }
-        if let Some(url) = self.link_to_copy.take() {
-            ctx.copy_text(url);
-        }
-        self.frames_drawn += 1;
-        // The first frame is painted before the second runs: ask for a second, and announce then.
-        #[cfg(target_arch = "wasm32")]
-        if self.frames_drawn == 1 {
-            ctx.request_repaint();
-        }
-        // What a browser test reads (window.tetlab_state()).
-        if self.platform.publishes() {
-            self.platform.publish(&self.report());
-        }
-        if self.frames_drawn == 2 {
-            self.platform.log(&format!(
-                "tetlab ready: {} with {} tets drawn; SIMD lanes in {}",
-                self.bench.scene.name,
-                self.bench.simulation.tets().len(),
-                tetlab_core::numbers::lanes::REGISTERS
-            ));
-        }
-    }
-
-    fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        self.preferences().save(storage);
-    }
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use tetlab_core::constraints::Family;
-    use tetlab_core::simulation::Method;
-
-    /// What `save` writes, `new` reads back: the preferences as JSON text.
-    #[test]
-    fn preferences_survive_a_save_and_load() {
-        let mut preferences = Preferences::default();
-        preferences.scene.builtin = "ball".into();
-        preferences.scene.resolution = 2;
-        preferences.settings.method = Method::Pbd;
-        preferences.settings.active[Family::HEIGHT] = true;
-        preferences.settings.substeps = 7;
-        preferences.view.see_through = true;
-        let text = serde_json::to_string(&preferences).unwrap();
-        let restored: Preferences = serde_json::from_str(&text).unwrap();
-        assert_eq!(restored, preferences);
-        let app = TetlabApp::with_preferences(restored);
-        assert_eq!(app.bench.scene.name, "ball");
-        assert_eq!(*app.bench.simulation.settings(), preferences.settings);
-    }
-
-    #[test]
-    fn missing_or_old_preferences_fall_back_to_defaults() {
-        let restored: Preferences =
-            serde_json::from_str(r#"{"scene": {"builtin": "tet"}}"#).unwrap();
-        assert_eq!(restored.scene.builtin, "tet");
-        assert_eq!(restored.settings, Preferences::default().settings);
-        assert!(restored.settings.settle_edits);
-    }
-
-    /// A link made on one workbench shows the same state on another: the scene, the settings,
-    /// the edits (the same positions, bit for bit), the camera; and a lesson at its step.
-    #[test]
-    fn a_link_shows_the_same_state_on_another_workbench() {
-        let mut teacher = TetlabApp::with_preferences(Preferences::default());
-        teacher.request(SceneRequest::Builtin(Builtin::Cube, 2));
-        let mut settings = *teacher.bench.simulation.settings();
-        settings.active[Family::HEIGHT] = true;
-        settings.substeps = 12;
-        teacher.set_settings(settings);
-        teacher.act(Action::Mirror);
-        teacher.bench.select_tet(5);
-        teacher.act(Action::InvertSelected);
-        teacher.viewport.camera.yaw = 2.0;
-        let url = teacher.link_url();
-        let (_, fragment) = url.split_once('#').unwrap();
-
-        let mut student = TetlabApp::with_preferences(Preferences::default());
-        student.open_fragment(fragment);
-        assert_eq!(student.error, None);
-        assert_eq!(student.bench.scene.name, "cube");
-        assert_eq!(student.bench.simulation.tets().len(), 48);
-        assert_eq!(
-            student.bench.simulation.settings(),
-            teacher.bench.simulation.settings()
-        );
-        assert_eq!(
-            student.bench.simulation.positions(),
-            teacher.bench.simulation.positions()
-        );
-        assert_eq!(student.viewport.camera, teacher.viewport.camera);
-        assert_eq!(student.link(), teacher.link());
-
-        teacher.lesson_request(LessonRequest::Builtin(2));
-        teacher.lesson_request(LessonRequest::Next);
-        let mut student = TetlabApp::with_preferences(Preferences::default());
-        student.open_fragment(&teacher.link().fragment());
-        let state = student.lesson.as_ref().expect("the lesson is open");
-        assert_eq!(state.step, 1);
-        assert_eq!(
-            state.lesson.title,
-            teacher.lesson.as_ref().unwrap().lesson.title
-        );
-    }
-
-    /// The report a browser test reads: the scene, the inversions, the lesson step and its
-    /// checks, the error.
-    #[test]
-    fn the_report_says_what_the_workbench_shows() {
-        let mut app = TetlabApp::with_preferences(Preferences::default());
-        app.lesson_request(LessonRequest::Builtin(3));
-        app.lesson_request(LessonRequest::Next);
-        let report = app.report();
-        assert_eq!((report.scene.as_str(), report.tets), ("tet", 1));
-        let lesson = report.lesson.expect("the lesson");
-        assert_eq!((lesson.step, lesson.steps), (2, 4));
-        assert_eq!(lesson.checks.len(), 1);
-        assert_eq!(lesson.checks[0].expect, "inverted_tets == 1");
-        assert!(!lesson.checks[0].holds);
-        app.do_step();
-        let report = app.report();
-        assert_eq!(report.inverted_tets, 1);
-        assert!(report.lesson.unwrap().checks[0].holds);
-        assert_eq!(report.frame, app.bench.simulation.frame());
-    }
-
-    /// A fragment that cannot be read leaves the defaults and says which key was wrong.
-    #[test]
-    fn a_malformed_link_falls_back_to_the_defaults_with_a_message() {
-        let mut app = TetlabApp::with_preferences(Preferences::default());
-        let before = *app.bench.simulation.settings();
-        app.open_fragment("#scene=cube&substeps=lots");
-        let error = app.error.as_deref().unwrap();
-        assert!(error.contains("'substeps'"), "{error}");
-        assert!(error.contains("defaults"), "{error}");
-        assert_eq!(*app.bench.simulation.settings(), before);
-
-        let mut app = TetlabApp::with_preferences(Preferences::default());
-        app.open_fragment("#scene=tet&edits=tet:9:0");
-        let error = app.error.as_deref().unwrap();
-        assert!(
-            error.contains("tet 9 is not in a body of 1 tets"),
-            "{error}"
-        );
-    }
-
-    #[test]
-    fn remembered_settings_out_of_range_are_refused_with_a_message() {
-        let mut preferences = Preferences::default();
-        preferences.settings.dt = 0.0;
-        preferences.settings.compliance[Family::VOLUME] = f64::INFINITY;
-        let app = TetlabApp::with_preferences(preferences);
-        assert_eq!(
-            *app.bench.simulation.settings(),
-            Preferences::default().settings
-        );
-        let error = app.error.expect("the refusal is shown");
-        assert!(error.contains("dt 0 is out of range"), "{error}");
-    }
-}
+mod tests;

@@ -1,7 +1,8 @@
-//! The table of families that a simulation, the checker, a lesson and the workbench each own: the
-//! built-in families ([`TABLE`]) and the constraint files loaded into it, as a value. Cloning it
-//! is cheap (the files are shared behind an [`Arc`]); defining a family makes a new table and
-//! leaves the old one to whoever still holds it, so nothing is leaked and nothing is global.
+//! The table of families that a simulation, the checker, a lesson and the workbench each own
+//! ([`Families`]): the built-in families ([`TABLE`]) and the constraint files loaded into it, as
+//! a value. Cloning it is cheap (the files are shared behind an [`Arc`]); defining a family makes a
+//! new table and leaves the old one to whoever still holds it, so nothing is leaked and nothing is
+//! global.
 //!
 //! A file's family takes the next place after the built-in ones ([`Family`] is a place in a
 //! table); loading a file of the same name again ([`Families::define`]: the workbench's editor, a
@@ -9,16 +10,11 @@
 //! ([`crate::simulation::Simulation::set_families`]) rebuilds the constraints of the families
 //! whose definition changed ([`Families::same_definition`]).
 
+use super::any::{AnyConstraint, Typed};
 use super::file::FileConstraint;
-use super::neohookean::{Deviatoric, Hydrostatic};
-use super::table::{Formula, Kind};
-use super::{
-    Binding, Constraint, Evaluation, Family, MAX_FAMILIES, PerFamily, Row, TABLE, Visit, VisitPair,
-    distance::Distance, height::Height, volume::Volume,
-};
+use super::row::Formula;
+use super::{Binding, Family, MAX_FAMILIES, PerFamily, Row, TABLE, builtin};
 use crate::constraint_file::ConstraintFile;
-use crate::constraints::material::Material;
-use glam::DVec3;
 use std::borrow::Cow;
 use std::sync::Arc;
 
@@ -58,11 +54,39 @@ pub struct Families {
     files: Arc<Vec<FileFamily>>,
 }
 
-/// A file's family: its row and its compiled file.
+/// A file's family: its row, its compiled file, and the file as a constraint of its arity.
 #[derive(Clone)]
 struct FileFamily {
     row: Row,
     file: Arc<ConstraintFile>,
+    code: Arc<FileCode>,
+}
+
+/// A constraint file as the [`super::Constraint`] type of its arity.
+pub(super) enum FileCode {
+    /// On two particles (edges, hinges' ends).
+    Two(Typed<2, FileConstraint<2>>),
+    /// On three (surface triangles).
+    Three(Typed<3, FileConstraint<3>>),
+    /// On four (tets, heights, hinges).
+    Four(Typed<4, FileConstraint<4>>),
+}
+
+impl FileFamily {
+    fn new(file: ConstraintFile, slot: usize) -> FileFamily {
+        let row = row_of(&file, slot);
+        let file = Arc::new(file);
+        let code = match row.arity {
+            2 => FileCode::Two(Typed(FileConstraint(file.clone()))),
+            3 => FileCode::Three(Typed(FileConstraint(file.clone()))),
+            _ => FileCode::Four(Typed(FileConstraint(file.clone()))),
+        };
+        FileFamily {
+            row,
+            file,
+            code: Arc::new(code),
+        }
+    }
 }
 
 impl std::fmt::Debug for Families {
@@ -95,7 +119,10 @@ fn row_of(file: &ConstraintFile, slot: usize) -> Row {
         group: Cow::Owned(file.group.clone().unwrap_or_else(|| file.name.clone())),
         compliance_from_material: file.stiffness.map(|s| s.compliance()),
         projected_with: None,
-        kind: Kind::File,
+        reads_rest_shape: file.reads_rest_shape(),
+        // μ and λ may appear in what an element stores and in its rest value.
+        rest_uses_material: true,
+        stored_len: file.stored_len(),
     }
 }
 
@@ -273,11 +300,7 @@ impl Families {
                     known.path.display()
                 ));
             }
-            let row = row_of(&file, slot);
-            Arc::make_mut(&mut self.files)[slot] = FileFamily {
-                row,
-                file: Arc::new(file),
-            };
+            Arc::make_mut(&mut self.files)[slot] = FileFamily::new(file, slot);
             return Ok(family);
         }
         let slot = self.files.len();
@@ -286,11 +309,7 @@ impl Families {
                 "at most {MAX_FILE_FAMILIES} constraint files can be loaded at once"
             ));
         }
-        let row = row_of(&file, slot);
-        Arc::make_mut(&mut self.files).push(FileFamily {
-            row,
-            file: Arc::new(file),
-        });
+        Arc::make_mut(&mut self.files).push(FileFamily::new(file, slot));
         Ok(Family::from_index(TABLE.len() + slot))
     }
 
@@ -456,221 +475,43 @@ impl Families {
         )
     }
 
-    /// Calls `visitor` with `family`'s [`Constraint`] type.
-    #[inline]
-    pub fn visit<T: Visit>(&self, family: Family, visitor: T) -> T::Output {
-        match self.row(family).kind {
-            Kind::Distance => visitor.visit(family, &Distance),
-            Kind::Height => visitor.visit(family, &Height),
-            Kind::Volume => visitor.visit(family, &Volume),
-            Kind::Deviatoric => visitor.visit(family, &Deviatoric),
-            Kind::Hydrostatic => visitor.visit(family, &Hydrostatic),
-            Kind::File => {
-                let file = self.file(family).expect("a family of kind File has a file");
-                match file.arity() {
-                    2 => visitor.visit(family, &FileConstraint::<2>(file)),
-                    3 => visitor.visit(family, &FileConstraint::<3>(file)),
-                    _ => visitor.visit(family, &FileConstraint::<4>(file)),
-                }
-            }
+    /// `family`'s constraint in f64, for tools and readers ([`AnyConstraint`]): C and ∇C at
+    /// given points, its rest value, what it stores, what else the inspector shows.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use tetlab_core::constraints::{Families, Family};
+    /// let families = Families::builtin();
+    /// let tet = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+    /// let volume = families.constraint(Family::VOLUME);
+    /// // The rest value of a volume is the rest tet's volume, 1/6; C there is zero.
+    /// let v = volume.rest_value(&tet, &Default::default());
+    /// assert!((v - 1.0 / 6.0).abs() < 1e-15);
+    /// assert_eq!(volume.evaluate(&tet, v, &tet).value, 0.0);
+    /// ```
+    pub fn constraint(&self, family: Family) -> &dyn AnyConstraint {
+        if family.index() < TABLE.len() {
+            return builtin::constraint(family);
+        }
+        match self.file_code(family) {
+            FileCode::Two(c) => c,
+            FileCode::Three(c) => c,
+            FileCode::Four(c) => c,
         }
     }
 
-    /// Calls `visitor` with `first`'s [`Constraint`] type and `second`'s (two nested
-    /// [`Families::visit`]s).
-    #[inline]
-    pub fn visit_pair<W: VisitPair>(&self, first: Family, second: Family, visitor: W) -> W::Output {
-        struct Outer<'t, W> {
-            families: &'t Families,
-            second: Family,
-            visitor: W,
-        }
-        struct Inner<'c, W, A, const N: usize> {
-            visitor: W,
-            first: &'c A,
-        }
-        impl<W: VisitPair, const N: usize, A: Constraint<N>> Visit for Inner<'_, W, A, N> {
-            type Output = W::Output;
-            #[inline]
-            fn visit<const M: usize, B: Constraint<M>>(self, _: Family, second: &B) -> W::Output {
-                // Only two types that can be a pair get pair code: the branch not taken is not
-                // compiled, since its condition is a constant of the two types.
-                if IsPair::<N, A, M, B>::VALUE {
-                    self.visitor.visit_pair::<N, A, M, B>(self.first, second)
-                } else {
-                    unreachable!("visit_pair of two families that are not a pair")
-                }
-            }
-        }
-        struct IsPair<const N: usize, A, const M: usize, B>(std::marker::PhantomData<(A, B)>);
-        impl<const N: usize, A: Constraint<N>, const M: usize, B: Constraint<M>> IsPair<N, A, M, B> {
-            const VALUE: bool = super::pairs::<N, A, M, B>();
-        }
-        impl<W: VisitPair> Visit for Outer<'_, W> {
-            type Output = W::Output;
-            #[inline]
-            fn visit<const N: usize, A: Constraint<N>>(self, _: Family, first: &A) -> W::Output {
-                self.families.visit(
-                    self.second,
-                    Inner::<W, A, N> {
-                        visitor: self.visitor,
-                        first,
-                    },
-                )
-            }
-        }
-        self.visit(
-            first,
-            Outer {
-                families: self,
-                second,
-                visitor,
-            },
-        )
-    }
-
-    /// C and ∇C of `family` in f64 at `points` (its arity of them), with rest value `rest` and
-    /// the constraint's particles at rest at `rest_shape`: the gradients padded to four, for tools
-    /// (the gradient check, `tetlab gradient`).
+    /// A file family's constraint type.
     ///
     /// # Panics
-    /// If the number of points is not the family's arity; callers check it first.
-    pub fn evaluate(
-        &self,
-        family: Family,
-        points: &[DVec3],
-        rest: f64,
-        rest_shape: &[DVec3],
-    ) -> Evaluation<DVec3, 4> {
-        struct At<'a>(&'a [DVec3], f64, &'a [DVec3]);
-        impl Visit for At<'_> {
-            type Output = Evaluation<DVec3, 4>;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
-                let (p, rest, shape) = (self.0, self.1, self.2);
-                let p: [DVec3; N] = std::array::from_fn(|k| p[k]);
-                let shape: [DVec3; N] = std::array::from_fn(|k| shape[k]);
-                let e = c.evaluate(&p, rest, &shape);
-                let mut gradients = [DVec3::ZERO; 4];
-                gradients[..N].copy_from_slice(&e.gradients);
-                Evaluation {
-                    value: e.value,
-                    gradients,
-                    degenerate: e.degenerate,
-                }
-            }
+    /// If `family` is not a file family of this table.
+    pub(super) fn file_code(&self, family: Family) -> &FileCode {
+        match self.file_family(family) {
+            Some(file) => &file.code,
+            None => panic!(
+                "family {} is not a file family of this table",
+                family.index()
+            ),
         }
-        assert!(
-            points.len() == self.arity(family) && rest_shape.len() == self.arity(family),
-            "wrong number of points for {}",
-            self.name(family)
-        );
-        self.visit(family, At(points, rest, rest_shape))
-    }
-
-    /// Whether `family`'s formula reads the rest shape ([`Constraint::uses_rest_shape`]).
-    pub fn uses_rest_shape(&self, family: Family) -> bool {
-        struct Uses;
-        impl Visit for Uses {
-            type Output = bool;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> bool {
-                c.uses_rest_shape()
-            }
-        }
-        self.visit(family, Uses)
-    }
-
-    /// Whether `family`'s rest values depend on the material
-    /// ([`Constraint::REST_USES_MATERIAL`]).
-    pub fn rest_uses_material(&self, family: Family) -> bool {
-        struct Uses;
-        impl Visit for Uses {
-            type Output = bool;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, _: &C) -> bool {
-                C::REST_USES_MATERIAL
-            }
-        }
-        self.visit(family, Uses)
-    }
-
-    /// The rest value (d, V, …) of `family` at a rest configuration
-    /// ([`Constraint::rest_value`]: C there with rest value 0, unless the family says otherwise).
-    ///
-    /// # Panics
-    /// If the number of points is not the family's arity.
-    pub fn rest_value(&self, family: Family, points: &[DVec3], material: &Material) -> f64 {
-        struct Rest<'a>(&'a [DVec3], &'a Material);
-        impl Visit for Rest<'_> {
-            type Output = f64;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> f64 {
-                let shape: [DVec3; N] = std::array::from_fn(|k| self.0[k]);
-                c.rest_value(&shape, self.1)
-            }
-        }
-        assert_eq!(points.len(), self.arity(family), "wrong number of points");
-        self.visit(family, Rest(points, material))
-    }
-
-    /// [`Constraint::describe_state`] of one of `family`'s constraints, its particles at
-    /// `points` and at rest at `rest_shape`.
-    pub fn describe_state(
-        &self,
-        family: Family,
-        points: &[DVec3],
-        rest_shape: &[DVec3],
-    ) -> Vec<String> {
-        struct State<'a>(&'a [DVec3], &'a [DVec3]);
-        impl Visit for State<'_> {
-            type Output = Vec<String>;
-            fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Vec<String> {
-                let p: [DVec3; N] = std::array::from_fn(|k| self.0[k]);
-                let shape: [DVec3; N] = std::array::from_fn(|k| self.1[k]);
-                c.describe_state(&p, &shape)
-            }
-        }
-        assert_eq!(points.len(), self.arity(family), "wrong number of points");
-        self.visit(family, State(points, rest_shape))
-    }
-
-    /// Among `active` families, the one `family` is projected together with, if `family` leads
-    /// the pair ([`Row::projected_with`]: the built-in neo-Hookean pair, a file's `pair`).
-    pub fn partner_in(&self, family: Family, active: &PerFamily<bool>) -> Option<Family> {
-        self.row(family)
-            .projected_with
-            .filter(|&partner| active[partner] && family < partner)
-    }
-
-    /// Whether, among `active` families, `family` is projected by the family it is paired with
-    /// (which comes first in the table) rather than on its own.
-    pub fn projected_by_partner(&self, family: Family, active: &PerFamily<bool>) -> bool {
-        self.row(family)
-            .projected_with
-            .is_some_and(|partner| active[partner] && partner < family)
-    }
-
-    /// The compliance of `family` when the material gives it ([`Row::compliance_from_material`]:
-    /// the built-in neo-Hookean pair's, and a file's `stiffness`).
-    pub fn compliance_from_material(&self, family: Family) -> Option<fn(&Material) -> f64> {
-        self.row(family).compliance_from_material
-    }
-
-    /// `compliance` with that of every file family that has a `stiffness` taken from
-    /// `material` (the built-in ones are by [`crate::simulation::Settings::set_material`]).
-    pub fn with_file_stiffness(
-        &self,
-        mut compliance: PerFamily<f64>,
-        material: &Material,
-    ) -> PerFamily<f64> {
-        for family in self.all().skip(TABLE.len()) {
-            if let Some(c) = self.compliance_from_material(family) {
-                compliance[family] = c(material);
-            }
-        }
-        compliance
-    }
-
-    /// Which of its families take their compliance from the material.
-    pub fn from_material(&self) -> PerFamily<bool> {
-        self.per_family(|f| self.compliance_from_material(f).is_some())
     }
 
     /// How `family` binds to a mesh.

@@ -1,0 +1,146 @@
+//! What a simulation owns and every engine steps: the [`Body`] (the rest shape, its masses, its
+//! constraints, the loads and holds it is simulated under) and the [`State`] (where the particles
+//! are and how they move, the constraints' multipliers, the grab), in f64 and in the scene's
+//! numbering: the state every front end reads, whichever engine stepped it.
+//!
+//! A [`Revision`] counts the edits of each. Code that changes the state or the body does it
+//! through [`super::Simulation::state_mut`] or [`super::Simulation::body_mut`], which bump it; an
+//! engine that keeps a copy of its own (the fast engine's f32 arrays) compares the revision it
+//! last saw with the simulation's and takes up the change before its next frame. No edit has to
+//! tell an engine anything.
+
+use super::ConstraintSet;
+use crate::constraints::PerFamily;
+use glam::DVec3;
+
+/// A particle held by the user.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grab {
+    /// The particle.
+    pub particle: usize,
+    /// Where the user holds it.
+    pub target: DVec3,
+    pub(super) target_at_last_step: DVec3,
+    /// How fast the target moved over the last step.
+    pub target_velocity: DVec3,
+    /// The multiplier of the compliant grab, accumulated within a substep.
+    pub(super) lambda: f64,
+}
+
+/// The body a simulation moves: its rest shape, its constraints and what it is simulated under.
+/// It changes only by an edit of the body ([`Revision::body`]): forces set, plane strain
+/// switched, constraints built, rebuilt, measured again or put in another order.
+#[derive(Clone, Debug)]
+pub struct Body {
+    /// Rest positions (the scene as made).
+    pub rest_positions: Vec<DVec3>,
+    /// The tets, as indices into the positions.
+    pub tets: Vec<[u32; 4]>,
+    /// Inverse masses lumped from density × rest volume / 4 per tet, pins not counted.
+    pub lumped_inverse_masses: Vec<f64>,
+    /// External forces per particle in N, besides gravity (empty: none).
+    pub forces: Vec<DVec3>,
+    /// Whether every particle keeps its z (plane strain).
+    pub plane_strain: bool,
+    /// The mean rest edge length, the scale of "settled".
+    pub mean_edge: f64,
+    /// The constraints of each family, as its binding makes them (those of a family the
+    /// simulation has not used are not built).
+    pub sets: PerFamily<ConstraintSet>,
+}
+
+/// Where the particles are and how they move, in f64 and in the scene's numbering.
+#[derive(Clone, Debug)]
+pub struct State {
+    /// Current positions.
+    pub positions: Vec<DVec3>,
+    /// Positions at the start of the substep.
+    pub previous: Vec<DVec3>,
+    /// Current velocities.
+    pub velocities: Vec<DVec3>,
+    /// Inverse masses in use: the lumped ones, 0 where pinned or rigidly grabbed.
+    pub inverse_masses: Vec<f64>,
+    /// Whether each particle is pinned.
+    pub pinned: Vec<bool>,
+    /// Δp of the last substep; during a substep, the predicted positions.
+    pub corrections: Vec<DVec3>,
+    /// The sum of Δp over the substeps of the frame so far, the measure of "settled".
+    pub frame_corrections: Vec<DVec3>,
+    /// The XPBD multiplier λ of each constraint of each family ([`Body::sets`]), accumulated
+    /// within the current substep.
+    pub lambdas: PerFamily<Vec<f64>>,
+    /// The particle the user holds, if any. Read afresh every frame: moving its target is not an
+    /// edit ([`super::Simulation::move_grab`]).
+    pub grab: Option<Grab>,
+}
+
+/// How many times the body and the state have been edited: what an engine compares with what
+/// it last saw ([`super::engine::Frame::revision`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Revision {
+    /// Edits of the [`Body`]: an engine built from it builds again.
+    pub body: u64,
+    /// Edits of the [`State`] from outside the engines (perturbations, particles placed or
+    /// pinned, a grab, a step taken one projection at a time): an engine that copies the state
+    /// takes it up again.
+    pub state: u64,
+}
+
+impl State {
+    /// A body at rest at its rest positions, with nothing pinned.
+    pub(super) fn at_rest(body: &Body) -> State {
+        let n = body.rest_positions.len();
+        State {
+            positions: body.rest_positions.clone(),
+            previous: body.rest_positions.clone(),
+            velocities: vec![DVec3::ZERO; n],
+            inverse_masses: body.lumped_inverse_masses.clone(),
+            pinned: vec![false; n],
+            corrections: vec![DVec3::ZERO; n],
+            frame_corrections: vec![DVec3::ZERO; n],
+            lambdas: body.sets.map(|set| vec![0.0; set.len()]),
+            grab: None,
+        }
+    }
+
+    /// The inverse masses the state should have: the lumped ones, 0 where pinned or held by
+    /// `rigid_grab`.
+    pub(super) fn wanted_inverse_mass(&self, body: &Body, i: usize, rigid_grab: bool) -> f64 {
+        let held = rigid_grab && self.grab.is_some_and(|g| g.particle == i);
+        if self.pinned[i] || held {
+            0.0
+        } else {
+            body.lumped_inverse_masses[i]
+        }
+    }
+
+    /// The bytes of memory its arrays take (their capacities).
+    pub(super) fn heap_bytes(&self) -> usize {
+        fn bytes<T>(v: &Vec<T>) -> usize {
+            v.capacity() * size_of::<T>()
+        }
+        bytes(&self.positions)
+            + bytes(&self.previous)
+            + bytes(&self.velocities)
+            + bytes(&self.inverse_masses)
+            + bytes(&self.pinned)
+            + bytes(&self.corrections)
+            + bytes(&self.frame_corrections)
+            + (self.lambdas.every_place())
+                .map(|l| l.capacity() * size_of::<f64>())
+                .sum::<usize>()
+    }
+}
+
+impl Body {
+    /// The bytes of memory its arrays take (their capacities).
+    pub(super) fn heap_bytes(&self) -> usize {
+        self.rest_positions.capacity() * size_of::<DVec3>()
+            + self.tets.capacity() * size_of::<[u32; 4]>()
+            + self.lumped_inverse_masses.capacity() * size_of::<f64>()
+            + self.forces.capacity() * size_of::<DVec3>()
+            + (self.sets.every_place())
+                .map(ConstraintSet::heap_bytes)
+                .sum::<usize>()
+    }
+}

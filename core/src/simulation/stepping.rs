@@ -1,0 +1,182 @@
+//! How a simulation moves: a frame on its engine ([`Simulation::step`]), which engine that is
+//! and on how many threads, and a substep taken stage by stage on the reference engine
+//! (step-by-step mode: [`Simulation::begin_substep`], [`Simulation::project`],
+//! [`Simulation::end_sweep`], [`Simulation::end_substep`]), the same stages
+//! [`super::substep::frame`] runs.
+
+use super::engine::{Build, Engine, Frame};
+use super::reference::OnState;
+use super::substep::{self, Plan};
+use super::{EngineChoice, Simulation};
+use crate::constraints::Family;
+use glam::DVec3;
+
+impl Simulation {
+    /// Advances one frame: `substeps` substeps of Δt / substeps, on the engine of
+    /// [`Simulation::engine`].
+    pub fn step(&mut self) {
+        self.refresh_inverse_masses();
+        self.state.frame_corrections.fill(DVec3::ZERO);
+        let settling = self.edits_settle_now();
+        // The slot is taken out while its engine steps the rest of the simulation.
+        let mut slot = std::mem::take(&mut self.engine);
+        let engine = slot.ready(self.engine(), self.start());
+        let skipped = engine.step(Frame {
+            families: &self.families,
+            resolved: &self.resolved,
+            body: &self.body,
+            state: &mut self.state,
+            revision: self.revision,
+            threads: self.threads,
+            settling,
+        });
+        self.engine = slot;
+        for family in self.families.all() {
+            self.skipped[family] = self.skipped[family] + skipped[family];
+        }
+        if let Some(grab) = &mut self.state.grab {
+            grab.target_velocity = (grab.target - grab.target_at_last_step) / self.settings.dt;
+            grab.target_at_last_step = grab.target;
+        }
+        if let Some(frames) = self.settling {
+            let largest = self.largest_frame_correction();
+            let settles = self.resolved.edits_settle();
+            self.settling = (settles && largest > self.settle_tolerance()).then_some(frames + 1);
+        }
+        self.frame += 1;
+        self.time += self.settings.dt;
+    }
+
+    /// Whether an edit settles in the next frame: one is settling, and edits settle
+    /// ([`super::Resolved::edits_settle`]).
+    fn edits_settle_now(&self) -> bool {
+        self.resolved.edits_settle() && self.settling.is_some()
+    }
+
+    /// The longest sum of Δp over the frame's substeps among particles that can move.
+    fn largest_frame_correction(&self) -> f64 {
+        let s = &self.state;
+        (s.frame_corrections.iter().zip(&s.inverse_masses))
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(c, _)| c.length())
+            .fold(0.0, f64::max)
+    }
+
+    /// Gives each particle its inverse mass (the lumped one, 0 where pinned or rigidly held):
+    /// an edit of the state where one changed (a pin, a grab, the grab's compliance set to 0).
+    pub(super) fn refresh_inverse_masses(&mut self) {
+        let rigid = self.settings.grab_compliance <= 0.0;
+        let wanted = |s: &Simulation, i: usize| s.state.wanted_inverse_mass(&s.body, i, rigid);
+        let n = self.state.inverse_masses.len();
+        if (0..n).any(|i| wanted(self, i) != self.state.inverse_masses[i]) {
+            let masses: Vec<f64> = (0..n).map(|i| wanted(self, i)).collect();
+            self.state_mut().inverse_masses = masses;
+        }
+    }
+
+    /// The engine the settings choose for this simulation: [`Settings::engine`](super::Settings::engine),
+    /// with [`EngineChoice::Auto`] resolved by the size of the scene. An engine given by code
+    /// ([`Simulation::use_engine`]) steps it instead; [`Simulation::describe_engine`] names
+    /// the one that does.
+    pub fn engine(&self) -> EngineChoice {
+        self.settings.engine.resolve(self.body.tets.len())
+    }
+
+    /// "reference (f64)" or "fast (f32, 2 threads)": what the front ends show.
+    pub fn describe_engine(&self) -> String {
+        match (&self.engine.built, self.engine.given) {
+            (Some((_, engine)), Some(_)) => engine.describe(),
+            (None, Some((_, name))) => name.to_owned(),
+            _ => self.engine().describe(self.threads),
+        }
+    }
+
+    /// Steps this simulation on the engine `build` makes (named `name` until it is built)
+    /// rather than the settings' choice: an engine that is not one of tetlab's own (a test's).
+    pub fn use_engine(&mut self, build: Build, name: &'static str) {
+        self.engine.given = Some((build, name));
+        self.engine.built = None;
+    }
+
+    /// The engine, built (and ready for the next frame) if it was not, as an `E` when it is one:
+    /// for `tetlab bench`, which times the fast engine and reads its per-family timings.
+    pub fn engine_as<E: Engine + 'static>(&mut self) -> Option<&mut E> {
+        let mut slot = std::mem::take(&mut self.engine);
+        slot.ready(self.engine(), self.start());
+        self.engine = slot;
+        let (_, engine) = self.engine.built.as_mut()?;
+        engine.as_any_mut().downcast_mut::<E>()
+    }
+
+    /// The threads an engine uses.
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// Sets the threads an engine may use (1 without the `parallel` feature, where every count
+    /// is 1); the results are the same bits for any count.
+    pub fn set_threads(&mut self, threads: usize) {
+        self.threads = if cfg!(feature = "parallel") {
+            threads.max(1)
+        } else {
+            1
+        };
+    }
+
+    /// The plan of a substep taken stage by stage: a frame's (every stage tracks Δp).
+    fn stage_plan(&self) -> Plan {
+        let grab = self.state.grab.map(|g| (g.particle, g.target));
+        let plane_strain = self.body.plane_strain;
+        let settling = self.edits_settle_now();
+        Plan::new(&self.families, &self.resolved, plane_strain, grab, settling)
+    }
+
+    /// Runs `stage` on the reference engine's view of the state: an edit of the state, as far as
+    /// another engine is concerned.
+    fn on_state<T>(&mut self, stage: impl FnOnce(&mut OnState<'_>, &Plan) -> T) -> T {
+        let plan = self.stage_plan();
+        let (families, body, state) = self.edit();
+        let mut on = OnState::new(families, body, state);
+        let out = stage(&mut on, &plan);
+        let skipped = on.skipped;
+        for family in self.families.all() {
+            self.skipped[family] = self.skipped[family] + skipped[family];
+        }
+        out
+    }
+
+    /// One substep on the reference engine: [`Simulation::begin_substep`], `iterations` sweeps
+    /// ([`Simulation::project`] of every constraint of [`Simulation::projection_order`], then
+    /// `Simulation::end_sweep`), `Simulation::end_substep`: done here in tight loops.
+    pub fn substep(&mut self) {
+        self.on_state(|on, plan| {
+            substep::begin_substep(on, plan, true);
+            for _ in 0..plan.iterations {
+                substep::sweep(on, plan);
+            }
+            substep::end_substep(on, plan, true);
+        });
+    }
+
+    /// The first stage of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
+    pub fn begin_substep(&mut self) {
+        self.on_state(|on, plan| substep::begin_substep(on, plan, true));
+    }
+
+    /// Projects constraint `c` of `family` once, exactly as a sweep does (with its partner, if it
+    /// leads a pair).
+    pub fn project(&mut self, family: Family, c: usize) {
+        let unit = self.families.unit_of(family, self.active());
+        self.on_state(|on, plan| on.project_one(unit, c, plan));
+    }
+
+    /// The end of one sweep, after the constraint families: the grab, then the ground y ≥ 0.
+    pub(crate) fn end_sweep(&mut self) {
+        self.on_state(|on, plan| substep::end_sweep(on, plan));
+    }
+
+    /// The last stage of a substep: Δp = x − predicted x, then velocities from the positions.
+    pub(crate) fn end_substep(&mut self) {
+        self.on_state(|on, plan| substep::end_substep(on, plan, true));
+    }
+}
