@@ -69,8 +69,10 @@ impl Simulation {
         let wanted = |s: &Simulation, i: usize| s.state.wanted_inverse_mass(&s.body, i, rigid);
         let n = self.state.inverse_masses.len();
         if (0..n).any(|i| wanted(self, i) != self.state.inverse_masses[i]) {
-            let masses: Vec<f64> = (0..n).map(|i| wanted(self, i)).collect();
-            self.state_mut().inverse_masses = masses;
+            let (_, body, state) = self.edit();
+            for i in 0..n {
+                state.inverse_masses[i] = state.wanted_inverse_mass(body, i, rigid);
+            }
         }
     }
 

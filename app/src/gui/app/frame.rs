@@ -2,7 +2,6 @@
 //! the panels laid out (classroom mode or the full workbench), the 3D views, and the requests
 //! the panels added carried out once every panel is drawn.
 
-#[cfg(not(target_arch = "wasm32"))]
 use super::super::files;
 use super::super::panels::{Context, Panel};
 use super::super::request::Request;
