@@ -547,3 +547,82 @@ fn the_engine_is_chosen_and_always_named() {
     assert_usage_error(&tetlab(&["run", "--engine", "gpu"]), "--engine");
     assert_usage_error(&tetlab(&["run", "--threads", "0"]), "--threads");
 }
+
+#[test]
+fn every_frame_carries_its_energy_account_and_the_summary_its_ends() {
+    let args = [
+        "run",
+        "--scene",
+        "cube",
+        "--resolution",
+        "2",
+        "--constraints",
+        "neohookean",
+        "--perturb",
+        "flatten",
+        "--frames",
+        "20",
+    ];
+    let lines = json_lines(&[&args[..], &["--json"]].concat());
+    for line in &lines {
+        let part = |key: &str| {
+            line[key]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{key}: {line}"))
+        };
+        let sum = part("energy_kinetic")
+            + part("energy_gravitational")
+            + part("energy_external")
+            + part("energy_elastic_neohookean-deviatoric")
+            + part("energy_elastic_neohookean-hydrostatic");
+        let total = part("energy_total");
+        assert!((sum - total).abs() <= 1e-9 * total.abs(), "{line}");
+    }
+    // The flattened material holds energy at the start and lets it go: the total only falls.
+    let totals: Vec<f64> = lines
+        .iter()
+        .map(|l| l["energy_total"].as_f64().unwrap())
+        .collect();
+    assert!(totals[0] > 0.0 && totals[20] < totals[0], "{totals:?}");
+    let output = tetlab(&args);
+    let text = stdout(&output);
+    assert!(text.contains("energy: "), "{text}");
+    assert!(!text.contains("the energy grew"), "{text}");
+}
+
+#[test]
+fn exact_step_says_how_far_each_frame_is_from_the_implicit_step() {
+    let run = |substeps: &str| {
+        json_lines(&[
+            "run",
+            "--scene",
+            "cube",
+            "--resolution",
+            "2",
+            "--perturb",
+            "scramble:7",
+            "--constraints",
+            "edges,volume",
+            "--compliance",
+            "edges=1e-3",
+            "--compliance",
+            "volume=1e-2",
+            "--substeps",
+            substeps,
+            "--frames",
+            "3",
+            "--exact-step",
+            "--json",
+        ])
+    };
+    let largest = |lines: &[Value]| {
+        (lines.iter().skip(1))
+            .map(|l| l["exact_step_distance"].as_f64().unwrap())
+            .fold(0.0, f64::max)
+    };
+    let (coarse, fine) = (largest(&run("5")), largest(&run("20")));
+    // XPBD's distance from the exact step shrinks with the substep (its bias goes as h²).
+    assert!(coarse > 0.0 && fine < coarse / 4.0, "{coarse} {fine}");
+    let output = tetlab(&["run", "--frames", "2", "--exact-step", "--ensemble", "2"]);
+    assert_usage_error(&output, "--exact-step");
+}

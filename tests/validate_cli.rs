@@ -49,6 +49,21 @@ fn the_quick_subset_passes_on_both_engines_and_writes_json() {
             );
         }
     }
+    // Every static case says whose error it is: a row on the solver's error (against the exact
+    // solution of the same discrete problem) or with that solution beside the measured value.
+    for case in ["patch", "hanging-bar", "cantilever", "stretch"] {
+        for engine in ["reference", "fast"] {
+            let judged = checks.iter().any(|c| {
+                c["case"] == case
+                    && c["engine"] == engine
+                    && (c["judged"] == "Solver" || c["discrete"].is_number())
+            });
+            assert!(
+                judged,
+                "{case} on {engine}: no row compares with the exact solution"
+            );
+        }
+    }
     // Nothing is written as NaN: a row that only reports has null where it has no number.
     assert!(!std::fs::read_to_string(&json).unwrap().contains("NaN"));
 }

@@ -32,7 +32,7 @@ pub struct Args {
     /// that checks it; repeatable.
     #[arg(long = "constraint-file", value_name = "FILE", conflicts_with = "list")]
     constraint_files: Vec<PathBuf>,
-    /// The engine instead of the lesson's: auto, reference or fast, as for `tetlab run`.
+    /// The engine instead of the lesson's: auto, reference, fast or newton, as for `tetlab run`.
     #[arg(long, value_parser = EngineChoice::parse, conflicts_with = "list")]
     engine: Option<EngineChoice>,
     /// Threads for the fast engine (1..=256) [default: every core].

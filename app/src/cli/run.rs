@@ -9,9 +9,12 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use tetlab_core::constraints::Family;
 use tetlab_core::input::limits;
+use tetlab_core::measures::energy_account::{Energy, EnergyWatch};
 use tetlab_core::measures::ensemble::{Ensemble, Member, Tally};
+use tetlab_core::measures::exact_step::ExactStepGap;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
+use tetlab_core::simulation::newton::NewtonEngine;
 use tetlab_core::simulation::{EngineChoice, Simulation};
 
 /// Options of `tetlab run`.
@@ -28,6 +31,12 @@ pub struct Args {
     /// [default: one run in the order of --order-seed].
     #[arg(long, value_name = "N", value_parser = |s: &str| limits::ENSEMBLE.parse(s), conflicts_with = "order_seed")]
     ensemble: Option<u64>,
+    /// Also step every frame's start with the Newton reference (the implicit Euler steps XPBD
+    /// approximates, solved exactly) and report how far XPBD's frame is from it: per frame in
+    /// --json (exact_step_distance, m, and exact_step_relative, of the frame's motion), and the
+    /// largest in the summary. Slow: for small scenes.
+    #[arg(long, conflicts_with = "ensemble")]
+    exact_step: bool,
 }
 
 /// One line of `--json` output.
@@ -54,6 +63,17 @@ pub struct FrameRecord {
     /// the reach (`tetlab_core::simulation::projection::DEFAULT_REACH`).
     #[serde(flatten)]
     skipped: BTreeMap<String, u64>,
+    /// The energy account (`tetlab_core::measures::energy_account`), J: `energy_kinetic`,
+    /// `energy_gravitational`, `energy_external`, `energy_elastic_<family>` for each active
+    /// family, `energy_total`.
+    #[serde(flatten)]
+    energy: BTreeMap<String, f64>,
+    /// With --exact-step: how far this frame is from the exact one from the same start
+    /// (`tetlab_core::measures::exact_step`), m, and relative to that frame's motion.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    exact_step_distance: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    exact_step_relative: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     particles: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -75,9 +95,15 @@ pub struct FrameRecord {
 }
 
 impl FrameRecord {
-    /// The record of the simulation's current frame; frame 0 also carries the sizes and the
-    /// settings that decide the order and the settling. `start` is the centre of mass at frame 0.
-    pub fn new(simulation: &Simulation, metrics: &Metrics, start: glam::DVec3) -> Self {
+    /// The record of the simulation's current frame, with its `energy`; frame 0 also carries
+    /// the sizes and the settings that decide the order and the settling. `start` is the centre
+    /// of mass at frame 0.
+    pub fn new(
+        simulation: &Simulation,
+        metrics: &Metrics,
+        energy: &Energy,
+        start: glam::DVec3,
+    ) -> Self {
         let first = simulation.frame() == 0;
         let (settings, active) = (simulation.resolved(), simulation.active());
         let families = simulation.families();
@@ -109,6 +135,22 @@ impl FrameRecord {
                     ]
                 })
                 .collect(),
+            energy: [
+                ("energy_kinetic".to_owned(), energy.kinetic),
+                ("energy_gravitational".to_owned(), energy.gravitational),
+                ("energy_external".to_owned(), energy.external),
+                ("energy_total".to_owned(), energy.total),
+            ]
+            .into_iter()
+            .chain(
+                families
+                    .values(&energy.elastic)
+                    .filter(|&(family, _)| active[family])
+                    .map(|(f, e)| (format!("energy_elastic_{}", families.name(f)), e)),
+            )
+            .collect(),
+            exact_step_distance: None,
+            exact_step_relative: None,
             particles: first.then(|| simulation.positions().len()),
             tets: first.then(|| simulation.tets().len()),
             edges: first.then(|| simulation.constraint_count(Family::EDGES)),
@@ -129,8 +171,11 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let io = UsageError::stdout;
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
     let mut outcome = Outcome::start(&simulation, &initial);
+    let mut energy = EnergyWatch::start(&simulation);
+    let energy_start = energy.last().total;
     if args.json {
-        write_json(out, &FrameRecord::new(&simulation, &initial, outcome.start)).map_err(io)?;
+        let record = FrameRecord::new(&simulation, &initial, energy.last(), outcome.start);
+        write_json(out, &record).map_err(io)?;
     } else {
         writeln!(
             out,
@@ -154,11 +199,27 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         .map_err(io)?;
         summary_line(out, 0, &initial).map_err(io)?;
     }
+    // The largest gap from the exact frame: (relative, metres, frame), and whether every
+    // exact frame converged.
+    let mut largest_gap: Option<(f64, f64, u64)> = None;
+    let mut gaps_converged = true;
     for _ in 0..args.simulation.frames {
+        let before = args.exact_step.then(|| simulation.clone());
         let metrics = SimulationArgs::step(&mut simulation)?;
         outcome.observe(&simulation, &metrics);
+        let gap = before.map(|before| ExactStepGap::measure(&before, &simulation));
+        if let Some(gap) = gap {
+            gaps_converged &= gap.converged;
+            if largest_gap.is_none_or(|(relative, _, _)| gap.relative > relative) {
+                largest_gap = Some((gap.relative, gap.largest, simulation.frame()));
+            }
+        }
+        let now = energy.observe(&simulation, simulation.frame());
         if args.json {
-            write_json(out, &FrameRecord::new(&simulation, &metrics, outcome.start)).map_err(io)?;
+            let mut record = FrameRecord::new(&simulation, &metrics, now, outcome.start);
+            record.exact_step_distance = gap.map(|g| g.largest);
+            record.exact_step_relative = gap.map(|g| g.relative);
+            write_json(out, &record).map_err(io)?;
         }
     }
     if !args.json {
@@ -188,6 +249,70 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         for line in super::simulation_args::describe_skipped(&simulation) {
             writeln!(out, "{line}").map_err(io)?;
         }
+        let start = energy_start;
+        writeln!(
+            out,
+            "energy: {:.4e} J at the start, {:.4e} J at the end (kinetic {:.3e}, gravitational \
+             {:.3e}, elastic {:.3e})",
+            start,
+            energy.last().total,
+            energy.last().kinetic,
+            energy.last().gravitational,
+            energy.last().total
+                - energy.last().kinetic
+                - energy.last().gravitational
+                - energy.last().external
+        )
+        .map_err(io)?;
+        if let Some((relative, metres, frame)) = largest_gap {
+            let unconverged = if gaps_converged {
+                ""
+            } else {
+                " (the Newton reference did not converge on every frame: there its answer is a local one)"
+            };
+            writeln!(
+                out,
+                "distance from the exact frame: at most {metres:.3e} m, {:.2e} of the frame's \
+                 motion, at frame {frame}{unconverged}",
+                relative
+            )
+            .map_err(io)?;
+        }
+        if energy.released > 0.0 {
+            writeln!(
+                out,
+                "energy released by rigid families undoing a violated start: {:.4e} J (a rigid \
+                 family stores no energy the account can measure)",
+                energy.released
+            )
+            .map_err(io)?;
+        }
+        if let Some(gain) = &energy.gain {
+            writeln!(
+                out,
+                "warning: the energy grew by {:.3e} J above its lowest by frame {} (more than \
+                 {:.3e} J, 1 % of what the body could give back), most in {}",
+                gain.amount,
+                gain.frame,
+                energy.bound(),
+                gain.from
+            )
+            .map_err(io)?;
+        }
+        if let Some(newton) = simulation.engine_as::<NewtonEngine>()
+            && newton.unconverged() > 0
+        {
+            let last = newton.last_report();
+            writeln!(
+                out,
+                "warning: the Newton reference did not solve {} substeps to its tolerance (the \
+                 last: residual {:.1e}, violation {:.1e}); its answer there is a local one",
+                newton.unconverged(),
+                last.residual,
+                last.violation
+            )
+            .map_err(io)?;
+        }
         if let Some(warning) = outcome.thrown_warning() {
             let advice = if simulation.resolved().edits_settle() {
                 ""
@@ -209,7 +334,7 @@ fn run_ensemble(args: &Args, n: u64, out: &mut impl Write) -> Result<(), UsageEr
     let (scene, simulation) = args.simulation.build()?;
     let engines = match args.simulation.solver.engine {
         Some(engine) if engine != EngineChoice::Auto => vec![engine],
-        _ => EngineChoice::engines().collect(),
+        _ => EngineChoice::position_based().collect(),
     };
     let ensemble = Ensemble {
         scene: &scene,

@@ -108,8 +108,9 @@ pub struct SolverArgs {
     #[arg(long, default_value = "xpbd", value_parser = Method::parse)]
     pub solver: Method,
     /// Which solver steps the simulation: reference (f64, one constraint at a time), fast (f32,
-    /// coloured, in SIMD lanes, on threads) or auto (reference below 1000 tets, fast from there)
-    /// [default: auto; bench: fast].
+    /// coloured, in SIMD lanes, on threads), newton (every substep's implicit Euler step solved
+    /// exactly: the answer XPBD approximates; slow, for small scenes) or auto (reference below
+    /// 1000 tets, fast from there) [default: auto; bench: fast].
     #[arg(long, value_parser = EngineChoice::parse)]
     pub engine: Option<EngineChoice>,
     /// Threads for the fast engine (1..=256; the results are the same for any count) [default:

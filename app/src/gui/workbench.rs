@@ -4,6 +4,7 @@
 use glam::DVec3;
 use std::collections::VecDeque;
 use tetlab_core::constraints::{Families, PerFamily};
+use tetlab_core::measures::energy_account::Energy;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::simulation::divergence::Divergence;
@@ -30,6 +31,8 @@ pub struct Sample {
     pub time: f64,
     /// The metrics at that time.
     pub metrics: Metrics,
+    /// The energy account at that time: kinetic, gravitational, elastic and total, J.
+    pub energy: [f64; 4],
 }
 
 /// The scene being simulated and everything the user has chosen about it.
@@ -446,9 +449,14 @@ impl Workbench {
         if self.history.len() == HISTORY {
             self.history.pop_front();
         }
+        let energy = Energy::measure(&self.simulation);
+        let elastic: f64 = (self.simulation.families().all())
+            .map(|f| energy.elastic[f])
+            .sum();
         self.history.push_back(Sample {
             time: self.simulation.time(),
             metrics: self.metrics,
+            energy: [energy.kinetic, energy.gravitational, elastic, energy.total],
         });
     }
 }

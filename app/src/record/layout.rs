@@ -3,8 +3,8 @@
 use rerun::RecordingStream;
 use tetlab_core::measures::metrics::Metrics;
 
-/// The default layout: a 3D view per root (side by side) on the left, the four metrics stacked on
-/// the right (each plot shows the metric of every root), and with `modes` a plot of the
+/// The default layout: a 3D view per root (side by side) on the left, the four metrics and the
+/// energy account stacked on the right (each plot shows the metric of every root), and with `modes` a plot of the
 /// eigenvalues `record --modes` logs below them.
 pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool) {
     use rerun::blueprint::{
@@ -30,7 +30,20 @@ pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool) {
             )
             .into()
     });
-    let plots: Vec<_> = plots.into_iter().chain(modes).collect();
+    // The energy account (`energy/*`), every part of it in one plot.
+    let energy = TimeSeriesView::new("energy, J")
+        .with_contents(
+            roots
+                .iter()
+                .map(|root| format!("+ {root}energy/**"))
+                .collect::<Vec<_>>(),
+        )
+        .into();
+    let plots: Vec<_> = plots
+        .into_iter()
+        .chain(std::iter::once(energy))
+        .chain(modes)
+        .collect();
     let views = roots.iter().map(|root| {
         let title = if root.is_empty() {
             "soft body"

@@ -6,6 +6,7 @@ use glam::Vec3;
 use rerun::RecordingStream;
 use tetlab_core::constraints::Families;
 use tetlab_core::energy::modes::Modes;
+use tetlab_core::measures::energy_account::Energy;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
 use tetlab_core::simulation::Simulation;
@@ -214,6 +215,18 @@ impl<'a> Recorder<'a> {
 
         for (name, value) in metrics.headline() {
             log(&format!("metrics/{name}"), &rerun::Scalars::single(value));
+        }
+        // The energy account, one series each in one plot.
+        let energy = Energy::measure(simulation);
+        let elastic: f64 = simulation.families().all().map(|f| energy.elastic[f]).sum();
+        for (name, value) in [
+            ("kinetic", energy.kinetic),
+            ("gravitational", energy.gravitational),
+            ("external", energy.external),
+            ("elastic", elastic),
+            ("total", energy.total),
+        ] {
+            log(&format!("energy/{name}"), &rerun::Scalars::single(value));
         }
     }
 

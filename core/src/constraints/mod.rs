@@ -27,6 +27,7 @@
 mod any;
 mod binding;
 mod builtin;
+pub mod differentiable;
 mod dispatch;
 pub mod distance;
 mod family_table;

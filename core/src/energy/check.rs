@@ -4,8 +4,8 @@
 //! central differences of ∇C by forward-mode AD; and a file's own `[hessian]` blocks against AD,
 //! block by block.
 
-use super::element::constraint;
 use crate::constraint_file::ConstraintFile;
+use crate::constraints::differentiable::value_and_gradient as constraint;
 use crate::constraints::material::Material;
 use crate::constraints::verify::{TableFamily, draw, well_conditioned};
 use crate::constraints::{Families, Family};

@@ -6,9 +6,9 @@
 //! ([`crate::constraints::Binding::particles`]): one volume, four heights, six edges; for a family
 //! of the surface, the tet's own four faces and six hinges, as if it stood alone.
 
-use crate::constraints::{Constraint, Families, Family, PerFamily, Stored, Visit};
-use crate::numbers::dual::DualVec3;
-use crate::numbers::vector::{Real, Vector3};
+use crate::constraints::differentiable::value_and_gradient;
+use crate::constraints::{Families, Family, PerFamily, Stored};
+use crate::numbers::vector::Real;
 use crate::scene::mesh::TetMesh;
 use crate::simulation::{DENSITY, Settings, Simulation};
 use glam::DVec3;
@@ -173,7 +173,7 @@ impl ElementEnergy {
         ) -> (T, [[T; 3]; 4]) {
             let p: [[T; 3]; N] = std::array::from_fn(|k| x[term.corners[k]]);
             let shape: [DVec3; N] = std::array::from_fn(|k| e.rest_shape[term.corners[k]]);
-            let (value, gradients) = constraint(
+            let (value, gradients) = value_and_gradient(
                 &e.families,
                 term.family,
                 &p,
@@ -203,56 +203,5 @@ impl ElementEnergy {
             sum += T::from_f64(0.5 * term.stiffness) * c * c;
         }
         sum
-    }
-}
-
-/// C and ∇C of one constraint of `family` at `x`, with its rest value and stored numbers `rest`
-/// and rest shape `rest_shape`, in any number type `T` that compares to a bool: ∇C by the
-/// family's formula, or for a file by its compiled AD (never the file's own gradient).
-pub fn constraint<T: Real<Mask = bool>, const N: usize>(
-    families: &Families,
-    family: Family,
-    x: &[[T; 3]; N],
-    (rest, stored): (f64, &[f64]),
-    rest_shape: &[DVec3; N],
-) -> (T, [[T; 3]; N]) {
-    let stored: arrayvec::ArrayVec<T, { crate::constraints::MAX_STORED }> =
-        stored.iter().map(|&s| T::from_f64(s)).collect();
-    if let Some(file) = families.file(family) {
-        let (value, gradients) = file.automatic_gradient(x, T::from_f64(rest), &stored);
-        let sound = crate::constraint_file::sound::<DualVec3<T>, N>(value, gradients);
-        return (sound.value, sound.gradients.map(|g| g.0));
-    }
-    families.visit(
-        family,
-        At {
-            x,
-            rest: T::from_f64(rest),
-            stored: &stored,
-            rest_shape,
-        },
-    )
-}
-
-/// One constraint of a built-in family evaluated at `x`, in the number type of `x`.
-struct At<'a, T, const M: usize> {
-    x: &'a [[T; 3]; M],
-    rest: T,
-    stored: &'a [T],
-    rest_shape: &'a [DVec3; M],
-}
-
-impl<T: Real<Mask = bool>, const M: usize> Visit for At<'_, T, M> {
-    type Output = (T, [[T; 3]; M]);
-
-    fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
-        assert_eq!(N, M, "the family's arity");
-        let p: [DualVec3<T>; N] = std::array::from_fn(|k| DualVec3(self.x[k]));
-        let shape: [DualVec3<T>; N] = std::array::from_fn(|k| {
-            let q = self.rest_shape[k];
-            DualVec3::<T>::from_f64s(q.x, q.y, q.z)
-        });
-        let e = c.evaluate_stored(&p, self.rest, &shape, self.stored);
-        (e.value, std::array::from_fn(|k| e.gradients[k].to_array()))
     }
 }

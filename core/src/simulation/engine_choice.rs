@@ -15,6 +15,10 @@ pub enum EngineChoice {
     Reference,
     /// The f32 engine in SIMD lanes and on threads: several times faster on a real mesh.
     Fast,
+    /// The Newton reference: every substep's implicit Euler step solved exactly (to 10⁻¹⁰), the
+    /// discrete problem XPBD approximates ([`super::newton`]). Slow: for validation and small
+    /// scenes.
+    Newton,
 }
 
 /// The size from which [`EngineChoice::Auto`] picks the fast engine. The reference engine's
@@ -27,18 +31,31 @@ pub const FAST_FROM_TETS: usize = 1000;
 
 impl EngineChoice {
     /// Every choice, in the order the front ends list them.
-    pub const ALL: [EngineChoice; 3] = [
+    pub const ALL: [EngineChoice; 4] = [
         EngineChoice::Auto,
         EngineChoice::Reference,
         EngineChoice::Fast,
+        EngineChoice::Newton,
     ];
 
-    /// The engines themselves, every choice but [`EngineChoice::Auto`]: what `validate --engine
-    /// both` and an ensemble run.
+    /// The engines themselves, every choice but [`EngineChoice::Auto`].
     pub fn engines() -> impl Iterator<Item = EngineChoice> {
         EngineChoice::ALL
             .into_iter()
             .filter(|&e| e != EngineChoice::Auto)
+    }
+
+    /// The position-based engines, those that project constraints (every engine but the Newton
+    /// reference, which solves the step they approximate): what `validate --engine both` and an
+    /// ensemble run, and what the engines' contract binds.
+    ///
+    /// ```
+    /// use tetlab_core::simulation::EngineChoice;
+    /// let both: Vec<_> = EngineChoice::position_based().collect();
+    /// assert_eq!(both, [EngineChoice::Reference, EngineChoice::Fast]);
+    /// ```
+    pub fn position_based() -> impl Iterator<Item = EngineChoice> {
+        EngineChoice::engines().filter(|&e| e != EngineChoice::Newton)
     }
 
     /// Its name on the command line, in files and links: `auto`, `reference` or `fast`.
@@ -47,6 +64,7 @@ impl EngineChoice {
             EngineChoice::Auto => "auto",
             EngineChoice::Reference => "reference",
             EngineChoice::Fast => "fast",
+            EngineChoice::Newton => "newton",
         }
     }
 
@@ -60,6 +78,10 @@ impl EngineChoice {
             EngineChoice::Fast => {
                 "f32, coloured, eight constraints at a time in SIMD lanes, on every core".into()
             }
+            EngineChoice::Newton => {
+                "f64, every substep's implicit step solved exactly: the reference XPBD approaches"
+                    .into()
+            }
         }
     }
 
@@ -68,7 +90,7 @@ impl EngineChoice {
     /// ```
     /// use tetlab_core::simulation::EngineChoice;
     /// assert_eq!(EngineChoice::parse("fast"), Ok(EngineChoice::Fast));
-    /// assert!(EngineChoice::parse("gpu").unwrap_err().contains("auto, reference or fast"));
+    /// assert!(EngineChoice::parse("gpu").unwrap_err().contains("auto, reference, fast or newton"));
     /// ```
     pub fn parse(text: &str) -> Result<EngineChoice, String> {
         let text = text.trim();
@@ -111,6 +133,7 @@ impl EngineChoice {
                 format!("fast (f32, {threads} thread{s})")
             }
             EngineChoice::Auto | EngineChoice::Reference => "reference (f64)".to_owned(),
+            EngineChoice::Newton => "newton (f64, implicit Euler to 1e-10)".to_owned(),
         }
     }
 }

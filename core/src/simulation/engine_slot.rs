@@ -5,6 +5,7 @@
 use super::EngineChoice;
 use super::engine::{Build, Engine, Start};
 use super::fast::FastSimulation;
+use super::newton::NewtonEngine;
 use super::reference::ReferenceEngine;
 
 /// How the engine of `choice` is made; [`EngineChoice::Auto`] is resolved by the size of the
@@ -13,6 +14,7 @@ pub(super) fn build(choice: EngineChoice) -> Build {
     match choice {
         EngineChoice::Auto | EngineChoice::Reference => |_| Box::new(ReferenceEngine),
         EngineChoice::Fast => |start| Box::new(FastSimulation::new(start)),
+        EngineChoice::Newton => |_| Box::new(NewtonEngine::default()),
     }
 }
 

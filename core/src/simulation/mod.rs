@@ -26,6 +26,7 @@ pub mod fast;
 mod inspection;
 mod integrate;
 mod masses;
+pub mod newton;
 pub mod projection;
 mod reference;
 mod resolved;
@@ -406,16 +407,7 @@ impl Simulation {
 
     /// The diagonal of the rest shape's bounding box, in metres: the size of the body.
     pub fn rest_diagonal(&self) -> f64 {
-        let rest = &self.body.rest_positions;
-        let (low, high) = rest.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(low, high), p| (low.min(*p), high.max(*p)),
-        );
-        if rest.is_empty() {
-            0.0
-        } else {
-            low.distance(high)
-        }
+        self.body.rest_diagonal()
     }
 
     /// Ok while every coordinate and velocity component is finite and below [`SOUND_LIMIT`] in

@@ -65,6 +65,11 @@ impl<'a> OnState<'a> {
         }
     }
 
+    /// The state the stages work on.
+    pub(crate) fn state(&mut self) -> &mut State {
+        self.state
+    }
+
     /// Projections skipped for a counted reason so far, per family.
     pub fn skipped(&self) -> PerFamily<SkipCounts> {
         self.skipped

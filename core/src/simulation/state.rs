@@ -133,6 +133,21 @@ impl State {
 }
 
 impl Body {
+    /// The diagonal of the rest shape's bounding box, in metres: the size of the body (0 for
+    /// none).
+    pub fn rest_diagonal(&self) -> f64 {
+        let rest = &self.rest_positions;
+        let (low, high) = rest.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(low, high), p| (low.min(*p), high.max(*p)),
+        );
+        if rest.is_empty() {
+            0.0
+        } else {
+            low.distance(high)
+        }
+    }
+
     /// The bytes of memory its arrays take (their capacities).
     pub(super) fn heap_bytes(&self) -> usize {
         self.rest_positions.capacity() * size_of::<DVec3>()

@@ -6,7 +6,7 @@
 
 use super::engine::{Build, Engine, Frame};
 use super::reference::OnState;
-use super::substep::{self, Plan};
+use super::substep::{self, Plan, Substeps};
 use super::{EngineChoice, Simulation};
 use crate::constraints::Family;
 use glam::DVec3;
@@ -153,9 +153,7 @@ impl Simulation {
     pub fn substep(&mut self) {
         self.on_state(|on, plan| {
             substep::begin_substep(on, plan, true);
-            for _ in 0..plan.iterations {
-                substep::sweep(on, plan);
-            }
+            on.sweeps(plan);
             substep::end_substep(on, plan, true);
         });
     }

@@ -133,6 +133,17 @@ pub trait Substeps {
     fn reset_multipliers(&mut self, plan: &Plan);
     /// Projects every constraint of `unit`, in the engine's order.
     fn project(&mut self, unit: Unit, plan: &Plan);
+    /// What a substep does between its start and its end: `iterations` Gauss–Seidel [`sweep`]s.
+    /// An engine that solves the substep's system another way (the Newton reference) does it
+    /// here instead.
+    fn sweeps(&mut self, plan: &Plan)
+    where
+        Self: Sized,
+    {
+        for _ in 0..plan.iterations {
+            sweep(self, plan);
+        }
+    }
     /// The position of `particle`, its inverse mass, and the compliant grab's multiplier, to
     /// be projected towards a target (`project_soft_grab`).
     fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_>;
@@ -156,16 +167,14 @@ pub enum GrabbedParticle<'a> {
     F32(&'a mut glam::Vec3A, f32, &'a mut f32),
 }
 
-/// One frame: `substeps` substeps, each [`begin_substep`], `iterations` × [`sweep`],
-/// [`end_substep`].
+/// One frame: `substeps` substeps, each [`begin_substep`], the sweeps ([`Substeps::sweeps`]:
+/// `iterations` × [`sweep`]), [`end_substep`].
 pub fn frame(engine: &mut impl Substeps, plan: &Plan) {
     engine.begin_frame(plan);
     for substep in 0..plan.substeps {
         let tracks = plan.tracks(substep);
         begin_substep(engine, plan, tracks);
-        for _ in 0..plan.iterations {
-            sweep(engine, plan);
-        }
+        engine.sweeps(plan);
         end_substep(engine, plan, tracks);
     }
 }

@@ -6,6 +6,10 @@ use crate::gui::workbench::Sample;
 use eframe::egui;
 use egui_plot::{Legend, Line, Plot, PlotPoints};
 
+/// Each plot's height: three fit where two of 110 did, so the display panel below stays in a
+/// window 800 pixels high.
+const PLOT_HEIGHT: f32 = 75.0;
+
 /// The readouts: the metrics of the current frame, the engine and timings, and plots of the
 /// recent frames.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -40,6 +44,19 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>) {
             ("min V/V0", format!("{:.4}", m.min_volume_ratio)),
             ("volume error", format!("{:.3e}", m.volume_error)),
             ("max edge strain", format!("{:.3e}", m.max_edge_strain)),
+            (
+                "energy",
+                bench
+                    .history
+                    .back()
+                    .map_or_else(String::new, |s| format!("{:.4e} J", s.energy[3])),
+            ),
+            (
+                "kinetic, elastic",
+                bench.history.back().map_or_else(String::new, |s| {
+                    format!("{:.2e}, {:.2e} J", s.energy[0], s.energy[2])
+                }),
+            ),
             (
                 "settling an edit",
                 if bench.simulation.is_settling() {
@@ -78,18 +95,29 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>) {
         )
     };
     Plot::new("inverted plot")
-        .height(110.0)
+        .height(PLOT_HEIGHT)
         .legend(Legend::default())
         .allow_scroll(false)
         .show(ui, |plot| {
             plot.line(series("inverted tets", |s| s.metrics.inverted_tets as f64));
         });
     Plot::new("volume plot")
-        .height(110.0)
+        .height(PLOT_HEIGHT)
         .legend(Legend::default())
         .allow_scroll(false)
         .show(ui, |plot| {
             plot.line(series("min V/V0", |s| s.metrics.min_volume_ratio));
             plot.line(series("volume error", |s| s.metrics.volume_error));
+        });
+    // The energy account: a total that rises, beyond what a violated rigid family releases, is
+    // a gain (tetlab_core::measures::energy_account).
+    Plot::new("energy plot")
+        .height(PLOT_HEIGHT)
+        .legend(Legend::default())
+        .allow_scroll(false)
+        .show(ui, |plot| {
+            plot.line(series("total energy, J", |s| s.energy[3]));
+            plot.line(series("kinetic", |s| s.energy[0]));
+            plot.line(series("elastic", |s| s.energy[2]));
         });
 }

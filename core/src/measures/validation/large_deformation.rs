@@ -15,8 +15,8 @@
 use super::at_rest::{AtRest, neohookean};
 use super::{Case, Check, Stop, Trial};
 use crate::constraints::material::Material;
+use crate::measures::energy_account::EnergyWatch;
 use crate::scene::{Scene, lattice};
-use crate::simulation::Simulation;
 use glam::{DQuat, DVec3};
 
 /// The twist.
@@ -131,10 +131,12 @@ fn recover(
     debug_assert_eq!(settings.active, neohookean());
     let mut simulation = trial.simulation(what, scene, settings);
     simulation.set_positions(start);
-    let budget = elastic_energy(&simulation) + potential_energy(&simulation, gravity);
+    let mut account = EnergyWatch::start(&simulation);
+    let budget = account.last().total;
     let mut most_kinetic: f64 = 0.0;
     let rest_state = RECOVERY.run_watching(trial, &mut simulation, |simulation| {
-        most_kinetic = most_kinetic.max(kinetic_energy(simulation));
+        let energy = account.observe(simulation, simulation.frame());
+        most_kinetic = most_kinetic.max(energy.kinetic);
     })?;
     let metrics = crate::measures::metrics::Metrics::measure(&simulation);
     Ok(vec![
@@ -143,6 +145,12 @@ fn recover(
             budget,
             "energy at the start (elastic + potential above the ground): a damped body gains none",
             most_kinetic,
+        ),
+        Check::at_most(
+            format!("{what}: largest rise of the energy above its lowest before, J"),
+            account.bound(),
+            "the energy account: nothing gives energy (1 % of what the body could give back)",
+            account.gain.as_ref().map_or(0.0, |g| g.amount),
         ),
         rest_state.check(what, &RECOVERY, &settings),
         Check::at_most(
@@ -158,52 +166,4 @@ fn recover(
             metrics.max_edge_strain,
         ),
     ])
-}
-
-/// Σ ½ mᵢ |vᵢ|² over the free particles.
-fn kinetic_energy(simulation: &Simulation) -> f64 {
-    simulation
-        .velocities()
-        .iter()
-        .zip(simulation.inverse_masses())
-        .filter(|(_, w)| **w > 0.0)
-        .map(|(v, w)| 0.5 * v.length_squared() / w)
-        .sum()
-}
-
-/// Σ mᵢ g yᵢ over the free particles: the potential energy above the ground (y = 0).
-fn potential_energy(simulation: &Simulation, gravity: f64) -> f64 {
-    simulation
-        .positions()
-        .iter()
-        .zip(simulation.inverse_masses())
-        .filter(|(_, w)| **w > 0.0)
-        .map(|(p, w)| gravity * p.y.max(0.0) / w)
-        .sum()
-}
-
-/// The neo-Hookean energy of the current shape, Σ over tets of V₀ Ψ(F), with
-/// Ψ = μ/2 (tr FᵀF − 3) + λ/2 (det F − γ)² − λ/2 (1 − γ)²: zero at rest.
-fn elastic_energy(simulation: &Simulation) -> f64 {
-    let material = simulation.settings().material;
-    let (mu, lambda, gamma) = (material.mu(), material.lambda(), material.gamma());
-    let rest = simulation.rest_positions();
-    let now = simulation.positions();
-    simulation
-        .tets()
-        .iter()
-        .map(|tet| {
-            let [a, b, c, d] = tet.map(|i| rest[i as usize]);
-            let dm = glam::DMat3::from_cols(b - a, c - a, d - a);
-            let [p, q, r, s] = tet.map(|i| now[i as usize]);
-            let ds = glam::DMat3::from_cols(q - p, r - p, s - p);
-            let f = ds * dm.inverse();
-            let frobenius =
-                f.x_axis.length_squared() + f.y_axis.length_squared() + f.z_axis.length_squared();
-            let j = f.determinant();
-            let psi = mu / 2.0 * (frobenius - 3.0)
-                + lambda / 2.0 * ((j - gamma).powi(2) - (1.0 - gamma).powi(2));
-            dm.determinant().abs() / 6.0 * psi
-        })
-        .sum()
 }

@@ -20,9 +20,12 @@
 mod at_rest;
 mod bars;
 mod cook;
+pub mod discrete;
 mod large_deformation;
 mod patch;
 mod stretch;
+
+pub use discrete::Judged;
 
 use crate::measures::metrics::Metrics;
 use crate::scene::Scene;
@@ -44,7 +47,17 @@ pub struct Check {
     pub source: String,
     /// What the run measured.
     pub measured: f64,
-    /// |measured − reference| / |reference|, or the absolute error where the reference is 0.
+    /// The same quantity of the exact solution of the same discrete problem (the Newton
+    /// reference on the same mesh, [`discrete`]), for a static case.
+    pub discrete: Option<f64>,
+    /// The solver's error: |measured − discrete| / |discrete|.
+    pub solver_error: Option<f64>,
+    /// The mesh's error: |discrete − reference| / |reference|.
+    pub mesh_error: Option<f64>,
+    /// Which error the criterion is on ([`Judged`]).
+    pub judged: Judged,
+    /// The error the criterion is on: |measured − reference| / |reference| (or the absolute
+    /// error where the reference is 0), or the solver's or the mesh's ([`Check::judged`]).
     pub error: f64,
     /// What passing means ("error ≤ 1 %").
     pub criterion: String,
@@ -68,6 +81,10 @@ impl Check {
             reference,
             source: source.into(),
             measured,
+            discrete: None,
+            solver_error: None,
+            mesh_error: None,
+            judged: Judged::Total,
             error,
             criterion,
             passed,
