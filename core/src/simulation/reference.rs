@@ -65,8 +65,9 @@ impl<'a> OnState<'a> {
         }
     }
 
-    /// The state the stages work on.
-    pub(crate) fn state(&mut self) -> &mut State {
+    /// The state the stages work on: what an engine that wraps these stages reads and changes
+    /// between them (the Newton reference solves the substep on it).
+    pub fn state(&mut self) -> &mut State {
         self.state
     }
 
