@@ -42,6 +42,48 @@ pub fn value_and_gradient<T: Real<Mask = bool>, const N: usize>(
     )
 }
 
+/// C and ∇C (one row per particle, the unused rows 0) of the constraint on `particles` of
+/// `family`, with its rest value and stored numbers `rest`, at positions `x` (every particle's),
+/// its rest shape from `rest_positions`: [`value_and_gradient`] in f64 for a constraint of any
+/// arity, read from the simulation's flat arrays.
+///
+/// ```
+/// use glam::DVec3;
+/// use tetlab_core::constraints::differentiable::of_constraint;
+/// use tetlab_core::constraints::{Families, Family};
+/// let x = [DVec3::ZERO, DVec3::new(3.0, 0.0, 4.0)];
+/// let (c, g) = of_constraint(&Families::builtin(), Family::EDGES, &[0, 1], (4.0, &[]), &x, &x);
+/// assert_eq!(c, 1.0);
+/// assert_eq!((g[1], g[2]), ([0.6, 0.0, 0.8], [0.0; 3]));
+/// ```
+pub fn of_constraint(
+    families: &Families,
+    family: Family,
+    particles: &[u32],
+    rest: (f64, &[f64]),
+    x: &[DVec3],
+    rest_positions: &[DVec3],
+) -> (f64, [[f64; 3]; 4]) {
+    fn at<const N: usize>(
+        (families, family, particles, rest): (&Families, Family, &[u32], (f64, &[f64])),
+        x: &[DVec3],
+        rest_positions: &[DVec3],
+    ) -> (f64, [[f64; 3]; 4]) {
+        let p: [[f64; 3]; N] = std::array::from_fn(|k| x[particles[k] as usize].to_array());
+        let shape: [DVec3; N] = std::array::from_fn(|k| rest_positions[particles[k] as usize]);
+        let (value, gradients) = value_and_gradient(families, family, &p, rest, &shape);
+        let mut padded = [[0.0; 3]; 4];
+        padded[..N].copy_from_slice(&gradients);
+        (value, padded)
+    }
+    let constraint = (families, family, particles, rest);
+    match particles.len() {
+        2 => at::<2>(constraint, x, rest_positions),
+        3 => at::<3>(constraint, x, rest_positions),
+        _ => at::<4>(constraint, x, rest_positions),
+    }
+}
+
 /// One constraint of a built-in family evaluated at `x`, in the number type of `x`.
 struct At<'a, T, const M: usize> {
     x: &'a [[T; 3]; M],

@@ -19,7 +19,7 @@
 //! own dissipation take energy; nothing else gives any. So beyond such a release E never grows,
 //! less rounding: [`EnergyWatch`] says where it does.
 
-use crate::constraints::differentiable::value_and_gradient;
+use crate::constraints::differentiable::of_constraint;
 use crate::constraints::{Family, PerFamily};
 use crate::simulation::Simulation;
 use glam::DVec3;
@@ -131,23 +131,20 @@ fn values<'a>(
     family: Family,
     x: &'a [DVec3],
 ) -> impl Iterator<Item = (f64, f64)> + 'a {
-    fn at<const N: usize>(simulation: &Simulation, family: Family, x: &[DVec3], c: usize) -> f64 {
-        let body = simulation.body();
-        let set = &body.sets[family];
-        let idx = set.particles(c);
-        let p: [[f64; 3]; N] = std::array::from_fn(|k| x[idx[k] as usize].to_array());
-        let shape: [DVec3; N] = std::array::from_fn(|k| body.rest_positions[idx[k] as usize]);
-        let rest = (set.rest()[c], set.stored(c));
-        value_and_gradient(simulation.families(), family, &p, rest, &shape).0
-    }
-    let set = &simulation.body().sets[family];
-    let arity = simulation.families().arity(family);
+    let body = simulation.body();
+    let set = &body.sets[family];
     (0..set.len()).map(move |c| {
-        let value = match arity {
-            2 => at::<2>(simulation, family, x, c),
-            3 => at::<3>(simulation, family, x, c),
-            _ => at::<4>(simulation, family, x, c),
-        };
+        let rest = (set.rest()[c], set.stored(c));
+        let particles = set.particles(c);
+        let value = of_constraint(
+            simulation.families(),
+            family,
+            particles,
+            rest,
+            x,
+            &body.rest_positions,
+        )
+        .0;
         (value, set.size()[c])
     })
 }

@@ -7,7 +7,7 @@
 //! order in how far the gradients turned during the substep.
 
 use glam::DVec3;
-use tetlab_core::constraints::differentiable::value_and_gradient;
+use tetlab_core::constraints::differentiable::of_constraint;
 use tetlab_core::constraints::{Families, PerFamily, Unit};
 use tetlab_core::simulation::projection::SkipCounts;
 use tetlab_core::simulation::substep::{self, GrabbedParticle, Plan, Substeps};
@@ -75,38 +75,20 @@ impl Rebuilding<'_> {
                     }
                     let idx = set.particles(c);
                     let rest = (set.rest()[c], set.stored(c));
-                    let mut add = |gradients: &[[f64; 3]]| {
-                        for (k, g) in gradients.iter().enumerate() {
-                            let i = idx[k] as usize;
-                            let w = state.inverse_masses[i];
-                            moved[i] += w * lambda * DVec3::from_array(*g);
-                        }
-                    };
-                    match idx.len() {
-                        2 => add(&gradient::<2>(
-                            families,
-                            family,
-                            &state.positions,
-                            idx,
-                            rest,
-                            body,
-                        )),
-                        3 => add(&gradient::<3>(
-                            families,
-                            family,
-                            &state.positions,
-                            idx,
-                            rest,
-                            body,
-                        )),
-                        _ => add(&gradient::<4>(
-                            families,
-                            family,
-                            &state.positions,
-                            idx,
-                            rest,
-                            body,
-                        )),
+                    let (value, gradients) = of_constraint(
+                        families,
+                        family,
+                        idx,
+                        rest,
+                        &state.positions,
+                        &body.rest_positions,
+                    );
+                    if !value.is_finite() || gradients.iter().flatten().any(|g| !g.is_finite()) {
+                        continue;
+                    }
+                    for (&i, g) in idx.iter().zip(&gradients) {
+                        let (i, w) = (i as usize, state.inverse_masses[i as usize]);
+                        moved[i] += w * lambda * DVec3::from_array(*g);
                     }
                 }
             }
@@ -116,25 +98,6 @@ impl Rebuilding<'_> {
                 }
             }
         }
-    }
-}
-
-/// ∇C of one constraint at `x`, per particle.
-fn gradient<const N: usize>(
-    families: &Families,
-    family: tetlab_core::constraints::Family,
-    x: &[DVec3],
-    idx: &[u32],
-    rest: (f64, &[f64]),
-    body: &Body,
-) -> [[f64; 3]; N] {
-    let p: [[f64; 3]; N] = std::array::from_fn(|k| x[idx[k] as usize].to_array());
-    let shape: [DVec3; N] = std::array::from_fn(|k| body.rest_positions[idx[k] as usize]);
-    let (value, gradients) = value_and_gradient(families, family, &p, rest, &shape);
-    if value.is_finite() && gradients.iter().flatten().all(|g| g.is_finite()) {
-        gradients
-    } else {
-        [[0.0; 3]; N]
     }
 }
 

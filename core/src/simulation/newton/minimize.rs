@@ -125,9 +125,8 @@ fn violation(objective: &Objective<'_>, x: &[DVec3], size: f64) -> f64 {
             continue;
         }
         let set = &objective.body.sets[family];
-        let arity = objective.families.arity(family);
         for c in 0..set.len() {
-            let value = objective.constraint_value(family, arity, c, x);
+            let value = objective.constraint_value(family, c, x);
             worst = worst.max(value.abs() / set.size()[c].max(f64::MIN_POSITIVE));
         }
     }
@@ -218,9 +217,8 @@ fn update_multipliers(objective: &Objective<'_>, x: &[DVec3], multipliers: &mut 
         if objective.terms[family] != Term::Rigid {
             continue;
         }
-        let arity = objective.families.arity(family);
         for c in 0..objective.body.sets[family].len() {
-            let value = objective.constraint_value(family, arity, c, x);
+            let value = objective.constraint_value(family, c, x);
             multipliers.rigid[family][c] += multipliers.rho * value;
         }
     }

@@ -20,7 +20,7 @@
 //! definite and every Newton step goes down.
 
 use super::super::state::Body;
-use crate::constraints::differentiable::{Matrix12, second_order, value_and_gradient};
+use crate::constraints::differentiable::{Matrix12, of_constraint, second_order};
 use crate::constraints::{Families, Family, PerFamily};
 use glam::DVec3;
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -166,11 +166,11 @@ impl Objective<'_> {
     /// Φ at `x`.
     pub(super) fn value(&self, x: &[DVec3], multipliers: &Multipliers) -> f64 {
         let mut sum = 0.0;
-        for (family, arity) in self.families() {
+        for (family, _) in self.families() {
             let set = &self.body.sets[family];
             for c in 0..set.len() {
                 let (k, offset) = self.scale(family, c, multipliers);
-                let value = self.constraint_value(family, arity, c, x);
+                let value = self.constraint_value(family, c, x);
                 // ½ k (C + o)² less its constant ½ k o²: λ C + ½ ρ C² for a rigid constraint.
                 sum += 0.5 * k * value * (value + 2.0 * offset);
             }
@@ -222,26 +222,19 @@ impl Objective<'_> {
     }
 
     /// C of constraint `c` of `family` at `x`.
-    pub(super) fn constraint_value(
-        &self,
-        family: Family,
-        arity: usize,
-        c: usize,
-        x: &[DVec3],
-    ) -> f64 {
-        fn at<const N: usize>(o: &Objective<'_>, family: Family, c: usize, x: &[DVec3]) -> f64 {
-            let set = &o.body.sets[family];
-            let idx = set.particles(c);
-            let p: [[f64; 3]; N] = std::array::from_fn(|k| x[idx[k] as usize].to_array());
-            let shape: [DVec3; N] = std::array::from_fn(|k| o.body.rest_positions[idx[k] as usize]);
-            let rest = (set.rest()[c], set.stored(c));
-            value_and_gradient(o.families, family, &p, rest, &shape).0
-        }
-        match arity {
-            2 => at::<2>(self, family, c, x),
-            3 => at::<3>(self, family, c, x),
-            _ => at::<4>(self, family, c, x),
-        }
+    pub(super) fn constraint_value(&self, family: Family, c: usize, x: &[DVec3]) -> f64 {
+        let set = &self.body.sets[family];
+        let rest = (set.rest()[c], set.stored(c));
+        let particles = set.particles(c);
+        of_constraint(
+            self.families,
+            family,
+            particles,
+            rest,
+            x,
+            &self.body.rest_positions,
+        )
+        .0
     }
 
     /// ∇Φ and ∇²Φ at `x`, the Hessian in the order of [`Objective::pattern`].
