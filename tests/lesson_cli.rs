@@ -55,6 +55,14 @@ fn the_gradient_exercise_fails_until_the_student_mends_the_file() {
         unobserved[1].starts_with("NOT OBSERVED: max_edge_strain < 1e-6"),
         "{text}"
     );
+    // Each step that runs frames prints its energy account; the wrong gradient pumps energy in,
+    // and the account says so, in the three steps that project along it.
+    let accounts = text.lines().filter(|l| l.starts_with("energy: ")).count();
+    let gains = text
+        .lines()
+        .filter(|l| l.starts_with("warning: the energy grew by"))
+        .count();
+    assert_eq!((accounts, gains), (3, 3), "{text}");
 
     let dir = scratch("exercise");
     let wrong = std::fs::read_to_string(asset("constraints/height-wrong-sign.toml")).unwrap();
@@ -67,6 +75,11 @@ fn the_gradient_exercise_fails_until_the_student_mends_the_file() {
         text.contains("observed: gradient_error.height-wrong-sign < 1e-6"),
         "{text}"
     );
+    let gains = text
+        .lines()
+        .filter(|l| l.starts_with("warning: the energy grew by"))
+        .count();
+    assert_eq!(gains, 2, "mended, the last step gains no energy: {text}");
 
     let broken = dir.join("broken.toml");
     std::fs::write(&broken, wrong.replace("g3 = (cross", "g3 = (crosss")).unwrap();

@@ -262,6 +262,9 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
         };
         if step.frames > 0 {
             writeln!(out, "(ran {} frames)", step.frames).map_err(UsageError::stdout)?;
+            for line in run.energy().lines() {
+                writeln!(out, "{line}").map_err(UsageError::stdout)?;
+            }
         }
         for (expectation, value, observed) in &outcome.checks {
             all_observed &= observed;

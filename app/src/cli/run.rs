@@ -172,7 +172,6 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
     let mut outcome = Outcome::start(&simulation, &initial);
     let mut energy = EnergyWatch::start(&simulation);
-    let energy_start = energy.last().total;
     if args.json {
         let record = FrameRecord::new(&simulation, &initial, energy.last(), outcome.start);
         write_json(out, &record).map_err(io)?;
@@ -249,21 +248,9 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         for line in super::simulation_args::describe_skipped(&simulation) {
             writeln!(out, "{line}").map_err(io)?;
         }
-        let start = energy_start;
-        writeln!(
-            out,
-            "energy: {:.4e} J at the start, {:.4e} J at the end (kinetic {:.3e}, gravitational \
-             {:.3e}, elastic {:.3e})",
-            start,
-            energy.last().total,
-            energy.last().kinetic,
-            energy.last().gravitational,
-            energy.last().total
-                - energy.last().kinetic
-                - energy.last().gravitational
-                - energy.last().external
-        )
-        .map_err(io)?;
+        for line in energy.lines() {
+            writeln!(out, "{line}").map_err(io)?;
+        }
         if let Some((relative, metres, frame)) = largest_gap {
             let unconverged = if gaps_converged {
                 ""
@@ -278,46 +265,15 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             )
             .map_err(io)?;
         }
-        if energy.released > 0.0 {
-            writeln!(
-                out,
-                "energy released by rigid families undoing a violated start: {:.4e} J (a rigid \
-                 family stores no energy the account can measure)",
-                energy.released
-            )
-            .map_err(io)?;
-        }
-        if let Some(gain) = &energy.gain {
-            writeln!(
-                out,
-                "warning: the energy grew by {:.3e} J above its lowest by frame {} (more than \
-                 {:.3e} J, 1 % of what the body could give back), most in {}",
-                gain.amount,
-                gain.frame,
-                energy.bound(),
-                gain.from
-            )
-            .map_err(io)?;
-        }
-        if let Some(newton) = simulation.engine_as::<NewtonEngine>()
-            && newton.unconverged() > 0
+        if let Some(warning) = simulation
+            .engine_as::<NewtonEngine>()
+            .and_then(|newton| newton.warning())
         {
-            let last = newton.last_report();
-            writeln!(
-                out,
-                "warning: the Newton reference did not solve {} substeps to its tolerance (the \
-                 last: residual {:.1e}, violation {:.1e}); its answer there is a local one",
-                newton.unconverged(),
-                last.residual,
-                last.violation
-            )
-            .map_err(io)?;
+            writeln!(out, "warning: {warning}").map_err(io)?;
         }
         if let Some(warning) = outcome.thrown_warning() {
             let advice = if simulation.resolved().edits_settle() {
                 ""
-            } else if simulation.settings().settle_edits {
-                " (edits do not settle while a material is active)"
             } else {
                 " (--no-settle-edits: without it, edits settle and the body recovers where it lies)"
             };

@@ -297,16 +297,12 @@ pub fn describe_order(settings: &Settings) -> String {
     }
 }
 
-/// ", edits settle", ", edits do not settle (--no-settle-edits)", or why they do not settle
-/// although asked to ([`Resolved::edits_settle`]: a material is active).
+/// ", edits settle" or ", edits do not settle (--no-settle-edits)" ([`Resolved::edits_settle`]).
 pub fn describe_settling(resolved: &Resolved) -> String {
-    match (resolved.settings.settle_edits, resolved.edits_settle()) {
-        (_, true) => ", edits settle".to_owned(),
-        (false, false) => ", edits do not settle (--no-settle-edits)".to_owned(),
-        (true, false) => ", edits do not settle while neohookean is active (a material carries \
-                          its own momentum through an inversion; capping it leaves the body \
-                          squashed)"
-            .to_owned(),
+    if resolved.edits_settle() {
+        ", edits settle".to_owned()
+    } else {
+        ", edits do not settle (--no-settle-edits)".to_owned()
     }
 }
 

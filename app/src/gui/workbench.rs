@@ -8,6 +8,7 @@ use tetlab_core::measures::energy_account::Energy;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::simulation::divergence::Divergence;
+use tetlab_core::simulation::newton::NewtonEngine;
 use tetlab_core::simulation::{Settings, Simulation};
 use tetlab_core::teaching::lesson::{Action as LessonAction, Measured};
 use tetlab_core::teaching::stepper::{Advanced, StepByStep};
@@ -64,6 +65,9 @@ pub struct Workbench {
     /// Why the settings may blow up ([`Simulation::stability_warning`]), as of the last change
     /// of settings.
     pub stability_warning: Option<String>,
+    /// Where the Newton reference steps the simulation and some substep's solve did not
+    /// converge, what it says ([`NewtonEngine::warning`]), as of the last step.
+    pub newton_warning: Option<String>,
     /// Grows with every change of the simulation's state: what the view compares to know whether
     /// to draw again.
     revision: u64,
@@ -114,6 +118,7 @@ impl Workbench {
         simulation.set_threads(threads());
         let mut workbench = Workbench {
             stability_warning: simulation.stability_warning(),
+            newton_warning: None,
             scene,
             metrics: Metrics::measure(&simulation),
             simulation,
@@ -172,6 +177,9 @@ impl Workbench {
     pub fn step_frame(&mut self) {
         self.leave_step_mode();
         self.simulation.step();
+        // The engine that just stepped is ready: asking for it builds nothing.
+        self.newton_warning =
+            (self.simulation.engine_as::<NewtonEngine>()).and_then(|newton| newton.warning());
         self.after_change();
     }
 
@@ -428,6 +436,7 @@ impl Workbench {
     /// back to rest, paused, and [`Workbench::diverged`] says why.
     fn after_change(&mut self) {
         self.revision += 1;
+
         match Metrics::measure_sound(&self.simulation) {
             Ok(metrics) => self.metrics = metrics,
             Err(divergence) => {
@@ -464,6 +473,35 @@ impl Workbench {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The Newton reference allowed one Newton iteration a substep: it cannot converge.
+    fn one_iteration(
+        _: tetlab_core::simulation::Start<'_>,
+    ) -> Box<dyn tetlab_core::simulation::Engine> {
+        let options = tetlab_core::simulation::newton::Options {
+            max_iterations: 1,
+            max_outer_iterations: 1,
+            ..Default::default()
+        };
+        Box::new(NewtonEngine::with_options(options))
+    }
+
+    #[test]
+    fn the_readouts_warn_when_the_newton_reference_did_not_converge() {
+        let mut bench = Workbench::builtin(Builtin::Cube, 1, Settings::default());
+        bench.step_frame();
+        assert_eq!(bench.newton_warning, None, "the reference engine steps it");
+        bench
+            .simulation
+            .use_engine(one_iteration, "newton, one iteration");
+        bench.perturb(Perturbation::Flatten);
+        bench.step_frame();
+        let warning = bench.newton_warning.clone().expect("a warning");
+        assert!(
+            warning.starts_with("the Newton reference did not solve"),
+            "{warning}"
+        );
+    }
 
     #[test]
     fn inverting_the_selected_tet_then_playing_recovers_it() {

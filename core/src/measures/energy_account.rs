@@ -6,20 +6,28 @@
 //! - K = Σᵢ ½ mᵢ |vᵢ|², the kinetic energy of the free particles (held ones have no mass here);
 //! - U_g = Σᵢ mᵢ g yᵢ, gravity's, above the ground's height y = 0;
 //! - U_f = −Σᵢ fᵢ·(xᵢ − x⁰ᵢ), the constant external forces', zero at the rest shape;
-//! - U_c = Σ_c ½ (C_c(x)² − C_c(x⁰)²) / α for each active compliant family: the energy XPBD's
-//!   compliance stands for (the material's, for the neo-Hookean pair), zero at the rest shape
-//!   (the pair is pre-stressed: its terms do not vanish there, their sum's gradient does).
+//! - U_c = Σ_c ½ (C_c(x)² − C_c(x⁰)²) / α for each active family that stores energy
+//!   ([`crate::simulation::Resolved::stores_energy`]: compliant, under XPBD or a material): the
+//!   energy XPBD's compliance stands for (the material's, for the neo-Hookean pair), zero at
+//!   the rest shape (the pair is pre-stressed: its terms do not vanish there, their sum's
+//!   gradient does).
 //!
-//! A rigid family (α = 0) stores no energy: what it holds it holds exactly, and a start that
-//! violates it (a mirrored body under rigid edges) has a store the account cannot see, released
-//! as motion and height while the violation is undone. The account measures that violation
-//! ([`Energy::violation`]) and books a rise of E in a frame that began with a rigid family
-//! violated as that release, not as a gain: the account judges energy while the rigid families
-//! hold. Damping, the ground's sticking and XPBD's
-//! own dissipation take energy; nothing else gives any. So beyond such a release E never grows,
-//! less rounding: [`EnergyWatch`] says where it does.
+//! Two kinds of family have a store the account cannot measure: a rigid one (α = 0), which holds
+//! exactly what it holds, and one under PBD's stiffness k, which is no material constant (the
+//! same k is stiffer at more substeps). A start that violates one (a mirrored body under rigid
+//! edges) holds a store the account cannot see, released as motion and height while the
+//! violation is undone. The account measures how far each such family is from holding
+//! ([`Energy::violation`]) and books a rise of E in a frame that began with one violated as
+//! that release, not as a gain, up to what the store can hold: for rigid families, whose store
+//! only a violated start (an edit) fills, ½ M (L / h)² over the run, the body's mass M moving
+//! its length L within one substep h, since a rigid projection undoes a violation within a
+//! substep and none asks a particle to cross more than the body; for PBD's stiffness, which stores as the body strains, what
+//! undoing the frame's fall in violation within a substep gives. A rise beyond that is a gain:
+//! a projection along a wrong gradient (lesson 8's) pumps energy in exactly so.
+//! Damping, the ground's sticking and XPBD's own dissipation take energy; nothing else gives
+//! any. So beyond such a release E never grows, less rounding: [`EnergyWatch`] says where it
+//! does.
 
-use crate::constraints::differentiable::of_constraint;
 use crate::constraints::{Family, PerFamily};
 use crate::simulation::Simulation;
 use glam::DVec3;
@@ -38,16 +46,16 @@ pub struct Energy {
     pub elastic: PerFamily<f64>,
     /// The sum of them all.
     pub total: f64,
-    /// Of each active rigid family, how far it is from holding: the largest and the sum of
-    /// |C| over its constraints, each relative to its element's size ((0, 0) for the others).
-    /// Not energy: a rigid family has none to measure.
+    /// Of each active family whose store the account cannot measure (rigid, or under PBD's
+    /// stiffness), how far it is from holding: the largest and the sum of the relative violations
+    /// of its constraints ([`VIOLATED`]; (0, 0) for the others). Not energy.
     #[serde(skip)]
     pub violation: PerFamily<(f64, f64)>,
 }
 
-/// A rigid family counts as violated, and a rise of the energy while it is as a release of what
-/// it held, above this violation (0.1 % of an element's size).
-pub const VIOLATED: f64 = 1e-3;
+/// A family without a measurable store counts as violated above this relative violation (0.1 %
+/// of an element), and a rise of the energy while it is undone as a release of what it held.
+pub use crate::simulation::VIOLATED;
 
 impl Energy {
     /// The energy of `simulation`'s state.
@@ -82,18 +90,17 @@ impl Energy {
                 external -= f.dot(positions[i] - body.rest_positions[i]);
             }
         }
+        let resolved = simulation.resolved();
         let elastic = simulation.families().per_family(|family| {
-            let compliance = simulation.resolved().compliance[family];
-            if !simulation.active()[family] || compliance <= 0.0 {
+            if !simulation.active()[family] || !resolved.stores_energy(family) {
                 return 0.0;
             }
             let now = squared_values(simulation, family, positions);
-            let rest = squared_values(simulation, family, &body.rest_positions);
-            0.5 * (now - rest) / compliance
+            let rest = body.sets[family].rest_squared();
+            0.5 * (now - rest) / resolved.compliance[family]
         });
         let violation = simulation.families().per_family(|family| {
-            let rigid = simulation.resolved().compliance[family] <= 0.0;
-            if !simulation.active()[family] || !rigid {
+            if !simulation.active()[family] || resolved.stores_energy(family) {
                 return (0.0, 0.0);
             }
             violation(simulation, family, positions)
@@ -112,41 +119,19 @@ impl Energy {
 
 /// Σ_c C_c(x)² over `family`'s constraints at positions `x` (a C that is not finite left out).
 fn squared_values(simulation: &Simulation, family: Family, x: &[DVec3]) -> f64 {
-    values(simulation, family, x)
+    simulation
+        .constraint_values(family, x)
         .map(|(c, _)| if c.is_finite() { c * c } else { 0.0 })
         .sum()
 }
 
-/// max_c and Σ_c of |C_c(x)| / size_c over `family`'s constraints at positions `x`.
+/// max_c and Σ_c of the relative violation of `family`'s constraints at positions `x`
+/// ([`crate::simulation::VIOLATED`]), those with a finite one.
 fn violation(simulation: &Simulation, family: Family, x: &[DVec3]) -> (f64, f64) {
-    values(simulation, family, x)
-        .map(|(c, size)| (c / size.max(f64::MIN_POSITIVE)).abs())
+    (simulation.constraint_values(family, x))
+        .map(|(_, violation)| violation)
         .filter(|v| v.is_finite())
         .fold((0.0, 0.0), |(largest, sum), v| (largest.max(v), sum + v))
-}
-
-/// C of each of `family`'s constraints at positions `x`, with its element's size.
-fn values<'a>(
-    simulation: &'a Simulation,
-    family: Family,
-    x: &'a [DVec3],
-) -> impl Iterator<Item = (f64, f64)> + 'a {
-    let body = simulation.body();
-    let set = &body.sets[family];
-    (0..set.len()).map(move |c| {
-        let rest = (set.rest()[c], set.stored(c));
-        let particles = set.particles(c);
-        let value = of_constraint(
-            simulation.families(),
-            family,
-            particles,
-            rest,
-            x,
-            &body.rest_positions,
-        )
-        .0;
-        (value, set.size()[c])
-    })
 }
 
 /// Where a run's energy grew past the bound: the frame, by how much (J), and what grew most in
@@ -166,16 +151,26 @@ pub struct Gain {
 /// A run that only loses energy never rises above its lowest total. The bound a rise is held to
 /// is [`EnergyWatch::TOLERANCE`] of the run's scale: the start's kinetic, elastic and external
 /// energy plus its weight times its height above the ground and the body's size (what it could
-/// give back at most), so that rounding in the sums is never a gain.
+/// give back at most), plus what rounding can make of a body that holds nothing (its mass moving
+/// a body length a frame at f32's precision), so that rounding in the sums is never a gain.
 #[derive(Clone, Debug)]
 pub struct EnergyWatch {
     lowest: f64,
+    /// What the rigid families' violated start can still release, J: at most the body's mass
+    /// moving its length within one substep, ½ M (L / h)², since a rigid projection undoes a
+    /// violation within a substep and none asks a particle to cross more than the body.
+    budget: f64,
+    /// The mass of the free particles, kg.
+    mass: f64,
     scale: f64,
+    /// The total at the start, J.
+    pub start_total: f64,
     last: Energy,
     /// The largest rise above the lowest total before it, once it passed the bound.
     pub gain: Option<Gain>,
-    /// What rigid families released so far (J): the rises of frames that began with a rigid
-    /// family violated (beyond [`VIOLATED`]).
+    /// What families without a measurable store (rigid, or under PBD's stiffness) released so
+    /// far (J): the rises of frames that began with one violated (beyond [`VIOLATED`]), up to
+    /// what its store can hold (module docs).
     pub released: f64,
 }
 
@@ -188,19 +183,33 @@ impl EnergyWatch {
         let energy = Energy::measure(simulation);
         let body = simulation.body();
         let size = body.rest_diagonal();
-        let weight: f64 = (simulation.inverse_masses().iter())
+        let mass: f64 = (simulation.inverse_masses().iter())
             .zip(&body.lumped_inverse_masses)
             .filter(|(w, _)| **w > 0.0)
-            .map(|(_, lumped)| simulation.settings().gravity.abs() / lumped)
+            .map(|(_, lumped)| 1.0 / lumped)
             .sum();
+        let weight = mass * simulation.settings().gravity.abs();
+        // What rounding alone can make of a body that holds nothing (no gravity, at rest): its
+        // mass moving a body length a frame, at f32's relative precision (the fast engine's).
+        let rounding = mass * (size / simulation.settings().dt).powi(2) * f64::from(f32::EPSILON);
         let elastic: f64 = simulation.families().all().map(|f| energy.elastic[f]).sum();
         let scale = energy.kinetic
             + elastic.abs()
             + energy.external.abs()
             + energy.gravitational.abs()
-            + weight * size;
+            + weight * size
+            + rounding;
         EnergyWatch {
             lowest: energy.total,
+            budget: {
+                let rigid = |f: &Family| simulation.resolved().compliance[*f] <= 0.0;
+                let violated = (simulation.families().all().filter(rigid))
+                    .any(|f| energy.violation[f].0 > VIOLATED);
+                let v = size / simulation.substep_length();
+                if violated { 0.5 * mass * v * v } else { 0.0 }
+            },
+            mass,
+            start_total: energy.total,
             scale: scale.max(f64::MIN_POSITIVE),
             last: energy,
             gain: None,
@@ -212,14 +221,31 @@ impl EnergyWatch {
     pub fn observe(&mut self, simulation: &Simulation, frame: u64) -> &Energy {
         let energy = Energy::measure(simulation);
         let step = energy.total - self.last.total;
-        let releasing = simulation
-            .families()
-            .all()
-            .any(|f| self.last.violation[f].0 > VIOLATED);
-        if releasing && step > 0.0 {
-            // A rigid family's store, let go: the level it lifts the total to is the new floor.
-            self.released += step;
-            self.lowest += step;
+        // A store the account cannot measure is released while it is undone (module docs):
+        // a rigid family's from the budget its violated start holds, in frames that begin with
+        // it violated; one under PBD's stiffness as its strain goes, up to what undoing that
+        // much within a substep can give.
+        let speed = |d: f64| d * simulation.body().mean_edge / simulation.substep_length();
+        let (mut rigid, mut stiffness) = (false, 0.0f64);
+        for f in simulation.families().all() {
+            let (before, after) = (self.last.violation[f], energy.violation[f]);
+            if before.0 <= VIOLATED {
+                continue;
+            }
+            if simulation.resolved().compliance[f] <= 0.0 {
+                rigid = true;
+            } else {
+                let v = speed((before.1 - after.1).max(0.0));
+                stiffness = stiffness.max(0.5 * self.mass * v * v);
+            }
+        }
+        let available = stiffness + if rigid { self.budget } else { 0.0 };
+        if step > 0.0 && available > 0.0 {
+            let release = step.min(available);
+            self.budget -= (release - stiffness).clamp(0.0, self.budget);
+            // An unmeasured store, let go: the level it lifts the total to is the new floor.
+            self.released += release;
+            self.lowest += release;
         }
         let rise = energy.total - self.lowest;
         let largest = self.gain.as_ref().map_or(0.0, |g| g.amount);
@@ -243,6 +269,52 @@ impl EnergyWatch {
     /// The last frame's energy.
     pub fn last(&self) -> &Energy {
         &self.last
+    }
+
+    /// What a front end prints of the account: the total at the start and now with the parts
+    /// of the last, what unmeasured stores released (if any), and a warning naming the frame and
+    /// what rose most where the total grew past the bound.
+    ///
+    /// ```
+    /// use tetlab_core::measures::energy_account::EnergyWatch;
+    /// use tetlab_core::scene::{Builtin, Scene};
+    /// use tetlab_core::simulation::{Settings, Simulation};
+    /// let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
+    /// let mut simulation = Simulation::new(&scene, Settings::default());
+    /// let mut watch = EnergyWatch::start(&simulation);
+    /// simulation.step();
+    /// watch.observe(&simulation, 1);
+    /// // A cube at rest on the ground keeps its energy: one line, no warning.
+    /// let lines = watch.lines();
+    /// assert_eq!(lines.len(), 1);
+    /// assert!(lines[0].starts_with("energy: "), "{lines:?}");
+    /// ```
+    pub fn lines(&self) -> Vec<String> {
+        let last = &self.last;
+        let elastic = last.total - last.kinetic - last.gravitational - last.external;
+        let mut lines = vec![format!(
+            "energy: {:.4e} J at the start, {:.4e} J at the end (kinetic {:.3e}, gravitational \
+             {:.3e}, elastic {:.3e})",
+            self.start_total, last.total, last.kinetic, last.gravitational, elastic
+        )];
+        if self.released > 0.0 {
+            lines.push(format!(
+                "energy released by families undoing their violation: {:.4e} J (a rigid family, or \
+                 one under PBD's stiffness, stores no energy the account can measure)",
+                self.released
+            ));
+        }
+        if let Some(gain) = &self.gain {
+            lines.push(format!(
+                "warning: the energy grew by {:.3e} J above its lowest by frame {} (more than \
+                 {:.3e} J, 1 % of what the body could give back), most in {}",
+                gain.amount,
+                gain.frame,
+                self.bound(),
+                gain.from
+            ));
+        }
+        lines
     }
 }
 

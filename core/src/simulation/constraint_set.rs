@@ -5,6 +5,7 @@
 //! Their multipliers λ are the state's ([`super::State::lambdas`]).
 
 use crate::constraint_file::ConstraintFile;
+use crate::constraints::differentiable::of_constraint;
 use crate::constraints::material::Material;
 use crate::constraints::{Families, Family};
 use crate::scene::mesh::TetMesh;
@@ -31,6 +32,9 @@ pub struct ConstraintSet {
     /// The order a sweep projects the constraints in; empty for 0, 1, 2, …
     /// ([`crate::simulation::Settings::order_seed`]).
     order: Vec<u32>,
+    /// Σ C(x⁰)² over the constraints at the rest shape (not 0 for a pre-stressed family such as
+    /// the neo-Hookean pair); the C that are not finite left out.
+    rest_squared: f64,
 }
 
 impl ConstraintSet {
@@ -60,6 +64,7 @@ impl ConstraintSet {
             stored_len: 0,
             size,
             order: Vec::new(),
+            rest_squared: 0.0,
         };
         set.measure_rest(families, family, &mesh.positions, material);
         set
@@ -96,6 +101,22 @@ impl ConstraintSet {
             }
         }
         (self.rest, self.stored, self.stored_len) = (rest, stored, stored_len);
+        self.rest_squared = (0..self.len())
+            .map(|c| {
+                let rest = (self.rest[c], self.stored(c));
+                let particles = self.particles(c);
+                let at = rest_positions;
+                of_constraint(families, family, particles, rest, at, at).0
+            })
+            .filter(|c| c.is_finite())
+            .map(|c| c * c)
+            .sum();
+    }
+
+    /// Σ C(x⁰)² over the constraints at the rest shape, as last measured (0 for a family whose
+    /// constraints all hold there; not for a pre-stressed one such as the neo-Hookean pair).
+    pub fn rest_squared(&self) -> f64 {
+        self.rest_squared
     }
 
     /// Whether it was built from the definition of `family` in `families`.

@@ -31,6 +31,7 @@ pub mod projection;
 mod reference;
 mod resolved;
 pub(crate) mod settings;
+mod settling;
 mod state;
 mod stepping;
 pub mod substep;
@@ -44,6 +45,7 @@ pub use masses::DENSITY;
 pub use reference::{OnState, ReferenceEngine};
 pub use resolved::Resolved;
 pub use settings::{DEFAULT_SUBSTEPS, Method, Settings, settable_family};
+pub use settling::VIOLATED;
 pub use state::{Body, Grab, Revision, State};
 
 use crate::constraints::{Families, Family, PerFamily};
@@ -77,6 +79,11 @@ pub struct Simulation {
     revision: Revision,
     /// Frames an edit has been settling, `None` when none is; see [`Settings::settle_edits`].
     settling: Option<u32>,
+    /// Whether the speed cap of a settling edit is held off for the coming frame (see
+    /// `Simulation::hold_off_settling`).
+    settling_held_off: bool,
+    /// Whether the settling edit left tets inverted under a material, as its first frame found.
+    edit_inverted: bool,
     frame: u64,
     time: f64,
     /// The engine that steps it.
@@ -132,6 +139,8 @@ impl Simulation {
             state,
             revision: Revision::default(),
             settling: None,
+            settling_held_off: false,
+            edit_inverted: false,
             frame: 0,
             time: 0.0,
             engine: EngineSlot::default(),

@@ -78,12 +78,19 @@ impl Resolved {
         }
     }
 
-    /// Whether edits settle: [`Settings::settle_edits`], except while a family a material
-    /// describes is active. A material carries its own momentum through an inversion (a
-    /// mirrored tet's way back passes close to F = 0, where its hydrostatic gradient vanishes);
-    /// capping the speed there leaves the body squashed to a point.
+    /// Whether edits settle: [`Settings::settle_edits`], under every family (the cap is held off
+    /// for a frame in one case: `Simulation::hold_off_settling` in `simulation/settling.rs`).
     pub fn edits_settle(&self) -> bool {
-        self.settings.settle_edits && !self.active.families().any(|f| self.from_material[f])
+        self.settings.settle_edits
+    }
+
+    /// Whether `family` stores energy the account can measure, ½ C² / α: it is compliant (α > 0)
+    /// and projected by a rule that keeps α (XPBD, or PBD on a material's family). A rigid family
+    /// (α = 0) stores none it could measure, and PBD's stiffness k is no material constant (the
+    /// same k is stiffer at more substeps), so neither has a store to book.
+    pub fn stores_energy(&self, family: Family) -> bool {
+        self.compliance[family] > 0.0
+            && (self.settings.method == Method::Xpbd || self.from_material[family])
     }
 
     /// Whether an active family takes its compliance from the material: the first, if one does.

@@ -17,6 +17,7 @@ impl Simulation {
     pub fn step(&mut self) {
         self.refresh_inverse_masses();
         self.state.frame_corrections.fill(DVec3::ZERO);
+        self.hold_off_settling();
         let settling = self.edits_settle_now();
         // The slot is taken out while its engine steps the rest of the simulation.
         let mut slot = std::mem::take(&mut self.engine);
@@ -41,25 +42,12 @@ impl Simulation {
         if let Some(frames) = self.settling {
             let largest = self.largest_frame_correction();
             let settles = self.resolved.edits_settle();
-            self.settling = (settles && largest > self.settle_tolerance()).then_some(frames + 1);
+            // Held off, the frame kept no Δp to measure: the edit is still to settle.
+            let unsettled = self.settling_held_off || largest > self.settle_tolerance();
+            self.settling = (settles && unsettled).then_some(frames + 1);
         }
         self.frame += 1;
         self.time += self.settings.dt;
-    }
-
-    /// Whether an edit settles in the next frame: one is settling, and edits settle
-    /// ([`super::Resolved::edits_settle`]).
-    fn edits_settle_now(&self) -> bool {
-        self.resolved.edits_settle() && self.settling.is_some()
-    }
-
-    /// The longest sum of Δp over the frame's substeps among particles that can move.
-    fn largest_frame_correction(&self) -> f64 {
-        let s = &self.state;
-        (s.frame_corrections.iter().zip(&s.inverse_masses))
-            .filter(|(_, w)| **w > 0.0)
-            .map(|(c, _)| c.length())
-            .fold(0.0, f64::max)
     }
 
     /// Gives each particle its inverse mass (the lumped one, 0 where pinned or rigidly held):
@@ -160,6 +148,7 @@ impl Simulation {
 
     /// The first stage of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
     pub fn begin_substep(&mut self) {
+        self.hold_off_settling();
         self.on_state(|on, plan| substep::begin_substep(on, plan, true));
     }
 

@@ -24,7 +24,10 @@ impl Panel for Readouts {
 fn show(ui: &mut egui::Ui, context: &Context<'_>) {
     let (bench, step_time, frame_time) = (context.bench, context.step_time, context.frame_time);
     let m = &bench.metrics;
-    if let Some(warning) = &bench.stability_warning {
+    for warning in [&bench.stability_warning, &bench.newton_warning]
+        .into_iter()
+        .flatten()
+    {
         ui.colored_label(egui::Color32::from_rgb(230, 160, 40), warning);
     }
     egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {

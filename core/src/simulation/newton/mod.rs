@@ -88,6 +88,14 @@ pub struct NewtonEngine {
 }
 
 impl NewtonEngine {
+    /// The engine solving each substep with `options` rather than [`Options::default`].
+    pub fn with_options(options: Options) -> NewtonEngine {
+        NewtonEngine {
+            options,
+            ..NewtonEngine::default()
+        }
+    }
+
     /// The last substep's solve.
     pub fn last_report(&self) -> Report {
         self.last
@@ -96,6 +104,19 @@ impl NewtonEngine {
     /// How many substeps' solves have not converged to the tolerance.
     pub fn unconverged(&self) -> u64 {
         self.unconverged
+    }
+
+    /// What a front end says when some substep's solve has not converged (`None` when every
+    /// one has): how many, the last one's residual and violation, and what follows.
+    pub fn warning(&self) -> Option<String> {
+        let last = self.last;
+        (self.unconverged > 0).then(|| {
+            format!(
+                "the Newton reference did not solve {} substeps to its tolerance (the last: \
+                 residual {:.1e}, violation {:.1e}); its answer there is a local one",
+                self.unconverged, last.residual, last.violation
+            )
+        })
     }
 }
 

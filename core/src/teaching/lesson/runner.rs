@@ -2,6 +2,7 @@
 //! checked.
 
 use super::*;
+use crate::measures::energy_account::EnergyWatch;
 
 /// One step's outcome when a lesson runs headless.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +37,10 @@ pub struct LessonRun {
     metrics: (Metrics, Option<Metrics>),
     /// Answers handed in ([`LessonRun::hand_in`]) not yet taken up.
     answers: Vec<ConstraintFile>,
+    /// The energy account of the simulation over the current step's frames, from the state its
+    /// actions left (an action such as a perturbation gives energy; the frames after it must
+    /// not).
+    energy: EnergyWatch,
 }
 
 impl LessonRun {
@@ -46,6 +51,7 @@ impl LessonRun {
             Simulation::with_families(&scene, lesson.settings, lesson.families.clone());
         LessonRun {
             metrics: (Metrics::measure(&simulation), None),
+            energy: EnergyWatch::start(&simulation),
             simulation,
             comparison: None,
             tet: lesson.tet,
@@ -126,6 +132,12 @@ impl LessonRun {
         (&self.metrics.0, self.metrics.1.as_ref())
     }
 
+    /// The energy account of the simulation over the current (or last) step's frames, from the
+    /// state the step's actions left: frame k is the step's k-th.
+    pub fn energy(&self) -> &EnergyWatch {
+        &self.energy
+    }
+
     /// The scene.
     pub fn scene(&self) -> &Scene {
         &self.scene
@@ -162,9 +174,11 @@ impl LessonRun {
             self.apply(action);
         }
         self.measure()?;
-        for _ in 0..step.frames {
+        self.energy = EnergyWatch::start(&self.simulation);
+        for frame in 1..=step.frames {
             self.step();
             self.measure()?;
+            self.energy.observe(&self.simulation, frame);
             if on_frame(self).is_break() {
                 return Ok(None);
             }
