@@ -691,4 +691,11 @@ fn each_panel_is_drawn_on_its_own_and_asks_through_requests() {
         _ => None,
     });
     assert_eq!(asked, Some(tetlab_core::simulation::Method::Pbd));
+    let mut harness = alone(Box::new(Readouts), 330.0, 450.0);
+    harness.get_by_label("distance from the exact step").click();
+    harness.run_steps(1);
+    assert!(matches!(
+        harness.state().requests.as_slice(),
+        [Request::ExactStep(true)]
+    ));
 }

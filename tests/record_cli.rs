@@ -294,6 +294,45 @@ fn modes_logs_the_tets_eigenvalues_and_lowest_mode_each_frame() {
     }
 }
 
+/// `--exact-step` logs each frame's distance from the exact frame (the Newton reference's from
+/// the same start), absolute and relative, one row a stepped frame; without it, neither.
+#[test]
+fn exact_step_logs_each_frames_distance_from_the_exact_one() {
+    let dir = scratch("exact-step");
+    for (exact, name) in [(true, "exact.rrd"), (false, "plain.rrd")] {
+        let path = dir.join(name);
+        let mut args = vec![
+            "record",
+            "--scene",
+            "tet",
+            "--frames",
+            "4",
+            "--quiet",
+            "--out",
+            path.to_str().unwrap(),
+        ];
+        if exact {
+            args.push("--exact-step");
+        }
+        let output = tetlab(&args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let entities = inspect(&path)["entities"].as_object().unwrap().clone();
+        for entity in ["exact_step/distance", "exact_step/relative"] {
+            if exact {
+                assert_eq!(
+                    entities[entity]["frame_rows"], 4,
+                    "{entity}: one row a frame"
+                );
+            } else {
+                assert!(
+                    !entities.contains_key(entity),
+                    "{entity} without --exact-step"
+                );
+            }
+        }
+    }
+}
+
 /// Ctrl-C (SIGINT) and SIGTERM stop after the current frame, within 5 s, with a message, and
 /// leave a complete recording of every finished frame and no partial file.
 #[cfg(unix)]

@@ -9,6 +9,7 @@ use rerun::RecordingStream;
 use std::io::Write;
 use std::path::PathBuf;
 use tetlab_core::constraints::Family;
+use tetlab_core::measures::exact_step::ExactStepGap;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
 use tetlab_core::simulation::Simulation;
@@ -48,6 +49,12 @@ pub struct Args {
     /// (`world/modes/lowest`), as `tetlab modes` computes them for the active families.
     #[arg(long)]
     modes: bool,
+    /// Also step each frame's start by the Newton reference and log how far the frame is from
+    /// that exact one: `exact_step/distance` (the largest over the particles, m) and
+    /// `exact_step/relative` (over the exact frame's largest motion), as `run --exact-step`.
+    /// Slow beyond small scenes.
+    #[arg(long)]
+    exact_step: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -75,7 +82,7 @@ pub fn main(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
     };
     let session = Session::open(destination, args.simulation.frames, args.quiet)?;
     let rec = session.rec();
-    send_layout(rec, &[""], args.modes);
+    send_layout(rec, &[""], args.modes, args.exact_step);
     describe(rec, &scene, &simulation, args);
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
     match run(rec, &session, &scene, &mut simulation, &initial, args) {
@@ -103,8 +110,16 @@ fn run(
         if session.should_stop() {
             break;
         }
+        let before = args.exact_step.then(|| simulation.clone());
         let metrics = SimulationArgs::step(simulation)?;
         recorder.log_frame(simulation, &metrics);
+        if let Some(before) = before {
+            let gap = ExactStepGap::measure(&before, simulation);
+            rec.log("exact_step/distance", &rerun::Scalars::single(gap.largest))
+                .ok();
+            rec.log("exact_step/relative", &rerun::Scalars::single(gap.relative))
+                .ok();
+        }
         session.advance();
     }
     Ok(())

@@ -26,6 +26,8 @@ pub enum Request {
     Constraint(Vec<ConstraintFile>),
     /// Show this mode of a tet's energy Hessian in the view, or none.
     ShowMode(Option<ModeShown>),
+    /// Measure each frame's distance from the exact one (the Newton reference's), or stop.
+    ExactStep(bool),
 }
 
 /// A scene the user asked for.

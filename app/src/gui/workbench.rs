@@ -5,6 +5,7 @@ use glam::DVec3;
 use std::collections::VecDeque;
 use tetlab_core::constraints::{Families, PerFamily};
 use tetlab_core::measures::energy_account::Energy;
+use tetlab_core::measures::exact_step::ExactStepGap;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::simulation::divergence::Divergence;
@@ -34,6 +35,10 @@ pub struct Sample {
     pub metrics: Metrics,
     /// The energy account at that time: kinetic, gravitational, elastic and total, J.
     pub energy: [f64; 4],
+    /// How far the frame that led here is from the exact one (the Newton reference's, from the
+    /// same start): the largest distance over the particles, m, when [`Workbench::exact_step`]
+    /// is on.
+    pub exact_step: Option<f64>,
 }
 
 /// The scene being simulated and everything the user has chosen about it.
@@ -77,6 +82,12 @@ pub struct Workbench {
     /// A mode of a tet's energy Hessian the view shows (the modes panel's pick): drawn only,
     /// the simulation is untouched.
     pub mode_shown: Option<ModeShown>,
+    /// Whether each frame is also stepped by the Newton reference from the same start, to show
+    /// how far the engine's frame is from the exact one ([`ExactStepGap`]); off by default,
+    /// since it solves every substep to 10⁻¹⁰ (slow beyond small scenes).
+    pub exact_step: bool,
+    /// The last frame's distance from the exact one, when measured.
+    pub exact_step_gap: Option<ExactStepGap>,
 }
 
 /// An eigenmode drawn on a tet: arrows of its eigenvector at the corners, and the tet moved
@@ -134,6 +145,8 @@ impl Workbench {
             revision: 0,
             edits: Vec::new(),
             mode_shown: None,
+            exact_step: false,
+            exact_step_gap: None,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -176,7 +189,9 @@ impl Workbench {
     /// Advances one frame.
     pub fn step_frame(&mut self) {
         self.leave_step_mode();
+        let before = self.exact_step.then(|| self.simulation.clone());
         self.simulation.step();
+        self.exact_step_gap = before.map(|before| ExactStepGap::measure(&before, &self.simulation));
         // The engine that just stepped is ready: asking for it builds nothing.
         self.newton_warning =
             (self.simulation.engine_as::<NewtonEngine>()).and_then(|newton| newton.warning());
@@ -466,6 +481,8 @@ impl Workbench {
             time: self.simulation.time(),
             metrics: self.metrics,
             energy: [energy.kinetic, energy.gravitational, elastic, energy.total],
+            // Each frame's gap is plotted once: the samples of edits after it have none.
+            exact_step: self.exact_step_gap.take().map(|gap| gap.largest),
         });
     }
 }
@@ -484,6 +501,29 @@ mod tests {
             ..Default::default()
         };
         Box::new(NewtonEngine::with_options(options))
+    }
+
+    #[test]
+    fn with_the_exact_step_on_each_frame_is_measured_against_the_newton_reference() {
+        let mut bench = Workbench::builtin(Builtin::Tet, 1, Settings::default());
+        bench.step_frame();
+        assert_eq!(
+            bench.history.back().unwrap().exact_step,
+            None,
+            "off by default"
+        );
+        bench.exact_step = true;
+        bench.step_frame();
+        // A tet resting on the ground: XPBD's frame sags by its solver's error, a small part of
+        // the frame's motion (gravity's, undone by the ground and the constraints).
+        let gap = bench.history.back().unwrap().exact_step.expect("measured");
+        assert!(gap > 0.0 && gap.is_finite(), "{gap}");
+        bench.perturb(Perturbation::Flatten);
+        assert_eq!(
+            bench.history.back().unwrap().exact_step,
+            None,
+            "an edit is no frame"
+        );
     }
 
     #[test]

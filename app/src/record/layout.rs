@@ -4,9 +4,10 @@ use rerun::RecordingStream;
 use tetlab_core::measures::metrics::Metrics;
 
 /// The default layout: a 3D view per root (side by side) on the left, the four metrics and the
-/// energy account stacked on the right (each plot shows the metric of every root), and with `modes` a plot of the
-/// eigenvalues `record --modes` logs below them.
-pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool) {
+/// energy account stacked on the right (each plot shows the metric of every root), with `modes`
+/// a plot of the eigenvalues `record --modes` logs below them, and with `exact_step` one of the
+/// distance from the exact step `record --exact-step` logs.
+pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool, exact_step: bool) {
     use rerun::blueprint::{
         Blueprint, BlueprintActivation, Horizontal, Spatial3DView, TimeSeriesView, Vertical,
     };
@@ -39,10 +40,22 @@ pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool) {
                 .collect::<Vec<_>>(),
         )
         .into();
+    // `record --exact-step`: each frame's distance from the exact one.
+    let exact_step = exact_step.then(|| {
+        TimeSeriesView::new("distance from the exact step, m")
+            .with_contents(
+                roots
+                    .iter()
+                    .map(|root| format!("+ {root}exact_step/distance"))
+                    .collect::<Vec<_>>(),
+            )
+            .into()
+    });
     let plots: Vec<_> = plots
         .into_iter()
         .chain(std::iter::once(energy))
         .chain(modes)
+        .chain(exact_step)
         .collect();
     let views = roots.iter().map(|root| {
         let title = if root.is_empty() {

@@ -510,6 +510,7 @@ impl TetlabApp {
             Request::Settings(settings) => self.set_settings(*settings),
             Request::Constraint(files) => self.define_constraints(files),
             Request::ShowMode(mode) => self.bench.mode_shown = mode,
+            Request::ExactStep(on) => self.bench.exact_step = on,
         }
     }
 

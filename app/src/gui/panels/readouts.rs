@@ -10,19 +10,28 @@ use egui_plot::{Legend, Line, Plot, PlotPoints};
 /// window 800 pixels high.
 const PLOT_HEIGHT: f32 = 75.0;
 
+/// Each plot's height with the fourth, the distance from the exact step, shown: the four take
+/// the room of three.
+const PLOT_HEIGHT_OF_FOUR: f32 = 0.75 * PLOT_HEIGHT;
+
 /// The readouts: the metrics of the current frame, the engine and timings, and plots of the
 /// recent frames.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Readouts;
 
 impl Panel for Readouts {
-    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, _: &mut Vec<Request>) {
-        show(ui, context);
+    fn ui(&mut self, ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
+        show(ui, context, requests);
     }
 }
 
-fn show(ui: &mut egui::Ui, context: &Context<'_>) {
+fn show(ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
     let (bench, step_time, frame_time) = (context.bench, context.step_time, context.frame_time);
+    let plot_height = if bench.exact_step {
+        PLOT_HEIGHT_OF_FOUR
+    } else {
+        PLOT_HEIGHT
+    };
     let m = &bench.metrics;
     for warning in [&bench.stability_warning, &bench.newton_warning]
         .into_iter()
@@ -91,6 +100,25 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>) {
             ui.end_row();
         }
     });
+    // How far XPBD's frame is from the exact one (tetlab_core::measures::exact_step): each frame
+    // stepped again by the Newton reference from the same start, so off unless asked.
+    ui.horizontal(|ui| {
+        let mut on = bench.exact_step;
+        let toggle = ui
+            .checkbox(&mut on, "distance from the exact step")
+            .on_hover_text(
+                "Each frame is stepped again by the Newton reference from the same start (every \
+             substep's implicit Euler step solved to 1e-10); the largest distance between the \
+             two is XPBD's error in that frame. Slow beyond small scenes.",
+            );
+        if toggle.changed() {
+            requests.push(Request::ExactStep(on));
+        }
+        if let Some(gap) = bench.history.back().and_then(|s| s.exact_step) {
+            ui.monospace(format!("{gap:.2e} m"))
+                .on_hover_text("the largest over the particles");
+        }
+    });
     let series = |name: &str, value: fn(&Sample) -> f64| {
         Line::new(
             name.to_owned(),
@@ -98,14 +126,14 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>) {
         )
     };
     Plot::new("inverted plot")
-        .height(PLOT_HEIGHT)
+        .height(plot_height)
         .legend(Legend::default())
         .allow_scroll(false)
         .show(ui, |plot| {
             plot.line(series("inverted tets", |s| s.metrics.inverted_tets as f64));
         });
     Plot::new("volume plot")
-        .height(PLOT_HEIGHT)
+        .height(plot_height)
         .legend(Legend::default())
         .allow_scroll(false)
         .show(ui, |plot| {
@@ -115,7 +143,7 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>) {
     // The energy account: a total that rises, beyond what a violated rigid family releases, is
     // a gain (tetlab_core::measures::energy_account).
     Plot::new("energy plot")
-        .height(PLOT_HEIGHT)
+        .height(plot_height)
         .legend(Legend::default())
         .allow_scroll(false)
         .show(ui, |plot| {
@@ -123,4 +151,20 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>) {
             plot.line(series("kinetic", |s| s.energy[0]));
             plot.line(series("elastic", |s| s.energy[2]));
         });
+    if bench.exact_step {
+        Plot::new("exact step plot")
+            .height(plot_height)
+            .legend(Legend::default())
+            .allow_scroll(false)
+            .show(ui, |plot| {
+                let gaps = bench
+                    .history
+                    .iter()
+                    .filter_map(|s| s.exact_step.map(|gap| [s.time, gap]));
+                plot.line(Line::new(
+                    "distance from the exact step, m".to_owned(),
+                    PlotPoints::from_iter(gaps),
+                ));
+            });
+    }
 }
