@@ -10,7 +10,7 @@ use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::simulation::divergence::Divergence;
 use tetlab_core::simulation::newton::NewtonEngine;
-use tetlab_core::simulation::{Settings, Simulation};
+use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 use tetlab_core::teaching::lesson::{Action as LessonAction, Measured};
 use tetlab_core::teaching::stepper::{Advanced, StepByStep};
 
@@ -40,6 +40,10 @@ pub struct Sample {
     /// is on.
     pub exact_step: Option<f64>,
 }
+
+/// How long a played frame of the Newton reference may take before playing pauses
+/// ([`Workbench::pause_if_slow`]).
+pub const SLOW_NEWTON_FRAME: std::time::Duration = std::time::Duration::from_secs(1);
 
 /// The scene being simulated and everything the user has chosen about it.
 pub struct Workbench {
@@ -88,6 +92,9 @@ pub struct Workbench {
     pub exact_step: bool,
     /// The last frame's distance from the exact one, when measured.
     pub exact_step_gap: Option<ExactStepGap>,
+    /// Why playing paused by itself after a frame of the Newton reference took too long, until
+    /// the next play.
+    pub slow_frame: Option<String>,
 }
 
 /// An eigenmode drawn on a tet: arrows of its eigenvector at the corners, and the tet moved
@@ -147,6 +154,7 @@ impl Workbench {
             mode_shown: None,
             exact_step: false,
             exact_step_gap: None,
+            slow_frame: None,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -184,6 +192,25 @@ impl Workbench {
     pub fn load(&mut self, scene: Scene) {
         let families = self.simulation.families().clone();
         *self = Workbench::with_families(scene, *self.simulation.settings(), families);
+    }
+
+    /// After a played frame that took `took`: where the Newton reference stepped it (as the
+    /// engine, or for the distance from the exact step) and it took longer than
+    /// [`SLOW_NEWTON_FRAME`], pauses and says why, so that a large or tangled scene does not hold
+    /// the window frozen frame after frame (each frame is solved on the window's thread). Step
+    /// frame goes on one frame at a time. Returns whether it paused.
+    pub fn pause_if_slow(&mut self, took: std::time::Duration) -> bool {
+        let newton = self.exact_step || self.simulation.engine() == EngineChoice::Newton;
+        if !(self.playing && newton && took > SLOW_NEWTON_FRAME) {
+            return false;
+        }
+        self.set_playing(false);
+        self.slow_frame = Some(format!(
+            "paused: the Newton reference took {:.1} s for the last frame (every substep solved \
+             exactly); Step frame goes on one frame at a time",
+            took.as_secs_f64()
+        ));
+        true
     }
 
     /// Advances one frame.
@@ -393,6 +420,7 @@ impl Workbench {
     pub fn set_playing(&mut self, playing: bool) {
         if playing {
             self.leave_step_mode();
+            self.slow_frame = None;
         }
         self.playing = playing;
         if let Some(particle) = self.dragging {
@@ -524,6 +552,27 @@ mod tests {
             None,
             "an edit is no frame"
         );
+    }
+
+    #[test]
+    fn a_slow_newton_frame_pauses_playing_and_says_why() {
+        use std::time::Duration;
+        let mut bench = Workbench::builtin(Builtin::Tet, 1, Settings::default());
+        bench.set_playing(true);
+        let slow = SLOW_NEWTON_FRAME + Duration::from_millis(1);
+        assert!(!bench.pause_if_slow(slow), "no Newton reference steps it");
+        bench.exact_step = true;
+        assert!(!bench.pause_if_slow(SLOW_NEWTON_FRAME / 2), "fast enough");
+        assert!(bench.playing);
+        assert!(bench.pause_if_slow(slow));
+        assert!(!bench.playing);
+        let why = bench.slow_frame.clone().unwrap();
+        assert!(
+            why.starts_with("paused: the Newton reference took 1.0 s"),
+            "{why}"
+        );
+        bench.set_playing(true);
+        assert_eq!(bench.slow_frame, None, "playing again clears it");
     }
 
     #[test]

@@ -62,6 +62,9 @@ impl TetlabApp {
         let started = Instant::now();
         self.bench.step_frame();
         self.step_time = started.elapsed();
+        if self.bench.pause_if_slow(self.step_time) {
+            self.set_playing(false);
+        }
         if let Some(comparison) = &mut self.comparison
             && comparison.bench.playing
         {

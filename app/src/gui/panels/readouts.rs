@@ -33,9 +33,13 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
         PLOT_HEIGHT
     };
     let m = &bench.metrics;
-    for warning in [&bench.stability_warning, &bench.newton_warning]
-        .into_iter()
-        .flatten()
+    for warning in [
+        &bench.stability_warning,
+        &bench.newton_warning,
+        &bench.slow_frame,
+    ]
+    .into_iter()
+    .flatten()
     {
         ui.colored_label(egui::Color32::from_rgb(230, 160, 40), warning);
     }
