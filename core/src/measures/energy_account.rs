@@ -48,7 +48,8 @@ pub struct Energy {
     pub total: f64,
     /// Of each active family whose store the account cannot measure (rigid, or under PBD's
     /// stiffness), how far it is from holding: the largest and the sum of the relative violations
-    /// of its constraints ([`VIOLATED`]; (0, 0) for the others). Not energy.
+    /// of its constraints ([`VIOLATED`]; (0, 0) for the others, and for all where measured by
+    /// [`Energy::measure`] rather than [`Energy::measure_with_violation`]). Not energy.
     #[serde(skip)]
     pub violation: PerFamily<(f64, f64)>,
 }
@@ -99,12 +100,6 @@ impl Energy {
             let rest = body.sets[family].rest_squared();
             0.5 * (now - rest) / resolved.compliance[family]
         });
-        let violation = simulation.families().per_family(|family| {
-            if !simulation.active()[family] || resolved.stores_energy(family) {
-                return (0.0, 0.0);
-            }
-            violation(simulation, family, positions)
-        });
         let elastic_sum: f64 = simulation.families().all().map(|f| elastic[f]).sum();
         Energy {
             kinetic,
@@ -112,8 +107,24 @@ impl Energy {
             external,
             total: kinetic + gravitational + external + elastic_sum,
             elastic,
-            violation,
+            violation: PerFamily::default(),
         }
+    }
+
+    /// [`Energy::measure`] with [`Energy::violation`] too: how far each family without a
+    /// measurable store is from holding, which a run's account ([`EnergyWatch`]) needs and a
+    /// display does not (it costs a C and a ∇C per constraint of those families every frame).
+    pub fn measure_with_violation(simulation: &Simulation) -> Energy {
+        let mut energy = Energy::measure(simulation);
+        let resolved = simulation.resolved();
+        let positions = simulation.positions();
+        energy.violation = simulation.families().per_family(|family| {
+            if !simulation.active()[family] || resolved.stores_energy(family) {
+                return (0.0, 0.0);
+            }
+            violation(simulation, family, positions)
+        });
+        energy
     }
 }
 
@@ -180,7 +191,7 @@ impl EnergyWatch {
 
     /// A watch from `simulation`'s state now (frame 0).
     pub fn start(simulation: &Simulation) -> EnergyWatch {
-        let energy = Energy::measure(simulation);
+        let energy = Energy::measure_with_violation(simulation);
         let body = simulation.body();
         let size = body.rest_diagonal();
         let mass: f64 = (simulation.inverse_masses().iter())
@@ -219,7 +230,7 @@ impl EnergyWatch {
 
     /// The energy after `frame`: measured, compared with the lowest before, and returned.
     pub fn observe(&mut self, simulation: &Simulation, frame: u64) -> &Energy {
-        let energy = Energy::measure(simulation);
+        let energy = Energy::measure_with_violation(simulation);
         let step = energy.total - self.last.total;
         // A store the account cannot measure is released while it is undone (module docs):
         // a rigid family's from the budget its violated start holds, in frames that begin with

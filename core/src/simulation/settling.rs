@@ -1,7 +1,7 @@
 //! When an edit settles ([`super::Settings::settle_edits`]): while it does, constraint
 //! corrections may move particles but not speed them up. The cap is held off in one case, an
-//! edit that inverted tets under a material, until they are undone
-//! (`Simulation::hold_off_settling` says why), and an edit has settled when a frame's corrections fall under
+//! edit that inverted tets under a material, until they are undone and out of the basin of
+//! F = 0 (`Simulation::hold_off_settling` says why), and an edit has settled when a frame's corrections fall under
 //! [`Simulation::settle_tolerance`].
 
 use super::Simulation;
@@ -22,37 +22,46 @@ impl Simulation {
     }
 
     /// Decides, before a frame (and before a substep taken step by step), whether the speed cap
-    /// of a settling edit is held off until the next decision: while a material family is
-    /// active, the edit left tets inverted (a mirror, not a flatten), a tet still is, and every
-    /// active rigid family holds (within [`VIOLATED`]).
+    /// of a settling edit is held off until the next decision: while a material family is active, the edit left tets inverted (a
+    /// mirror, not a flatten), a tet is still inverted or in the basin of F = 0
+    /// (`basin_of_collapse`), and every active rigid family holds (within [`VIOLATED`]).
     ///
     /// Why: a mirrored material's way back under the cap does not arrive; its deviatoric term
     /// (½ μ |F|², a zero-length spring on F) shrinks the tets while the hydrostatic term, whose
     /// gradient cof F vanishes as F does, cannot push them through, and F = 0 is a local minimum
     /// of the energy (Ψ ≈ μ/2 |F|² + λ/2 γ² there, det F being cubic): the body stays squashed
-    /// to a point. Only momentum carries it across. The material's store is energy the account
-    /// measures, so letting it move the body gains nothing. A violated rigid family is
-    /// different: it stores no energy, and undoing it at full speed gives v = C / h, unbounded
-    /// as h shrinks; the cap stays on while one is violated. A flattened body (det F ≥ 0 at the
-    /// edit) settles under the cap throughout, even where its flat tets cross zero volume on
-    /// the way back (cof F ≠ 0 there points home).
+    /// to a point. Only momentum carries it across: a cap eased to a few element lengths a
+    /// second still left the 3 × 3 × 3 cube collapsed to a point, so the store moves the body
+    /// freely (the mirrored cube at 154 m/s, 5 m across the ground), energy the account
+    /// measures, not a gain. A violated rigid family is different: undoing it at full speed
+    /// gives v = C / h, unbounded as h shrinks; the cap stays on while one is violated. A
+    /// flattened body (det F ≥ 0 at the edit) settles under the cap throughout, even where its
+    /// flat tets cross zero volume on the way back (cof F ≠ 0 there points home).
     pub(super) fn hold_off_settling(&mut self) {
         let material = self.resolved.material_family().is_some();
         if self.settling == Some(0) {
-            self.edit_inverted = material && self.any_tet_inverted();
+            self.edit_inverted = material && self.any_tet_below(0.0);
         }
         self.settling_held_off = self.settling.is_some()
             && material
             && self.edit_inverted
-            && self.any_tet_inverted()
+            && self.any_tet_below(self.basin_of_collapse())
             && self.largest_rigid_violation() <= VIOLATED;
     }
 
-    /// Whether a tet of the body has a negative signed volume now.
-    fn any_tet_inverted(&self) -> bool {
-        let p = &self.state.positions;
-        let volume = |t: &[u32; 4]| signed_volume(&t.map(|i| p[i as usize]));
-        self.body.tets.iter().any(|t| volume(t) < 0.0)
+    /// J = V / V₀ below which a tet of the material is in the basin of F = 0 along the way
+    /// back through it, F = s I: Ψ(s) = 3 μ s² / 2 + λ (s³ − γ)² / 2 has dΨ/ds = 3 μ s −
+    /// 3 λ s² (γ − s³), positive (pulling the tet to F = 0 under a dissipative step) for s below
+    /// the root s* of μ = λ s (γ − s³), γ = 1 + μ / λ; J* = s*³, 0.0246 at ν = 0.3 (λ here is λ_L + μ), whatever E.
+    /// Found by Newton's method from s = μ / (λ γ), where s³ is negligible.
+    fn basin_of_collapse(&self) -> f64 {
+        basin_of_collapse(&self.settings.material)
+    }
+    /// Whether a tet of the body has V / V₀ below `ratio` now.
+    fn any_tet_below(&self, ratio: f64) -> bool {
+        let (p, rest) = (&self.state.positions, &self.body.rest_positions);
+        let volume = |x: &[DVec3], t: &[u32; 4]| signed_volume(&t.map(|i| x[i as usize]));
+        (self.body.tets.iter()).any(|t| volume(p, t) < ratio * volume(rest, t))
     }
 
     /// The largest relative violation ([`VIOLATED`]) among the active rigid families'
@@ -111,5 +120,45 @@ impl Simulation {
             .filter(|(_, w)| **w > 0.0)
             .map(|(c, _)| c.length())
             .fold(0.0, f64::max)
+    }
+}
+
+/// J* of `Simulation::basin_of_collapse` for `material`.
+fn basin_of_collapse(material: &crate::constraints::material::Material) -> f64 {
+    let (mu, lambda, gamma) = (material.mu(), material.lambda(), material.gamma());
+    let mut s = mu / (lambda * gamma);
+    for _ in 0..20 {
+        let f = lambda * s * (gamma - s.powi(3)) - mu;
+        let slope = lambda * (gamma - 4.0 * s.powi(3));
+        s -= f / slope;
+    }
+    s.powi(3)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::basin_of_collapse;
+    use crate::constraints::material::Material;
+
+    #[test]
+    fn at_the_basins_edge_the_pull_to_f_0_and_the_push_home_balance() {
+        for poisson in [0.1, 0.3, 0.45] {
+            let m = Material {
+                young: 1e6,
+                poisson,
+            };
+            let j = basin_of_collapse(&m);
+            let s = j.cbrt();
+            let slope =
+                |s: f64| 3.0 * m.mu() * s - 3.0 * m.lambda() * s * s * (m.gamma() - s.powi(3));
+            assert!(slope(s).abs() < 1e-9 * m.mu(), "{poisson}: {}", slope(s));
+            // Below it F = s I falls to 0, above it climbs home.
+            assert!(slope(0.9 * s) > 0.0 && slope(1.1 * s) < 0.0, "{poisson}");
+        }
+        let j = basin_of_collapse(&Material {
+            young: 1e6,
+            poisson: 0.3,
+        });
+        assert!((j - 0.0246).abs() < 1e-4, "{j}");
     }
 }

@@ -42,7 +42,7 @@ impl Simulation {
         if let Some(frames) = self.settling {
             let largest = self.largest_frame_correction();
             let settles = self.resolved.edits_settle();
-            // Held off, the frame kept no Δp to measure: the edit is still to settle.
+            // Held off, the edit is still to settle, whatever the frame's Δp.
             let unsettled = self.settling_held_off || largest > self.settle_tolerance();
             self.settling = (settles && unsettled).then_some(frames + 1);
         }
