@@ -11,45 +11,29 @@ pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool, exact_ste
     use rerun::blueprint::{
         Blueprint, BlueprintActivation, Horizontal, Spatial3DView, TimeSeriesView, Vertical,
     };
-    let plots = Metrics::default().headline().map(|(name, _)| {
-        let contents: Vec<String> = roots
-            .iter()
-            .map(|root| format!("+ {root}metrics/{name}"))
-            .collect();
-        TimeSeriesView::new(name.replace('_', " "))
-            .with_contents(contents)
-            .into()
-    });
+    // One plot of the entity at `path` under every root.
+    let plot = |title: String, path: &str| -> rerun::blueprint::ContainerLike {
+        let contents: Vec<String> = roots.iter().map(|root| format!("+ {root}{path}")).collect();
+        TimeSeriesView::new(title).with_contents(contents).into()
+    };
+    let plots = Metrics::default()
+        .headline()
+        .map(|(name, _)| plot(name.replace('_', " "), &format!("metrics/{name}")));
+    // The energy account (`energy/*`), every part of it in one plot.
+    let energy = plot("energy, J".into(), "energy/**");
     // The eigenvalues of `record --modes`, one plot with a series per mode.
     let modes = modes.then(|| {
-        TimeSeriesView::new("eigenvalues of the tet's energy Hessian")
-            .with_contents(
-                roots
-                    .iter()
-                    .map(|root| format!("+ {root}modes/eigenvalues"))
-                    .collect::<Vec<_>>(),
-            )
-            .into()
-    });
-    // The energy account (`energy/*`), every part of it in one plot.
-    let energy = TimeSeriesView::new("energy, J")
-        .with_contents(
-            roots
-                .iter()
-                .map(|root| format!("+ {root}energy/**"))
-                .collect::<Vec<_>>(),
+        plot(
+            "eigenvalues of the tet's energy Hessian".into(),
+            "modes/eigenvalues",
         )
-        .into();
+    });
     // `record --exact-step`: each frame's distance from the exact one.
     let exact_step = exact_step.then(|| {
-        TimeSeriesView::new("distance from the exact step, m")
-            .with_contents(
-                roots
-                    .iter()
-                    .map(|root| format!("+ {root}exact_step/distance"))
-                    .collect::<Vec<_>>(),
-            )
-            .into()
+        plot(
+            "distance from the exact step, m".into(),
+            "exact_step/distance",
+        )
     });
     let plots: Vec<_> = plots
         .into_iter()
