@@ -484,6 +484,39 @@ fn gradient_of_a_constraint_file_shows_automatic_yours_and_finite_differences() 
 
 /// A file `name` with `text` in a fresh folder (whose name has a space, as paths do), and the
 /// folder to remove.
+/// For a file that reads the rest shape (F), the printed command gives the failing rest shape
+/// too, so that it shows the configuration that failed, not F = I.
+#[test]
+fn the_printed_command_of_a_file_that_reads_the_rest_shape_reproduces_the_failure() {
+    let dir = std::env::temp_dir().join(format!("tetlab-rest-shape-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("detf.toml");
+    let text = "name = \"detf\"\napplies_to = \"tets\"\nvalue = \"det(F) - 1\"\n\n[gradient]\n\
+                p0 = \"p0 * 0\"\np1 = \"p1 * 0\"\np2 = \"p2 * 0\"\np3 = \"p3 * 0\"\n";
+    std::fs::write(&path, text).unwrap();
+    let file = path.to_str().unwrap();
+    let output = tetlab(&["check-gradients", "--constraint-file", file, "--json"]);
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    let v: Value = serde_json::from_str(&stdout(&output)).unwrap();
+    let command = v["worst"]["command"].as_str().unwrap();
+    assert!(command.contains(" --rest-shape "), "{command}");
+    let mut args: Vec<&str> = command.split(' ').skip(1).collect();
+    args.push("--json");
+    let shown = json(&args);
+    // Not the rest shape's F = I (where det F − 1 = 0 and AD's gradient is the cofactor of I):
+    // the failing configuration's C, and the gradients that differ there.
+    let value = shown["value"].as_f64().unwrap();
+    assert!(value.abs() > 1e-6, "{shown}");
+    let automatic = vectors(&shown["automatic"]);
+    let yours = vectors(&shown["yours"]);
+    let largest = |g: &[[f64; 3]]| g.iter().flatten().map(|x| x.abs()).fold(0.0, f64::max);
+    assert!(
+        largest(&automatic) > 0.0 && largest(&yours) == 0.0,
+        "{shown}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 fn written(name: &str, text: &str) -> (std::path::PathBuf, String) {
     let dir = std::env::temp_dir().join(format!("tetlab constraint {} {name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

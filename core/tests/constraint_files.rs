@@ -175,6 +175,30 @@ fn every_mistake_names_file_line_and_column() {
         assert!(message.starts_with(at), "{body}: {message}");
         assert!(message.contains(what), "{body}: {message}");
     }
+    // A bracketed operand is quoted with its brackets, at its opening one.
+    let tets = "name = \"c\"\napplies_to = \"tets\"\n";
+    for (value, at, quoted) in [
+        (
+            "dot((p1 - p0) * F, p2)",
+            "mine.toml:3:14: ",
+            "(`(p1 - p0) * F`)",
+        ),
+        (
+            "dot(F + (p1 - p0), p2)",
+            "mine.toml:3:14: ",
+            "(`F + (p1 - p0)`)",
+        ),
+    ] {
+        let message = error(&format!("{tets}value = \"{value}\"\n"));
+        assert!(message.starts_with(at), "{value}: {message}");
+        assert!(message.ends_with(quoted), "{value}: {message}");
+    }
+    // A tet's matrices on a triangle: the binding's particles counted right.
+    let message = error("name = \"c\"\napplies_to = \"triangles\"\nvalue = \"det(Dm)\"\n");
+    assert!(
+        message.contains("`Dm` is a tet's: this binding has three particles, p0…p2"),
+        "{message}"
+    );
     let message = error(header);
     assert!(message.contains("no `value`"), "{message}");
     let message = error("name = \"c\"\napplies_to = \"faces\"\nvalue = \"1\"\n");

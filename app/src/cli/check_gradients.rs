@@ -268,16 +268,25 @@ fn file_output(
             rest: w.rest,
             relative_error: Figure::of(Some(w.relative_error)),
             absolute: w.absolute,
-            command: format!(
-                "tetlab gradient --constraint-file {} --points {} --rest {:?}",
-                shell_word(path),
-                w.points
-                    .iter()
-                    .map(|p| format!("{:?},{:?},{:?}", p.x, p.y, p.z))
-                    .collect::<Vec<_>>()
-                    .join(" "),
-                w.rest
-            ),
+            command: {
+                // Every number as Rust prints an f64: the shortest text that reads back as the
+                // same bits, so the command reproduces the failure exactly.
+                let points = |points: &[glam::DVec3]| {
+                    (points.iter())
+                        .map(|p| format!("{:?},{:?},{:?}", p.x, p.y, p.z))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                };
+                let shape = (w.rest_shape.as_deref())
+                    .map(|shape| format!(" --rest-shape {}", points(shape)))
+                    .unwrap_or_default();
+                format!(
+                    "tetlab gradient --constraint-file {} --points {}{shape} --rest {:?}",
+                    shell_word(path),
+                    points(&w.points),
+                    w.rest
+                )
+            },
         });
     FileOutput {
         constraint_file: path.display().to_string(),

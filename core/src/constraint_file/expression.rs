@@ -119,6 +119,20 @@ pub enum Expr {
 }
 
 impl Expr {
+    /// The same expression, said to be at `span` (a bracketed one: with its brackets).
+    fn at(mut self, span: Span) -> Expr {
+        match &mut self {
+            Expr::Number(_, s)
+            | Expr::Name(_, s)
+            | Expr::Neg(_, s)
+            | Expr::Binary(.., s)
+            | Expr::Member(.., s)
+            | Expr::Compare(.., s) => *s = span,
+            Expr::Call { span: s, .. } => *s = span,
+        }
+        self
+    }
+
     /// Where the expression is in its source.
     pub fn span(&self) -> Span {
         match self {
@@ -283,9 +297,13 @@ fn syntax_error(text: &str, e: pest::error::Error<Rule>) -> SyntaxError {
 
 fn describe(rule: &Rule) -> Option<&'static str> {
     Some(match rule {
-        Rule::number | Rule::name | Rule::call | Rule::expr | Rule::neg | Rule::argument => {
-            "a number, a name or ("
-        }
+        Rule::number
+        | Rule::name
+        | Rule::call
+        | Rule::expr
+        | Rule::neg
+        | Rule::argument
+        | Rule::paren => "a number, a name or (",
         Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::member => "an operator",
         Rule::le | Rule::lt | Rule::ge | Rule::gt => "a comparison",
         Rule::assignment => "`name = expression`",
@@ -335,6 +353,13 @@ fn primary(pair: Pair<'_, Rule>) -> Expr {
                 args: inner.map(argument).collect(),
                 span,
             }
+        }
+        Rule::paren => {
+            let inner = pair
+                .into_inner()
+                .next()
+                .expect("brackets hold an expression");
+            build(inner).at(span)
         }
         _ => build(pair),
     }

@@ -36,6 +36,8 @@ pub struct Worst {
     pub particle: usize,
     /// The configuration.
     pub points: Vec<DVec3>,
+    /// Its rest shape, for a constraint that reads one (Dm, F, V0); `None` otherwise.
+    pub rest_shape: Option<Vec<DVec3>>,
     /// Its rest value.
     pub rest: f64,
     /// That particle's error: |yours − AD|∞ / maxⱼ |∇ⱼC|; where AD's gradient is zero, the
@@ -428,6 +430,7 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
                 report.worst = Some(Worst {
                     particle: k,
                     points: points.clone(),
+                    rest_shape: source.uses_rest_shape().then(|| shape.clone()),
                     rest,
                     relative_error: error,
                     absolute: scale == 0.0,

@@ -353,7 +353,11 @@ impl Program {
         if self.arity != 4 {
             return Err(CompileError {
                 span,
-                message: format!("`{name}` is a tet's: this binding has two particles"),
+                message: format!(
+                    "`{name}` is a tet's: this binding has {} particles, p0…p{}",
+                    ["no", "one", "two", "three"][self.arity.min(3)],
+                    self.arity.saturating_sub(1)
+                ),
             });
         }
         let edges = |program: &mut Program, corner: fn(u8) -> Op, what| {
