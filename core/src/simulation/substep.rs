@@ -116,6 +116,73 @@ impl Plan {
     }
 }
 
+/// The stages of [`Substeps`] an engine that wraps the reference engine's ([`super::OnState`],
+/// in the field named first) leaves to it, each forwarded as is: write the stages it changes
+/// by hand and list the others here.
+///
+/// ```text
+/// impl Substeps for Backwards<'_> {
+///     tetlab_core::forward_stages!(on: predict, hold, keep_predicted, reset_multipliers,
+///         grabbed, ground_and_plane, keep_corrections, update_velocities);
+///     fn project(&mut self, unit: Unit, plan: &Plan) { /* its own order */ }
+/// }
+/// ```
+#[macro_export]
+macro_rules! forward_stages {
+    ($on:ident: $($stage:ident),+ $(,)?) => {
+        $($crate::forward_stages!(@stage $on $stage);)+
+    };
+    (@stage $on:ident predict) => {
+        fn predict(&mut self, plan: &$crate::simulation::substep::Plan) {
+            self.$on.predict(plan);
+        }
+    };
+    (@stage $on:ident hold) => {
+        fn hold(&mut self, particle: usize, target: ::glam::DVec3) {
+            self.$on.hold(particle, target);
+        }
+    };
+    (@stage $on:ident keep_predicted) => {
+        fn keep_predicted(&mut self) {
+            self.$on.keep_predicted();
+        }
+    };
+    (@stage $on:ident reset_multipliers) => {
+        fn reset_multipliers(&mut self, plan: &$crate::simulation::substep::Plan) {
+            self.$on.reset_multipliers(plan);
+        }
+    };
+    (@stage $on:ident project) => {
+        fn project(
+            &mut self,
+            unit: $crate::constraints::Unit,
+            plan: &$crate::simulation::substep::Plan,
+        ) {
+            self.$on.project(unit, plan);
+        }
+    };
+    (@stage $on:ident grabbed) => {
+        fn grabbed(&mut self, particle: usize) -> $crate::simulation::substep::GrabbedParticle<'_> {
+            self.$on.grabbed(particle)
+        }
+    };
+    (@stage $on:ident ground_and_plane) => {
+        fn ground_and_plane(&mut self, plan: &$crate::simulation::substep::Plan) {
+            self.$on.ground_and_plane(plan);
+        }
+    };
+    (@stage $on:ident keep_corrections) => {
+        fn keep_corrections(&mut self) {
+            self.$on.keep_corrections();
+        }
+    };
+    (@stage $on:ident update_velocities) => {
+        fn update_velocities(&mut self, plan: &$crate::simulation::substep::Plan) {
+            self.$on.update_velocities(plan);
+        }
+    };
+}
+
 /// What a CPU engine does at each stage of a substep, on its own arrays.
 pub trait Substeps {
     /// Before the frame's first substep (the fast engine moves its origin to the body).

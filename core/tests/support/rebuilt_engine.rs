@@ -8,9 +8,9 @@
 
 use glam::DVec3;
 use tetlab_core::constraints::differentiable::of_constraint;
-use tetlab_core::constraints::{Families, PerFamily, Unit};
+use tetlab_core::constraints::{Families, PerFamily};
 use tetlab_core::simulation::projection::SkipCounts;
-use tetlab_core::simulation::substep::{self, GrabbedParticle, Plan, Substeps};
+use tetlab_core::simulation::substep::{self, Plan, Substeps};
 use tetlab_core::simulation::{Body, Engine, Frame, OnState, Resolved, Start};
 
 /// The reference engine with its positions rebuilt after every sweep.
@@ -102,6 +102,10 @@ impl Rebuilding<'_> {
 }
 
 impl Substeps for Rebuilding<'_> {
+    tetlab_core::forward_stages!(on:
+        keep_predicted, reset_multipliers, project, grabbed, ground_and_plane, keep_corrections,
+        update_velocities);
+
     fn predict(&mut self, plan: &Plan) {
         self.on.predict(plan);
         self.predicted.clone_from(&self.on.state().positions);
@@ -112,39 +116,11 @@ impl Substeps for Rebuilding<'_> {
         self.predicted[particle] = target;
     }
 
-    fn keep_predicted(&mut self) {
-        self.on.keep_predicted();
-    }
-
-    fn reset_multipliers(&mut self, plan: &Plan) {
-        self.on.reset_multipliers(plan);
-    }
-
-    fn project(&mut self, unit: Unit, plan: &Plan) {
-        self.on.project(unit, plan);
-    }
-
     fn sweeps(&mut self, plan: &Plan) {
         for _ in 0..plan.iterations {
             substep::sweep(self, plan);
             self.rebuild();
             self.on.ground_and_plane(plan);
         }
-    }
-
-    fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_> {
-        self.on.grabbed(particle)
-    }
-
-    fn ground_and_plane(&mut self, plan: &Plan) {
-        self.on.ground_and_plane(plan);
-    }
-
-    fn keep_corrections(&mut self) {
-        self.on.keep_corrections();
-    }
-
-    fn update_velocities(&mut self, plan: &Plan) {
-        self.on.update_velocities(plan);
     }
 }

@@ -7,7 +7,7 @@
 
 use tetlab_core::constraints::{PerFamily, Unit};
 use tetlab_core::simulation::projection::SkipCounts;
-use tetlab_core::simulation::substep::{self, GrabbedParticle, Plan, Substeps};
+use tetlab_core::simulation::substep::{self, Plan, Substeps};
 use tetlab_core::simulation::{Body, Engine, Frame, OnState, Start};
 
 /// The reference engine's substep with every sweep's order reversed.
@@ -60,42 +60,14 @@ struct Backwards<'a> {
 }
 
 impl Substeps for Backwards<'_> {
-    fn predict(&mut self, plan: &Plan) {
-        self.on.predict(plan);
-    }
-
-    fn hold(&mut self, particle: usize, target: glam::DVec3) {
-        self.on.hold(particle, target);
-    }
-
-    fn keep_predicted(&mut self) {
-        self.on.keep_predicted();
-    }
-
-    fn reset_multipliers(&mut self, plan: &Plan) {
-        self.on.reset_multipliers(plan);
-    }
+    tetlab_core::forward_stages!(on:
+        predict, hold, keep_predicted, reset_multipliers, grabbed, ground_and_plane,
+        keep_corrections, update_velocities);
 
     fn project(&mut self, unit: Unit, plan: &Plan) {
         let set = &self.body.sets[unit.lead];
         for k in (0..set.len()).rev() {
             self.on.project_one(unit, set.in_order(k), plan);
         }
-    }
-
-    fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_> {
-        self.on.grabbed(particle)
-    }
-
-    fn ground_and_plane(&mut self, plan: &Plan) {
-        self.on.ground_and_plane(plan);
-    }
-
-    fn keep_corrections(&mut self) {
-        self.on.keep_corrections();
-    }
-
-    fn update_velocities(&mut self, plan: &Plan) {
-        self.on.update_velocities(plan);
     }
 }

@@ -24,7 +24,7 @@ mod objective;
 use super::engine::{Engine, Frame, Start};
 use super::reference::OnState;
 use super::state::Body;
-use super::substep::{self, GrabbedParticle, Plan, Substeps};
+use super::substep::{self, Plan, Substeps};
 use crate::constraints::{Families, PerFamily, Unit};
 use crate::simulation::Resolved;
 use crate::simulation::projection::SkipCounts;
@@ -186,21 +186,9 @@ fn force_scale(heaviest: f64, gravity: f64, forces: &[DVec3]) -> f64 {
 }
 
 impl Substeps for Implicit<'_> {
-    fn predict(&mut self, plan: &Plan) {
-        self.on.predict(plan);
-    }
-
-    fn hold(&mut self, particle: usize, target: DVec3) {
-        self.on.hold(particle, target);
-    }
-
-    fn keep_predicted(&mut self) {
-        self.on.keep_predicted();
-    }
-
-    fn reset_multipliers(&mut self, plan: &Plan) {
-        self.on.reset_multipliers(plan);
-    }
+    crate::forward_stages!(on:
+        predict, hold, keep_predicted, reset_multipliers, grabbed, ground_and_plane,
+        keep_corrections, update_velocities);
 
     /// Never called: [`Implicit::sweeps`] solves the whole substep.
     fn project(&mut self, _: Unit, _: &Plan) {
@@ -249,22 +237,6 @@ impl Substeps for Implicit<'_> {
         if !engine.last.converged {
             engine.unconverged += 1;
         }
-    }
-
-    fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_> {
-        self.on.grabbed(particle)
-    }
-
-    fn ground_and_plane(&mut self, plan: &Plan) {
-        self.on.ground_and_plane(plan);
-    }
-
-    fn keep_corrections(&mut self) {
-        self.on.keep_corrections();
-    }
-
-    fn update_velocities(&mut self, plan: &Plan) {
-        self.on.update_velocities(plan);
     }
 }
 
