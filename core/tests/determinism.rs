@@ -19,6 +19,7 @@ fn simulation(engine: EngineChoice, threads: usize) -> Simulation {
         Settings {
             engine,
             substeps: 10,
+            damping: 1.0,
             active: PerFamily::builtin_list("edges,height,volume").unwrap(),
             ..Settings::default()
         },
@@ -28,14 +29,19 @@ fn simulation(engine: EngineChoice, threads: usize) -> Simulation {
     simulation
 }
 
-/// FNV-1a over the bits of every coordinate of [`simulation`] after two frames.
+/// FNV-1a over the bits of every coordinate of [`simulation`] after two frames, and of what the
+/// ground, damping and the settling cap took (summed over the particles: in the same order for
+/// any thread count).
 fn bits_of_a_run(engine: EngineChoice, threads: usize) -> u64 {
     let mut simulation = simulation(engine, threads);
     for _ in 0..2 {
         simulation.step();
     }
+    let taken = simulation.state().taken;
+    assert!(taken.ground > 0.0 && taken.damping > 0.0, "{taken:?}");
     let mut hash = 0xcbf2_9ce4_8422_2325_u64;
-    for coordinate in simulation.positions().iter().flat_map(|p| p.to_array()) {
+    let coordinates = simulation.positions().iter().flat_map(|p| p.to_array());
+    for coordinate in coordinates.chain([taken.ground, taken.damping, taken.settling]) {
         for byte in coordinate.to_bits().to_le_bytes() {
             hash = (hash ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
         }

@@ -65,7 +65,8 @@ pub struct FrameRecord {
     skipped: BTreeMap<String, u64>,
     /// The energy account (`tetlab_core::measures::energy_account`), J: `energy_kinetic`,
     /// `energy_gravitational`, `energy_external`, `energy_elastic_<family>` for each active
-    /// family, `energy_total`.
+    /// family, `energy_total`; and what left the body so far, `energy_taken_ground`,
+    /// `energy_taken_damping`, `energy_taken_settling` (`tetlab_core::simulation::Taken`).
     #[serde(flatten)]
     energy: BTreeMap<String, f64>,
     /// With --exact-step: how far this frame is from the exact one from the same start
@@ -140,6 +141,9 @@ impl FrameRecord {
                 ("energy_gravitational".to_owned(), energy.gravitational),
                 ("energy_external".to_owned(), energy.external),
                 ("energy_total".to_owned(), energy.total),
+                ("energy_taken_ground".to_owned(), energy.taken.ground),
+                ("energy_taken_damping".to_owned(), energy.taken.damping),
+                ("energy_taken_settling".to_owned(), energy.taken.settling),
             ]
             .into_iter()
             .chain(

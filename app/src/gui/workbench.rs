@@ -33,8 +33,10 @@ pub struct Sample {
     pub time: f64,
     /// The metrics at that time.
     pub metrics: Metrics,
-    /// The energy account at that time: kinetic, gravitational, elastic and total, J.
-    pub energy: [f64; 4],
+    /// The energy account at that time: kinetic, gravitational, elastic and total, J, and the
+    /// total with what the ground and damping took since frame 0 added back (what never rises
+    /// but by a gain: `tetlab_core::measures::energy_account::EnergyWatch`).
+    pub energy: [f64; 5],
     /// How far the frame that led here is from the exact one (the Newton reference's, from the
     /// same start): the largest distance over the particles, m, when [`Workbench::exact_step`]
     /// is on.
@@ -508,7 +510,13 @@ impl Workbench {
         self.history.push_back(Sample {
             time: self.simulation.time(),
             metrics: self.metrics,
-            energy: [energy.kinetic, energy.gravitational, elastic, energy.total],
+            energy: [
+                energy.kinetic,
+                energy.gravitational,
+                elastic,
+                energy.total,
+                energy.total + energy.taken.ground + energy.taken.damping,
+            ],
             // Each frame's gap is plotted once: the samples of edits after it have none.
             exact_step: self.exact_step_gap.take().map(|gap| gap.largest),
         });

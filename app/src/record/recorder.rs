@@ -225,6 +225,9 @@ impl<'a> Recorder<'a> {
             ("external", energy.external),
             ("elastic", elastic),
             ("total", energy.total),
+            ("taken_by_ground", energy.taken.ground),
+            ("taken_by_damping", energy.taken.damping),
+            ("taken_by_settling", energy.taken.settling),
         ] {
             log(&format!("energy/{name}"), &rerun::Scalars::single(value));
         }

@@ -29,7 +29,7 @@
 //! does.
 
 use crate::constraints::{Family, PerFamily};
-use crate::simulation::Simulation;
+use crate::simulation::{Simulation, Taken};
 use glam::DVec3;
 
 /// The energy of one state, J.
@@ -46,6 +46,9 @@ pub struct Energy {
     pub elastic: PerFamily<f64>,
     /// The sum of them all.
     pub total: f64,
+    /// What the ground, damping and the settling cap took since the simulation was made, J
+    /// (not part of the total: energy gone from the body).
+    pub taken: Taken,
     /// Of each active family whose store the account cannot measure (rigid, or under PBD's
     /// stiffness), how far it is from holding: the largest and the sum of the relative violations
     /// of its constraints ([`VIOLATED`]; (0, 0) for the others, and for all where measured by
@@ -106,6 +109,7 @@ impl Energy {
             gravitational,
             external,
             total: kinetic + gravitational + external + elastic_sum,
+            taken: simulation.state().taken,
             elastic,
             violation: PerFamily::default(),
         }
@@ -151,13 +155,17 @@ fn violation(simulation: &Simulation, family: Family, x: &[DVec3]) -> (f64, f64)
 pub struct Gain {
     /// The frame at whose end the total was highest above its lowest before.
     pub frame: u64,
-    /// The total at that frame less the lowest total before it, J.
+    /// The total at that frame less the lowest total before it, J, what left the body between
+    /// them added back ([`EnergyWatch`]).
     pub amount: f64,
     /// What rose most over that frame.
     pub from: String,
 }
 
-/// A run's energy, frame by frame: the lowest total so far, and the largest rise above it.
+/// A run's energy, frame by frame: the lowest total so far, and the largest rise above it, with
+/// what left the body added back to the total: what the ground and damping took since the start
+/// ([`Taken`]). So energy the ground takes in a landing cannot hide a gain elsewhere in the same
+/// frame.
 ///
 /// A run that only loses energy never rises above its lowest total. The bound a rise is held to
 /// is [`EnergyWatch::TOLERANCE`] of the run's scale: the start's kinetic, elastic and external
@@ -176,6 +184,11 @@ pub struct EnergyWatch {
     scale: f64,
     /// The total at the start, J.
     pub start_total: f64,
+    /// What had left the body at the start ([`Energy::taken`]), J.
+    start_taken: Taken,
+    /// Whether some active family has a store the account cannot measure (rigid, or under PBD's
+    /// stiffness): then what the solver's projections dissipated cannot be told.
+    unmeasured: bool,
     last: Energy,
     /// The largest rise above the lowest total before it, once it passed the bound.
     pub gain: Option<Gain>,
@@ -221,6 +234,9 @@ impl EnergyWatch {
             },
             mass,
             start_total: energy.total,
+            start_taken: energy.taken,
+            unmeasured: (simulation.families().all())
+                .any(|f| simulation.active()[f] && !simulation.resolved().stores_energy(f)),
             scale: scale.max(f64::MIN_POSITIVE),
             last: energy,
             gain: None,
@@ -231,7 +247,7 @@ impl EnergyWatch {
     /// The energy after `frame`: measured, compared with the lowest before, and returned.
     pub fn observe(&mut self, simulation: &Simulation, frame: u64) -> &Energy {
         let energy = Energy::measure_with_violation(simulation);
-        let step = energy.total - self.last.total;
+        let step = self.held(&energy) - self.held(&self.last);
         // A store the account cannot measure is released while it is undone (module docs):
         // a rigid family's from the budget its violated start holds, in frames that begin with
         // it violated; one under PBD's stiffness as its strain goes, up to what undoing that
@@ -258,7 +274,7 @@ impl EnergyWatch {
             self.released += release;
             self.lowest += release;
         }
-        let rise = energy.total - self.lowest;
+        let rise = self.held(&energy) - self.lowest;
         let largest = self.gain.as_ref().map_or(0.0, |g| g.amount);
         if rise > Self::TOLERANCE * self.scale && rise > largest {
             self.gain = Some(Gain {
@@ -267,9 +283,24 @@ impl EnergyWatch {
                 from: grew_most(simulation, &self.last, &energy),
             });
         }
-        self.lowest = self.lowest.min(energy.total);
+        self.lowest = self.lowest.min(self.held(&energy));
         self.last = energy;
         &self.last
+    }
+
+    /// The total of `energy` with what the ground and damping took since the start added back,
+    /// J: what the watch holds to never rise. What the settling cap took is not: the cap removes
+    /// only speed a frame's projections gave beyond what a particle had, which never was in the
+    /// account (a rigid family's store let go, or a gain cut off as it was made), so adding it
+    /// back would count that release a second time.
+    fn held(&self, energy: &Energy) -> f64 {
+        let taken = energy.taken - self.start_taken;
+        energy.total + taken.ground + taken.damping
+    }
+
+    /// What the ground, damping and the settling cap took since the start, J.
+    pub fn taken(&self) -> Taken {
+        self.last.taken - self.start_taken
     }
 
     /// The bound a rise is held to, J.
@@ -283,8 +314,10 @@ impl EnergyWatch {
     }
 
     /// What a front end prints of the account: the total at the start and now with the parts
-    /// of the last, what unmeasured stores released (if any), and a warning naming the frame and
-    /// what rose most where the total grew past the bound.
+    /// of the last, what left the body (where more than a thousandth of the bound) and, where
+    /// every active family's store is measured, what the solver's projections dissipated beside
+    /// it, what unmeasured stores released (if any),
+    /// and a warning naming the frame and what rose most where the total grew past the bound.
     ///
     /// ```
     /// use tetlab_core::measures::energy_account::EnergyWatch;
@@ -308,6 +341,20 @@ impl EnergyWatch {
              {:.3e}, elastic {:.3e})",
             self.start_total, last.total, last.kinetic, last.gravitational, elastic
         )];
+        let taken = self.taken();
+        if taken.total() > 1e-3 * self.bound() {
+            let mut line = format!(
+                "energy that left the body: {:.4e} J to the ground, {:.4e} J to damping, {:.4e} \
+                 J to the settling cap",
+                taken.ground, taken.damping, taken.settling
+            );
+            // With every store measured, the rest of what the total lost is the solver's own.
+            if !self.unmeasured {
+                let solver = self.start_total - last.total - taken.total();
+                line += &format!("; the solver's projections dissipated {solver:.4e} J");
+            }
+            lines.push(line);
+        }
         if self.released > 0.0 {
             lines.push(format!(
                 "energy released by families undoing their violation: {:.4e} J (a rigid family, or \

@@ -54,6 +54,7 @@ impl Simulation {
         let (_, body, state) = self.edit();
         state.positions.copy_from_slice(&body.rest_positions);
         stop(state);
+        state.taken = super::Taken::default();
         self.skipped = Default::default();
         self.settling = None;
         self.frame = 0;

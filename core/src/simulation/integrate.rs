@@ -45,6 +45,10 @@ pub struct Substep {
 ///
 /// With `residuals` ([`Residuals`]), x + r advances by v h: x = fl(x + (v h + r)), and r keeps
 /// what the rounding lost, r = (v h + r) − (x_new − x).
+///
+/// `pushes` starts the substep's tally of the ground's moves ([`Book::pushes`]): 0, or the move
+/// back onto the ground of a particle predicted below it.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn predict<V: Vector3>(
     positions: &mut [V],
     previous: &mut [V],
@@ -53,6 +57,7 @@ pub(crate) fn predict<V: Vector3>(
     forces: &[V],
     substep: Substep,
     mut residuals: Option<Residuals<'_, V>>,
+    pushes: &mut [V],
 ) where
     V::Real: PartialOrd,
 {
@@ -65,8 +70,10 @@ pub(crate) fn predict<V: Vector3>(
     let pull = V::from_f64s(0.0, -gravity, 0.0) * V::Real::from_f64(h);
     let h = V::Real::from_f64(h);
     let floor = ground.map(V::Real::from_f64);
+    let zero = V::from_f64s(0.0, 0.0, 0.0);
     for i in 0..positions.len() {
         previous[i] = positions[i];
+        pushes[i] = zero;
         if let Some(r) = &mut residuals {
             r.previous[i] = r.now[i];
         }
@@ -94,27 +101,34 @@ pub(crate) fn predict<V: Vector3>(
         if let Some(floor) = floor
             && positions[i].y() < floor
         {
+            let predicted = positions[i];
             positions[i] = previous[i];
             positions[i].set_y(floor);
+            pushes[i] = positions[i] - predicted;
             if let Some(r) = &mut residuals {
+                let predicted = r.now[i];
                 r.now[i] = r.previous[i];
                 r.now[i].set_y(V::Real::ZERO);
+                pushes[i] += r.now[i] - predicted;
             }
         }
     }
 }
 
-/// The ground as a constraint: y ≥ `ground` for every free particle.
+/// The ground as a constraint: y ≥ `ground` for every free particle, each move added to the
+/// particle's push of the substep ([`Book::pushes`]).
 pub(crate) fn project_ground<V: Vector3>(
     positions: &mut [V],
     inverse_masses: &[V::Real],
     ground: f64,
+    pushes: &mut [V],
 ) where
     V::Real: PartialOrd,
 {
     let floor = V::Real::from_f64(ground);
-    for (p, &w) in positions.iter_mut().zip(inverse_masses) {
+    for ((p, &w), push) in positions.iter_mut().zip(inverse_masses).zip(pushes) {
         if w > V::Real::ZERO && p.y() < floor {
+            *push += V::from_array([V::Real::ZERO, floor - p.y(), V::Real::ZERO]);
             p.set_y(floor);
         }
     }
@@ -130,9 +144,36 @@ pub(crate) fn hold_plane<V: Vector3>(positions: &mut [V], previous: &[V]) {
     }
 }
 
+/// What the velocity update books of each particle's energy: what the ground, damping and the
+/// settling cap took from it ([`crate::simulation::Taken`]).
+///
+/// The ground acts on a particle by moving it (`pushes`: the sum of its moves within the
+/// substep, Δx_g, from [`predict`] and [`project_ground`]), an impulse m Δx_g / h. Its work is
+/// that impulse against the particle's mean velocity over the substep, (v₀ + v₁) / 2, v₀ at the
+/// start (before gravity and the forces) and v₁ at the end (before damping): the work of an
+/// impulse, exact when nothing else acts, and 0 for a particle resting on the ground (v₀ = v₁ =
+/// 0), whose push only undoes gravity's. It is negative for a landing or a particle held by the
+/// ground's sticking, and the ground took −W. Damping took ½ m |v₁|² (1 − k²) of the velocity
+/// it multiplied by k; the settling cap ½ m (|v₁|² − |v_cap|²).
+pub(crate) struct Book<'a, V: Vector3> {
+    /// The inverse masses (0: held, not booked).
+    pub inverse_masses: &'a [V::Real],
+    /// The external forces per particle, N (empty: none), which the prediction added.
+    pub forces: &'a [V],
+    /// Gravity, m/s², along −y, which the prediction added.
+    pub gravity: f64,
+    /// The ground's moves of each particle within the substep, Δx_g.
+    pub pushes: &'a [V],
+    /// Per particle, what was taken so far (J), added to: x the ground's, y damping's, z the
+    /// settling cap's.
+    pub taken: &'a mut [V],
+}
+
 /// v = (x − x_prev) / h, then damped: v *= max(0, 1 − damping · h). With `cap`, |v| is first
 /// limited to the speed the particle had before (the predicted velocity in `velocities`). With
 /// `residuals` ([`Residuals`]), v = ((x − x_prev) + (r − r_prev)) / h: the motion of x + r.
+/// What the ground, damping and the cap took is added to `book` ([`Book`]).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn update_velocities<V: Vector3>(
     positions: &[V],
     previous: &[V],
@@ -141,23 +182,42 @@ pub(crate) fn update_velocities<V: Vector3>(
     damping: f64,
     cap: bool,
     residuals: Option<&Residuals<'_, V>>,
+    book: Book<'_, V>,
 ) where
     V::Real: PartialOrd,
 {
     let keep = V::Real::from_f64((1.0 - damping * h).max(0.0));
+    let lost = V::Real::ONE - keep * keep;
+    let half = V::Real::from_f64(0.5);
+    let pull = V::from_f64s(0.0, -book.gravity * h, 0.0);
     let h = V::Real::from_f64(h);
     for i in 0..positions.len() {
         let moved = match residuals {
             None => positions[i] - previous[i],
             Some(r) => (positions[i] - previous[i]) + (r.now[i] - r.previous[i]),
         };
-        let mut velocity = moved / h;
+        let end = moved / h;
+        let mut velocity = end;
         if cap {
             let limit = velocities[i].length();
             let squared = velocity.length_squared();
             if squared > limit * limit {
                 velocity = (velocity / squared.sqrt()) * limit;
             }
+        }
+        let w = book.inverse_masses[i];
+        if w > V::Real::ZERO {
+            let half_mass = half / w;
+            let mut added = pull;
+            if let Some(&force) = book.forces.get(i) {
+                added += force * (w * h);
+            }
+            // velocities[i] is still the predicted velocity, v₀ + (g + w f) h.
+            let start = velocities[i] - added;
+            let ground = -(half_mass / h) * book.pushes[i].dot(start + end);
+            let kept = velocity.length_squared();
+            let capped = half_mass * (end.length_squared() - kept);
+            book.taken[i] += V::from_array([ground, half_mass * kept * lost, capped]);
         }
         velocities[i] = velocity * keep;
     }

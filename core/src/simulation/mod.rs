@@ -46,7 +46,7 @@ pub use reference::{OnState, ReferenceEngine};
 pub use resolved::Resolved;
 pub use settings::{DEFAULT_SUBSTEPS, Method, Settings, settable_family};
 pub use settling::VIOLATED;
-pub use state::{Body, Grab, Revision, State};
+pub use state::{Body, Grab, Revision, State, Taken};
 
 use crate::constraints::{Families, Family, PerFamily};
 use crate::scene::Scene;

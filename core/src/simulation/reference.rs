@@ -108,6 +108,7 @@ impl Substeps for OnState<'_> {
             &self.body.forces,
             plan.motion,
             None,
+            &mut s.pushes,
         );
     }
 
@@ -144,7 +145,7 @@ impl Substeps for OnState<'_> {
     fn ground_and_plane(&mut self, plan: &Plan) {
         let s = &mut *self.state;
         if let Some(ground) = plan.motion.ground {
-            integrate::project_ground(&mut s.positions, &s.inverse_masses, ground);
+            integrate::project_ground(&mut s.positions, &s.inverse_masses, ground, &mut s.pushes);
         }
         if plan.motion.plane_strain {
             integrate::hold_plane(&mut s.positions, &s.previous);
@@ -174,7 +175,15 @@ impl Substeps for OnState<'_> {
             plan.damping,
             plan.settling,
             None,
+            integrate::Book {
+                inverse_masses: &s.inverse_masses,
+                forces: &self.body.forces,
+                gravity: plan.motion.gravity,
+                pushes: &s.pushes,
+                taken: &mut s.taken_by_particle,
+            },
         );
+        s.taken.add_and_clear(&mut s.taken_by_particle);
     }
 }
 

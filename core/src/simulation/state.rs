@@ -72,6 +72,62 @@ pub struct State {
     /// The particle the user holds, if any. Read afresh every frame: moving its target is not an
     /// edit ([`super::Simulation::move_grab`]).
     pub grab: Option<Grab>,
+    /// The ground's moves of each particle within the current substep (what it took is worked
+    /// out from them at the substep's end: `integrate::Book`).
+    pub pushes: Vec<DVec3>,
+    /// Per particle, what the ground, damping and the settling cap took within the current
+    /// substep (J), before it is added to [`State::taken`].
+    pub taken_by_particle: Vec<DVec3>,
+    /// What the ground, damping and the settling cap took from the body so far, J.
+    pub taken: Taken,
+}
+
+/// The energy taken from a body by what is not a family (J): the ground (its impulses against
+/// the particles' motion: landings, and its sticking friction), velocity damping, and the cap
+/// on speed while an edit settles. What XPBD's own projections dissipate is not among them: it
+/// is what the energy account's total lost beyond these.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Taken {
+    /// By the ground, J.
+    pub ground: f64,
+    /// By velocity damping, J.
+    pub damping: f64,
+    /// By the speed cap of settling edits, J.
+    pub settling: f64,
+}
+
+impl Taken {
+    /// Adds per-particle tallies (x the ground's, y damping's, z the cap's, J) in order, and
+    /// zeroes them.
+    pub(crate) fn add_and_clear<V: crate::numbers::vector::Vector3>(&mut self, tallies: &mut [V])
+    where
+        V::Real: Into<f64>,
+    {
+        let zero = V::from_f64s(0.0, 0.0, 0.0);
+        for tally in tallies {
+            let [ground, damping, settling] = tally.to_array();
+            self.ground += ground.into();
+            self.damping += damping.into();
+            self.settling += settling.into();
+            *tally = zero;
+        }
+    }
+
+    /// The sum of the three, J.
+    pub fn total(&self) -> f64 {
+        self.ground + self.damping + self.settling
+    }
+}
+
+impl std::ops::Sub for Taken {
+    type Output = Taken;
+    fn sub(self, other: Taken) -> Taken {
+        Taken {
+            ground: self.ground - other.ground,
+            damping: self.damping - other.damping,
+            settling: self.settling - other.settling,
+        }
+    }
 }
 
 /// How many times the body and the state have been edited: what an engine compares with what
@@ -100,6 +156,9 @@ impl State {
             frame_corrections: vec![DVec3::ZERO; n],
             lambdas: body.sets.map(|set| vec![0.0; set.len()]),
             grab: None,
+            pushes: vec![DVec3::ZERO; n],
+            taken_by_particle: vec![DVec3::ZERO; n],
+            taken: Taken::default(),
         }
     }
 
@@ -126,6 +185,8 @@ impl State {
             + bytes(&self.pinned)
             + bytes(&self.corrections)
             + bytes(&self.frame_corrections)
+            + bytes(&self.pushes)
+            + bytes(&self.taken_by_particle)
             + (self.lambdas.every_place())
                 .map(|l| l.capacity() * size_of::<f64>())
                 .sum::<usize>()

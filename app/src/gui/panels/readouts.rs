@@ -33,6 +33,7 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
         PLOT_HEIGHT
     };
     let m = &bench.metrics;
+    let taken = bench.simulation.state().taken;
     for warning in [
         &bench.stability_warning,
         &bench.newton_warning,
@@ -72,6 +73,10 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
                 bench.history.back().map_or_else(String::new, |s| {
                     format!("{:.2e}, {:.2e} J", s.energy[0], s.energy[2])
                 }),
+            ),
+            (
+                "to ground, damping",
+                format!("{:.2e}, {:.2e} J", taken.ground, taken.damping),
             ),
             (
                 "settling an edit",
@@ -144,14 +149,21 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
             plot.line(series("min V/V0", |s| s.metrics.min_volume_ratio));
             plot.line(series("volume error", |s| s.metrics.volume_error));
         });
-    // The energy account: a total that rises, beyond what a violated rigid family releases, is
-    // a gain (tetlab_core::measures::energy_account).
+    // The energy account: a total that rises, with what the ground and damping took added
+    // back and beyond what a violated rigid family releases, is a gain
+    // (tetlab_core::measures::energy_account).
     Plot::new("energy plot")
         .height(plot_height)
-        .legend(Legend::default())
+        // Four series: a small legend, in their order, so that it leaves the plot visible.
+        .legend(
+            Legend::default()
+                .text_style(egui::TextStyle::Small)
+                .follow_insertion_order(true),
+        )
         .allow_scroll(false)
         .show(ui, |plot| {
             plot.line(series("total energy, J", |s| s.energy[3]));
+            plot.line(series("total + taken", |s| s.energy[4]));
             plot.line(series("kinetic", |s| s.energy[0]));
             plot.line(series("elastic", |s| s.energy[2]));
         });

@@ -56,7 +56,7 @@ use crate::constraints::{Families, Family, PerFamily};
 use crate::simulation::engine::{Engine, Frame, Start};
 use crate::simulation::projection::SkipCounts;
 use crate::simulation::substep::{self, Plan};
-use crate::simulation::{Divergence, Resolved};
+use crate::simulation::{Divergence, Resolved, Taken};
 use family_batches::Jacobi;
 use glam::{DVec3, Vec3A};
 use layouts::Layouts;
@@ -152,6 +152,11 @@ pub struct FastSimulation {
     forces: Vec<Vec3A>,
     /// Whether every particle keeps its z ([`crate::simulation::Simulation::set_plane_strain`]).
     plane_strain: bool,
+    /// The ground's moves of each particle within the substep (`integrate::Book`).
+    pushes: Vec<Vec3A>,
+    /// Per particle, what the ground, damping and the settling cap took within the frame (J),
+    /// summed in order once a frame ([`crate::simulation::Taken`]), so for any thread count.
+    taken: Vec<Vec3A>,
 }
 
 /// Δp per particle (new numbering), kept on request.
@@ -257,6 +262,8 @@ impl FastSimulation {
             corrections: Corrections::default(),
             forces,
             plane_strain: body.plane_strain,
+            pushes: vec![Vec3A::ZERO; n],
+            taken: vec![Vec3A::ZERO; n],
         }
     }
 
@@ -351,8 +358,9 @@ impl FastSimulation {
     }
 
     /// One frame of `plan` on its own arrays; large colours are shared with its team's threads,
-    /// which wait for the next colour spinning, not asleep, while a frame is under way.
-    fn run(&mut self, plan: &Plan) {
+    /// which wait for the next colour spinning, not asleep, while a frame is under way. Returns
+    /// what the ground, damping and the settling cap took over the frame.
+    fn run(&mut self, plan: &Plan) -> Taken {
         let team = self.team.take();
         let mut on = substeps::OnArrays {
             simulation: self,
@@ -362,6 +370,9 @@ impl FastSimulation {
         substep::frame(&mut on, plan);
         self.team = team;
         self.frame += 1;
+        let mut taken = Taken::default();
+        taken.add_and_clear(&mut self.taken);
+        taken
     }
 
     /// Projects in `order` from now on (Gauss–Seidel unless set).
@@ -436,7 +447,7 @@ impl FastSimulation {
     /// velocities, residuals and theirs at the start of the substep) and read (inverse masses,
     /// forces).
     #[allow(clippy::type_complexity)]
-    fn particle_arrays(&mut self) -> ([&mut [Vec3A]; 5], &[f32], &[Vec3A]) {
+    fn particle_arrays(&mut self) -> ([&mut [Vec3A]; 7], &[f32], &[Vec3A]) {
         (
             [
                 &mut self.positions,
@@ -444,6 +455,8 @@ impl FastSimulation {
                 &mut self.velocities,
                 &mut self.residuals,
                 &mut self.previous_residuals,
+                &mut self.pushes,
+                &mut self.taken,
             ],
             &self.inverse_masses,
             &self.forces,
@@ -476,8 +489,11 @@ impl Engine for FastSimulation {
             grab,
             frame.settling,
         );
-        self.run(&plan);
+        let taken = self.run(&plan);
         let state = frame.state;
+        state.taken.ground += taken.ground;
+        state.taken.damping += taken.damping;
+        state.taken.settling += taken.settling;
         let corrections = (&mut state.corrections[..], &mut state.frame_corrections[..]);
         self.store(
             &mut state.positions,

@@ -47,7 +47,7 @@ impl Substeps for OnArrays<'_> {
         schedule::by_particles(
             self.team,
             arrays,
-            |range, [positions, previous, velocities, now, before]| {
+            |range, [positions, previous, velocities, now, before, pushes, _]| {
                 let forces = forces.get(range.clone()).unwrap_or_default();
                 integrate::predict(
                     positions,
@@ -60,6 +60,7 @@ impl Substeps for OnArrays<'_> {
                         now,
                         previous: before,
                     }),
+                    pushes,
                 );
             },
         );
@@ -137,9 +138,11 @@ impl Substeps for OnArrays<'_> {
             return;
         }
         let (inverse_masses, previous) = (&s.inverse_masses[..], &s.previous[..]);
-        schedule::by_particles(self.team, [&mut s.positions], |range, [positions]| {
+        let arrays = [&mut s.positions[..], &mut s.pushes[..]];
+        schedule::by_particles(self.team, arrays, |range, [positions, pushes]| {
             if let Some(ground) = ground {
-                integrate::project_ground(positions, &inverse_masses[range.clone()], ground);
+                let inverse_masses = &inverse_masses[range.clone()];
+                integrate::project_ground(positions, inverse_masses, ground, pushes);
             }
             if plane_strain {
                 integrate::hold_plane(positions, &previous[range]);
@@ -164,10 +167,12 @@ impl Substeps for OnArrays<'_> {
 
     fn update_velocities(&mut self, plan: &Plan) {
         let (h, damping, settling) = (plan.h, plan.damping, plan.settling);
+        let gravity = plan.motion.gravity;
+        let (arrays, inverse_masses, forces) = self.simulation.particle_arrays();
         schedule::by_particles(
             self.team,
-            self.simulation.particle_arrays().0,
-            |_, [positions, previous, velocities, now, before]| {
+            arrays,
+            |range, [positions, previous, velocities, now, before, pushes, taken]| {
                 integrate::update_velocities(
                     positions,
                     previous,
@@ -179,6 +184,13 @@ impl Substeps for OnArrays<'_> {
                         now,
                         previous: before,
                     }),
+                    integrate::Book {
+                        inverse_masses: &inverse_masses[range.clone()],
+                        forces: forces.get(range).unwrap_or_default(),
+                        gravity,
+                        pushes,
+                        taken,
+                    },
                 );
             },
         );

@@ -150,13 +150,15 @@ pub(super) struct Scales {
 }
 
 /// Minimises `objective` from `x` (moved in place): Newton on Φ, in an augmented Lagrangian loop
-/// when it has rigid constraints or a ground.
+/// when it has rigid constraints or a ground. With a ground, `ground_forces` gets the force (N,
+/// along +y) it holds each particle up with at the end, max(0, μ − ρ_g (y − y₀)) (0 without).
 pub(super) fn minimize(
     objective: &Objective<'_>,
     x: &mut [DVec3],
     factoriser: &mut Factoriser,
     scales: Scales,
     options: &Options,
+    ground_forces: &mut Vec<f64>,
 ) -> Result<Report, String> {
     let Scales {
         stiffness,
@@ -207,6 +209,14 @@ pub(super) fn minimize(
             multipliers.rho_ground *= 10.0;
         }
         last_violation = report.violation;
+    }
+    ground_forces.clear();
+    ground_forces.resize(x.len(), 0.0);
+    if let Some(ground) = objective.ground {
+        let rho = multipliers.rho_ground;
+        for ((force, mu), p) in ground_forces.iter_mut().zip(&multipliers.ground).zip(&*x) {
+            *force = (mu - rho * (p.y - ground)).max(0.0);
+        }
     }
     Ok(report)
 }

@@ -85,6 +85,8 @@ pub struct NewtonEngine {
     last: Report,
     /// Substeps whose solve did not converge, since the engine was built.
     unconverged: u64,
+    /// The force the ground holds each particle up with at the end of the last solve, N.
+    ground_forces: Vec<f64>,
 }
 
 impl NewtonEngine {
@@ -232,7 +234,17 @@ impl Substeps for Implicit<'_> {
             &mut engine.factoriser,
             scales,
             &engine.options,
+            &mut engine.ground_forces,
         );
+        // The ground's share of the move from x̃: x = x̃ + h² W (f_ground − ∇E), so its push is
+        // h² w f_ground along +y (what it took is booked from it, as on every engine).
+        let h2 = plan.h * plan.h;
+        for ((push, &w), &force) in (state.pushes.iter_mut())
+            .zip(&state.inverse_masses)
+            .zip(&engine.ground_forces)
+        {
+            push.y += h2 * w * force;
+        }
         engine.last = solved.unwrap_or_default();
         if !engine.last.converged {
             engine.unconverged += 1;
@@ -292,6 +304,7 @@ pub fn equilibrium(start: Start<'_>, options: &Options) -> Result<(Vec<DVec3>, R
         &mut Factoriser::default(),
         scales,
         options,
+        &mut Vec::new(),
     )?;
     Ok((x, report))
 }
