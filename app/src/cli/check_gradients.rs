@@ -303,9 +303,7 @@ fn file_output(
         worst,
         automatic_vs_finite_difference: report.automatic_vs_finite_difference,
         translation_invariant: report.translation_invariant(),
-        your_gradient_translation_invariant: report
-            .translation_given
-            .map(|t| t <= tetlab_core::constraint_file::check::INVARIANCE),
+        your_gradient_translation_invariant: report.given_translation_invariant(),
         rotation_invariant: report.rotation_invariant(),
         kinks: kinks
             .iter()
@@ -363,9 +361,9 @@ fn write_file_report(
     )?;
     writeln!(
         out,
-        "translation invariant (sum of the gradients = 0): AD's {} ({:.1e})",
+        "translation invariant (sum of the gradients = 0): AD's {} ({})",
         yes(o.translation_invariant),
-        report.translation
+        against_rounding(report.translation, report.translation_excess)
     )?;
     match report.translation_given {
         Some(t) => writeln!(
@@ -373,7 +371,7 @@ fn write_file_report(
             "  and yours {} ({})",
             yes(o.your_gradient_translation_invariant == Some(true)),
             if t.is_finite() {
-                format!("{t:.1e}")
+                against_rounding(t, report.translation_given_excess.unwrap_or(0.0))
             } else {
                 "non-finite".to_owned()
             }
@@ -385,9 +383,9 @@ fn write_file_report(
     }
     writeln!(
         out,
-        "rotation invariant (sum of p x gradient = 0): {} ({:.1e})",
+        "rotation invariant (sum of p x gradient = 0): {} ({})",
         yes(o.rotation_invariant),
-        report.rotation
+        against_rounding(report.rotation, report.rotation_excess)
     )?;
     match report.reflection {
         Reflection::Untried => writeln!(out, "a reflection (x -> -x): {}", o.reflection)?,
@@ -549,4 +547,18 @@ fn write(args: &Args, rows: &[Row], out: &mut impl Write) -> std::io::Result<()>
         MAX_SAMPLES
     )?;
     Ok(())
+}
+
+/// A largest sum of an invariance check (relative to the gradient's size), and what it is
+/// against rounding: within the fixed bound, within what rounding allows at its configuration
+/// (an ill-conditioned one), or how many times that it is.
+fn against_rounding(largest: f64, excess: f64) -> String {
+    use tetlab_core::constraint_file::check::INVARIANCE;
+    if largest <= INVARIANCE {
+        format!("{largest:.1e}")
+    } else if excess <= 1.0 {
+        format!("{largest:.1e}, within what rounding gives at that configuration")
+    } else {
+        format!("{largest:.1e}, {excess:.1e} times what rounding gives there")
+    }
 }

@@ -26,7 +26,9 @@ pub const CONDITIONING: f64 = 0.05;
 pub const AGREEMENT: f64 = 1e-6;
 
 /// The largest |Σᵢ ∇ᵢC| (and |Σᵢ pᵢ × ∇ᵢC|), relative to the gradient's size (times the
-/// configuration's), at which C counts as translation (rotation) invariant.
+/// configuration's), at which C counts as translation (rotation) invariant, where rounding
+/// allows no less; where it allows more, what it allows at that configuration
+/// ([`rounding_floor`]).
 pub const INVARIANCE: f64 = 1e-9;
 
 /// The configuration where the file's gradient is furthest from AD.
@@ -93,6 +95,15 @@ pub struct Report {
     pub translation_given: Option<f64>,
     /// The largest |Σᵢ (pᵢ − centre) × ∇ᵢC| / (maxᵢ |∇ᵢC| · size) (AD).
     pub rotation: f64,
+    /// The largest of [`Report::translation`]'s ratios to what rounding allows at its own
+    /// configuration ([`rounding_floor`]): at most 1 for a translation-invariant C.
+    pub translation_excess: f64,
+    /// The same of [`Report::translation_given`].
+    pub translation_given_excess: Option<f64>,
+    /// The same of [`Report::rotation`].
+    pub rotation_excess: f64,
+    /// The largest that rounding allowed at any configuration, relative ([`rounding_floor`]).
+    pub rounding: f64,
     /// What a reflection does to C (with rest 0).
     pub reflection: Reflection,
     /// Near-degenerate configurations evaluated (points coincident or coplanar).
@@ -110,14 +121,21 @@ impl Report {
             .all(|&e| e <= AGREEMENT)
     }
 
-    /// Whether Σᵢ ∇ᵢC = 0 within [`INVARIANCE`].
+    /// Whether Σᵢ ∇ᵢC = 0 (AD's) at every configuration, within [`INVARIANCE`] or what rounding
+    /// allows there ([`rounding_floor`]).
     pub fn translation_invariant(&self) -> bool {
-        self.translation <= INVARIANCE
+        self.translation_excess <= 1.0
     }
 
-    /// Whether Σᵢ pᵢ × ∇ᵢC = 0 within [`INVARIANCE`].
+    /// The same of the gradient the source gives, when it gives every particle's.
+    pub fn given_translation_invariant(&self) -> Option<bool> {
+        self.translation_given_excess.map(|excess| excess <= 1.0)
+    }
+
+    /// Whether Σᵢ pᵢ × ∇ᵢC = 0 at every configuration, within [`INVARIANCE`] or what rounding
+    /// allows there.
     pub fn rotation_invariant(&self) -> bool {
-        self.rotation <= INVARIANCE
+        self.rotation_excess <= 1.0
     }
 }
 
@@ -354,6 +372,47 @@ pub fn random_check(
     }
 }
 
+/// What rounding can make of Σᵢ ∇ᵢC at one configuration, relative to the gradient's size
+/// `scale`, never below [`INVARIANCE`]: how far AD's gradient (`automatic`) moves when every
+/// point moves by the same 10⁻⁹ of the configuration's size, times the particles (a sum of that
+/// many terms) and a margin of 10.
+///
+/// Why: such a move leaves the exact gradient of a translation-invariant C as it is, and changes
+/// the rounding of every operation, so the change is the rounding's size there. An exactly
+/// invariant C on an ill-conditioned rest shape (det F − 1, a normalised shear: Dm⁻¹ large) has
+/// Σ ∇C of 10⁻⁸ of |∇C| from rounding alone, which a fixed bound of 10⁻⁹ read as "not
+/// invariant". A C that is not invariant changes by H t there, 10⁻⁹ of it, and its Σ ∇C (a
+/// property of C, the size of ∇C itself) stays far above the floor.
+fn rounding_floor<S: GradientSource>(
+    source: &S,
+    (points, rest, shape): (&[DVec3], f64, &[DVec3]),
+    automatic: &[DVec3],
+    scale: f64,
+) -> f64 {
+    let size = points
+        .iter()
+        .flat_map(|p| points.iter().map(move |q| p.distance(*q)))
+        .fold(0.0, f64::max);
+    let shift = DVec3::new(0.48, -0.62, 0.62) * (1e-9 * size);
+    let moved: Vec<DVec3> = points.iter().map(|p| *p + shift).collect();
+    // The rest shape too (by another shift): the rounding of what is worked out from it (Dm⁻¹)
+    // is as much the configuration's as that of the points.
+    let reshaped: Vec<DVec3> = shape
+        .iter()
+        .map(|p| *p + DVec3::new(shift.z, shift.x, shift.y))
+        .collect();
+    let noise = match source.automatic(&moved, rest, &reshaped) {
+        Some(again) => max_abs_error(&again, automatic) / scale,
+        None => 0.0,
+    };
+    let floor = 10.0 * points.len() as f64 * noise;
+    if floor.is_finite() {
+        floor.max(INVARIANCE)
+    } else {
+        INVARIANCE
+    }
+}
+
 /// Compares on `configs` well-conditioned random configurations ([`draw`]; rest value the natural
 /// one × U(−1.5, 1.5)), then on near-degenerate ones.
 pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report {
@@ -368,6 +427,10 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
         translation: 0.0,
         translation_given: None,
         rotation: 0.0,
+        translation_excess: 0.0,
+        translation_given_excess: None,
+        rotation_excess: 0.0,
+        rounding: INVARIANCE,
         reflection: Reflection::Unchanged,
         near_degenerate: 0,
         undefined: 0,
@@ -399,12 +462,20 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
             .automatic_vs_finite_difference
             .max(relative_error(&automatic, &numeric));
         let given = source.given(&points, rest, &shape);
+        let floor = if scale > 0.0 {
+            rounding_floor(source, (&points, rest, &shape), &automatic, scale)
+        } else {
+            INVARIANCE
+        };
+        report.rounding = report.rounding.max(floor);
         if scale > 0.0 && given.iter().all(Option::is_some) {
             let sum: DVec3 = given.iter().flatten().sum();
             let off = sum.length() / scale;
             let off = if off.is_finite() { off } else { f64::INFINITY };
             let slot = report.translation_given.get_or_insert(0.0);
             *slot = slot.max(off);
+            let slot = report.translation_given_excess.get_or_insert(0.0);
+            *slot = slot.max(off / floor);
         }
         for (k, yours) in given.iter().enumerate() {
             let Some(yours) = yours else { continue };
@@ -439,14 +510,18 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
         }
         if scale > 0.0 {
             let sum: DVec3 = automatic.iter().sum();
-            report.translation = report.translation.max(sum.length() / scale);
+            let translation = sum.length() / scale;
+            report.translation = report.translation.max(translation);
+            report.translation_excess = report.translation_excess.max(translation / floor);
             let mean = points.iter().sum::<DVec3>() / arity as f64;
             let torque: DVec3 = points
                 .iter()
                 .zip(&automatic)
                 .map(|(p, g)| (*p - mean).cross(*g))
                 .sum();
-            report.rotation = report.rotation.max(torque.length() / (scale * size));
+            let rotation = torque.length() / (scale * size);
+            report.rotation = report.rotation.max(rotation);
+            report.rotation_excess = report.rotation_excess.max(rotation / floor);
         }
         // Reflection, and a rotation's effect on C itself, with rest 0.
         let raw = source.value(&points, 0.0, &shape);

@@ -12,13 +12,13 @@
 //!
 //! A constraint is skipped (no correction) where its evaluation is degenerate (undefined ∇C),
 //! where every particle is fixed, where it is [`LOCKED`], and where its step would be longer
-//! than [`DEFAULT_REACH`] times the longest rest edge of its element: such a step is not a correction
-//! but a singularity of ∇C (see [`DEFAULT_REACH`]). The degenerate and the too long are counted
-//! ([`SkipCounts`]).
+//! than [`DEFAULT_REACH`] times the longest rest edge of its element and would lengthen the
+//! element ([`correct_in_reach`]): such a step is not a correction but a singularity of ∇C (see
+//! [`DEFAULT_REACH`]). The degenerate and the too long are counted ([`SkipCounts`]).
 
 pub use super::settings::DEFAULT_REACH;
 use crate::constraints::Evaluation;
-use crate::numbers::vector::{Real, Vector3};
+use crate::numbers::vector::{Mask, Real, Vector3};
 use glam::DVec3;
 
 /// The change one projection of `K` values makes: Δλ of each (XPBD; the scaled step s for PBD),
@@ -85,6 +85,86 @@ pub fn correct<V: Vector3, const N: usize, const K: usize>(
         }
         _ => unreachable!("a projection has one value or two"),
     }
+}
+
+/// [`correct`] with the reach of an element: a step longer than `reach` times `size` (the
+/// element's longest rest edge) is skipped, unless it leaves the element no larger than it is
+/// now (its `extent`, the longest distance between two of its particles at `positions`): a
+/// correction that pulls a stretched element together is the one that undoes the damage, and
+/// it is never a singularity's throw, which flings a particle away from the others.
+///
+/// Why: a body stretched far beyond its rest shape (1,200-fold in one frame by a dihedral-angle
+/// file on a mirrored cube) needs steps of its stretched size to come back; measured against the
+/// rest size alone, every one of them, the rigid edges' included, was skipped and the body could
+/// never return. Measured against the current size instead, each step could grow the element
+/// by the reach and the next step allow a longer one: a singular ∇C would throw the body without
+/// bound. A step that does not lengthen the element cannot do that.
+///
+/// The positions are read only where a step was too long (`positions` is called then), and a
+/// lane's correction is the same whether its neighbours' were or not.
+///
+/// ```
+/// use glam::DVec3;
+/// use tetlab_core::constraints::distance;
+/// use tetlab_core::simulation::projection::{Rule, correct_in_reach};
+/// // An edge of rest length 1 stretched to 1000: its correction, 999, is far beyond a reach of
+/// // 100 rest lengths, but it pulls the edge together, so it is made.
+/// let p = [DVec3::ZERO, DVec3::new(1000.0, 0.0, 0.0)];
+/// let rule = Rule::Xpbd { alpha_tilde: 0.0 };
+/// let pull = |p: [DVec3; 2]| {
+///     let e = distance::evaluate(&p, 1.0);
+///     correct_in_reach([e], [1.0, 1.0], [0.0], [rule], (100.0, 1.0), || p)
+/// };
+/// let c = pull(p);
+/// assert!(!c.skipped[0].too_long);
+/// assert!(((p[1] + c.delta_x[1] - p[0] - c.delta_x[0]).length() - 1.0).abs() < 1e-9);
+/// // Pushed apart instead (rest length 10⁶ from 1000), the same length of step is skipped.
+/// let e = distance::evaluate(&p, 1e6);
+/// let c = correct_in_reach([e], [1.0, 1.0], [0.0], [rule], (100.0, 1.0), || p);
+/// assert!(c.skipped[0].too_long);
+/// ```
+#[inline(always)]
+pub fn correct_in_reach<V: Vector3, const N: usize, const K: usize>(
+    evaluations: [Evaluation<V, N>; K],
+    weights: [V::Real; N],
+    lambda: [V::Real; K],
+    rules: [Rule<V::Real>; K],
+    (reach, size): (V::Real, V::Real),
+    positions: impl FnOnce() -> [V; N],
+) -> Correction<N, K, V> {
+    let limited = reach * size;
+    let first = correct(evaluations, weights, lambda, rules, limited);
+    if !first.skipped.iter().any(|s| s.too_long.any()) {
+        return first;
+    }
+    let p = positions();
+    let unlimited = V::Real::from_f64(f64::INFINITY);
+    let free = correct(evaluations, weights, lambda, rules, unlimited);
+    let mut after = p;
+    for (x, dx) in after.iter_mut().zip(free.delta_x) {
+        *x += dx;
+    }
+    let shrinks = extent(&after).le(extent(&p));
+    correct(
+        evaluations,
+        weights,
+        lambda,
+        rules,
+        V::Real::select(shrinks, unlimited, limited),
+    )
+}
+
+/// The longest squared distance between two of `p`: the size of an element now, squared.
+#[inline(always)]
+fn extent<V: Vector3, const N: usize>(p: &[V; N]) -> V::Real {
+    let mut largest = V::Real::ZERO;
+    for i in 0..N {
+        for j in i + 1..N {
+            let d = (p[i] - p[j]).length_squared();
+            largest = V::Real::select(d.gt(largest), d, largest);
+        }
+    }
+    largest
 }
 
 /// How a correction is scaled: XPBD with α̃ = α / h², or PBD with the per-iteration stiffness k′.

@@ -6,7 +6,7 @@
 use super::constraint_set::ConstraintSet;
 use super::engine::{Engine, Frame};
 use super::integrate;
-use super::projection::{Correction, Rule, SkipCounts, correct};
+use super::projection::{Correction, Rule, SkipCounts, correct_in_reach};
 use super::state::{Body, State};
 use super::substep::{self, GrabbedParticle, Plan, Substeps};
 use crate::constraints::{
@@ -257,7 +257,8 @@ pub(super) fn project_unit<const N: usize, const K: usize, P: Projected<N, K>>(
     let evaluations = constraint.evaluate_stored(&p, rest, &shape, stored);
     let weights = particles.map(|i| inverse_masses[i as usize]);
     let lambda = families.map(|f| lambdas[f][c]);
-    let correction = correct(evaluations, weights, lambda, rules, reach * lead.size()[c]);
+    let size = (reach, lead.size()[c]);
+    let correction = correct_in_reach(evaluations, weights, lambda, rules, size, || p);
     UnitProjection {
         particles,
         evaluations,

@@ -13,7 +13,9 @@ use crate::input::limits::{self, Bounds};
 /// How far one projection may move a particle by default ([`crate::simulation::Settings::reach`]),
 /// in longest rest edges of its element (the constraint's particles at rest: an edge's length,
 /// a tet's longest edge): 100. A step
-/// max |Δxᵢ| = wᵢ|∇ᵢC||Δλ| beyond it is skipped and counted ([`super::projection::Skipped::too_long`]).
+/// max |Δxᵢ| = wᵢ|∇ᵢC||Δλ| beyond it is skipped and counted ([`super::projection::Skipped::too_long`]),
+/// unless it leaves its element no larger than it is: a correction that pulls a stretched
+/// element together is made however long ([`super::projection::correct_in_reach`]).
 ///
 /// A projection moves a particle by about |C| / |∇C|, which grows without bound where ∇C
 /// vanishes and C does not: the dihedral angle's cosine at a folded or flattened hinge

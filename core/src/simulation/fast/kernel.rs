@@ -1,7 +1,7 @@
 //! The fast solver's kernel: what one projection moves (a family alone, or a pair as one
 //! constraint of two values, [`Projected`]) projected colour by colour, eight elements (edges,
 //! tets or a tet's vertices) at a time in SIMD lanes, through the generic formula and the
-//! projection rule every engine shares ([`correct`]); threads share large colours.
+//! projection rule every engine shares ([`correct_in_reach`]); threads share large colours.
 //!
 //! A batch's particles are gathered into registers, its constraints projected there, and the
 //! corrections added to the positions (Gauss–Seidel) or to the Jacobi sums.
@@ -13,7 +13,7 @@ use super::team::Team;
 use crate::constraints::{GROUP, Projected};
 use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
 use crate::numbers::vector::{Real, Vector3};
-use crate::simulation::projection::{Rule, SkipCounts, correct};
+use crate::simulation::projection::{Rule, SkipCounts, correct_in_reach};
 use glam::Vec3A;
 
 /// The particles `indices` (one per lane) as eight x, eight y and eight z.
@@ -84,7 +84,14 @@ fn project_batches<const N: usize, const K: usize, P: Projected<N, K>>(
         ($b:expr, $evaluations:expr) => {{
             let b = $b;
             let lambdas = std::array::from_fn(|k| lambda[k][b]);
-            let d = correct($evaluations, weights[b], lambdas, rules, size[b] * reach);
+            let d = correct_in_reach(
+                $evaluations,
+                weights[b],
+                lambdas,
+                rules,
+                (reach, size[b]),
+                || gather_batch(read, &particles[b]),
+            );
             for k in 0..K {
                 skips[k].add(d.skipped[k]);
                 lambda[k][b] += d.delta_lambda[k];
