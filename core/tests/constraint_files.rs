@@ -328,3 +328,27 @@ fn reverse_and_forward_mode_agree_on_every_example() {
         }
     }
 }
+
+/// A file may give every Hessian block its binding has, and they cost an element no storage:
+/// only the check runs them, from the rest shape. `green-strain.toml` gives all ten of a tet's,
+/// constant blocks bᵢ bⱼ I (90 numbers), and stores only what C and its gradient read (22
+/// numbers); each block
+/// agrees with AD. (Before, the blocks were stored with what else depends on the rest shape, and
+/// the file was refused at its value's line: "108 numbers per element; at most 48 are
+/// stored".)
+#[test]
+fn hessian_blocks_cost_an_element_no_storage() {
+    let file = load("green-strain.toml");
+    // What C and the gradient read of the rest shape: inverse(Dm) and the four bᵢ, 22 numbers.
+    assert!(file.stored_len() <= 24, "stores {}", file.stored_len());
+    let mut families = tetlab_core::constraints::Families::builtin();
+    let family = families.register(file.clone()).unwrap();
+    let report = tetlab_core::energy::check::check(&families, family, Some(&file), 200, 1);
+    assert_eq!(report.compared, 200);
+    assert_eq!(report.yours.len(), 10, "{report:?}");
+    for ((i, j), error) in &report.yours {
+        assert!(*error < 1e-12, "p{i}p{j}: {error}");
+    }
+    let gradients = check(&file, 2000, 1);
+    assert!(gradients.agrees(), "{gradients:?}");
+}

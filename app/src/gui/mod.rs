@@ -7,6 +7,7 @@ pub mod app;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod browser;
 pub mod camera;
+pub mod energy_watch;
 pub mod files;
 pub mod fonts;
 pub mod geometry;

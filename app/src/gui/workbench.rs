@@ -1,6 +1,7 @@
 //! The workbench's state apart from any widget: the scene, the simulation, what is selected and
 //! held, and the recent metrics. Every action a panel or the 3D view offers is a method here.
 
+use super::energy_watch::WorkbenchWatch;
 use glam::DVec3;
 use std::collections::VecDeque;
 use tetlab_core::constraints::{Families, PerFamily};
@@ -97,6 +98,10 @@ pub struct Workbench {
     /// Why playing paused by itself after a frame of the Newton reference took too long, until
     /// the next play.
     pub slow_frame: Option<String>,
+    /// The energy account's watch over the frames played ([`WorkbenchWatch`]).
+    energy_watch: WorkbenchWatch,
+    /// Where the energy grew past the watch's bound: its warning, as `tetlab run` prints it.
+    pub energy_warning: Option<String>,
 }
 
 /// An eigenmode drawn on a tet: arrows of its eigenvector at the corners, and the tet moved
@@ -157,6 +162,8 @@ impl Workbench {
             exact_step: false,
             exact_step_gap: None,
             slow_frame: None,
+            energy_watch: WorkbenchWatch::default(),
+            energy_warning: None,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -219,7 +226,9 @@ impl Workbench {
     pub fn step_frame(&mut self) {
         self.leave_step_mode();
         let before = self.exact_step.then(|| self.simulation.clone());
+        self.energy_watch.before_frame(&self.simulation);
         self.simulation.step();
+        self.energy_warning = self.energy_watch.after_frame(&self.simulation);
         self.exact_step_gap = before.map(|before| ExactStepGap::measure(&before, &self.simulation));
         // The engine that just stepped is ready: asking for it builds nothing.
         self.newton_warning =
@@ -275,6 +284,8 @@ impl Workbench {
 
     /// Back to the rest shape.
     pub fn reset(&mut self) {
+        self.energy_watch.stop();
+        self.energy_warning = None;
         self.stepping = None;
         self.last_advance = None;
         self.simulation.reset();
@@ -696,5 +707,43 @@ mod tests {
             bench.step_frame();
         }
         assert_eq!(bench.history.len(), HISTORY);
+    }
+
+    /// The readouts warn where the energy grows, as `tetlab run` does: the cube under its volume
+    /// constraint alone (lesson 4's first step: XPBD's step on slivers gives energy) warns; at
+    /// rest under the default families, and while a particle is held (its pull does work), it
+    /// does not; a reset forgets the warning.
+    #[test]
+    fn the_readouts_warn_where_the_energy_grows() {
+        let settings = Settings {
+            active: PerFamily::builtin_list("volume").unwrap(),
+            substeps: 10,
+            ..Settings::default()
+        };
+        let mut bench = Workbench::builtin(Builtin::Cube, 4, settings);
+        for _ in 0..120 {
+            bench.step_frame();
+        }
+        let warning = bench
+            .energy_warning
+            .clone()
+            .expect("the volume alone gains");
+        assert!(warning.contains("the energy grew"), "{warning}");
+        bench.reset();
+        assert_eq!(bench.energy_warning, None);
+
+        let mut bench = Workbench::builtin(Builtin::Cube, 4, Settings::default());
+        for _ in 0..60 {
+            bench.step_frame();
+        }
+        assert_eq!(bench.energy_warning, None);
+        bench.simulation.grab(0, DVec3::new(0.0, 5.0, 0.0));
+        for _ in 0..30 {
+            bench.step_frame();
+        }
+        assert_eq!(
+            bench.energy_warning, None,
+            "a held particle's pull is not a gain"
+        );
     }
 }

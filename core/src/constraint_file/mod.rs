@@ -412,19 +412,27 @@ impl ConstraintFile {
     }
 
     /// The Hessian blocks the file gives (`[hessian]`), ∂²C/∂pᵢ∂pⱼ at `points` with rest value
-    /// `rest`: each (i, j) and the 3 × 3 block, entry (r, c) = ∂²C/∂pᵢ[r]∂pⱼ[c]. Empty when the
-    /// file gives none.
+    /// `rest`, rest shape `rest_shape` and `material`: each (i, j) and the 3 × 3 block, entry
+    /// (r, c) = ∂²C/∂pᵢ[r]∂pⱼ[c]. Empty when the file gives none. Only the check reads them, so
+    /// their tape works out what it needs of the rest shape itself: an element stores nothing for
+    /// them, however many blocks a file gives.
     pub(crate) fn your_hessian(
         &self,
         points: &[DVec3],
         rest: f64,
-        stored: &[f64],
+        (rest_shape, material): (&[DVec3], &Material),
     ) -> Vec<((usize, usize), glam::DMat3)> {
         let Some(tape) = &self.hessian else {
             return Vec::new();
         };
         let points = self.coordinates(points);
-        tape.run(&self.inputs(&points, rest, stored), |r| {
+        let shape = self.coordinates(rest_shape);
+        let inputs = Inputs {
+            shape: &shape,
+            material: material_values(material),
+            ..Inputs::of(&points, rest)
+        };
+        tape.run(&inputs, |r| {
             self.hessian_blocks
                 .iter()
                 .enumerate()

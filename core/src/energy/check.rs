@@ -174,7 +174,7 @@ fn check_on<const N: usize>(
             report.against_finite_differences.max(relative(&fd, &h));
         if let Some(file) = file {
             let scale = h2.amax().max(f64::MIN_POSITIVE);
-            for ((i, j), block) in file.your_hessian(&points, rest, &stored) {
+            for ((i, j), block) in file.your_hessian(&points, rest, (&shape, &material)) {
                 let mut error: f64 = 0.0;
                 for c in 0..3 {
                     for r in 0..3 {

@@ -150,11 +150,14 @@ pub(crate) fn hold_plane<V: Vector3>(positions: &mut [V], previous: &[V]) {
 /// The ground acts on a particle by moving it (`pushes`: the sum of its moves within the
 /// substep, Δx_g, from [`predict`] and [`project_ground`]), an impulse m Δx_g / h. Its work is
 /// that impulse against the particle's mean velocity over the substep, (v₀ + v₁) / 2, v₀ at the
-/// start (before gravity and the forces) and v₁ at the end (before damping): the work of an
-/// impulse, exact when nothing else acts, and 0 for a particle resting on the ground (v₀ = v₁ =
-/// 0), whose push only undoes gravity's. It is negative for a landing or a particle held by the
-/// ground's sticking, and the ground took −W. Damping took ½ m |v₁|² (1 − k²) of the velocity
-/// it multiplied by k; the settling cap ½ m (|v₁|² − |v_cap|²).
+/// start (before gravity and the forces) and v₁ at the end (after the settling cap, before
+/// damping): the work of an impulse, exact when nothing else acts, and 0 for a particle resting
+/// on the ground (v₀ = v₁ = 0), whose push only undoes gravity's. The impulses of a substep
+/// share its change of kinetic energy so, each against the same mean velocity. It is negative
+/// for a landing or a particle held by the ground's sticking (the ground took −W), and positive
+/// where the ground pushes a particle out from under it (it gave: the height it lifts it by).
+/// Damping took ½ m |v₁|² (1 − k²) of the velocity it multiplied by k; the settling cap
+/// ½ m (|v|² − |v₁|²) of the velocity v the projections gave.
 pub(crate) struct Book<'a, V: Vector3> {
     /// The inverse masses (0: held, not booked).
     pub inverse_masses: &'a [V::Real],
@@ -214,7 +217,7 @@ pub(crate) fn update_velocities<V: Vector3>(
             }
             // velocities[i] is still the predicted velocity, v₀ + (g + w f) h.
             let start = velocities[i] - added;
-            let ground = -(half_mass / h) * book.pushes[i].dot(start + end);
+            let ground = -(half_mass / h) * book.pushes[i].dot(start + velocity);
             let kept = velocity.length_squared();
             let capped = half_mass * (end.length_squared() - kept);
             book.taken[i] += V::from_array([ground, half_mass * kept * lost, capped]);

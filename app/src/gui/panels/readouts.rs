@@ -38,6 +38,7 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
         &bench.stability_warning,
         &bench.newton_warning,
         &bench.slow_frame,
+        &bench.energy_warning,
     ]
     .into_iter()
     .flatten()
