@@ -28,7 +28,7 @@ pub const AGREEMENT: f64 = 1e-6;
 /// The largest |Σᵢ ∇ᵢC| (and |Σᵢ pᵢ × ∇ᵢC|), relative to the gradient's size (times the
 /// configuration's), at which C counts as translation (rotation) invariant, where rounding
 /// allows no less; where it allows more, what it allows at that configuration
-/// ([`rounding_floor`]).
+/// (`rounding_floor`).
 pub const INVARIANCE: f64 = 1e-9;
 
 /// The configuration where the file's gradient is furthest from AD.
@@ -96,13 +96,13 @@ pub struct Report {
     /// The largest |Σᵢ (pᵢ − centre) × ∇ᵢC| / (maxᵢ |∇ᵢC| · size) (AD).
     pub rotation: f64,
     /// The largest of [`Report::translation`]'s ratios to what rounding allows at its own
-    /// configuration ([`rounding_floor`]): at most 1 for a translation-invariant C.
+    /// configuration (`rounding_floor`): at most 1 for a translation-invariant C.
     pub translation_excess: f64,
     /// The same of [`Report::translation_given`].
     pub translation_given_excess: Option<f64>,
     /// The same of [`Report::rotation`].
     pub rotation_excess: f64,
-    /// The largest that rounding allowed at any configuration, relative ([`rounding_floor`]).
+    /// The largest that rounding allowed at any configuration, relative (`rounding_floor`).
     pub rounding: f64,
     /// What a reflection does to C (with rest 0).
     pub reflection: Reflection,
@@ -122,7 +122,7 @@ impl Report {
     }
 
     /// Whether Σᵢ ∇ᵢC = 0 (AD's) at every configuration, within [`INVARIANCE`] or what rounding
-    /// allows there ([`rounding_floor`]).
+    /// allows there (`rounding_floor`).
     pub fn translation_invariant(&self) -> bool {
         self.translation_excess <= 1.0
     }
