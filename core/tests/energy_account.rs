@@ -146,35 +146,52 @@ fn a_rise_the_account_cannot_explain_is_flagged_with_its_frame_and_source() {
     assert!(gain.amount > watch.bound());
 }
 
+/// The 2 × 2 × 2 cube under `settings` on each engine: reference, fast and the Newton reference.
+fn small_cube_on_every_engine(
+    settings: Settings,
+) -> impl Iterator<Item = (EngineChoice, Simulation)> {
+    let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
+    [
+        EngineChoice::Reference,
+        EngineChoice::Fast,
+        EngineChoice::Newton,
+    ]
+    .into_iter()
+    .map(move |engine| {
+        let settings = Settings { engine, ..settings };
+        (engine, Simulation::new(&scene, settings))
+    })
+}
+
+/// One second (60 frames) of `simulation` under a watch: the watch, the total at the start
+/// and at the end.
+fn watched_second(simulation: &mut Simulation) -> (EnergyWatch, f64, f64) {
+    let mut watch = EnergyWatch::start(simulation);
+    let start = watch.last().total;
+    for frame in 1..=60 {
+        simulation.step();
+        watch.observe(simulation, frame);
+    }
+    let end = watch.last().total;
+    (watch, start, end)
+}
+
 /// Particles dropped 1 m onto the ground with nothing between them (no family active): the
 /// ground stops each where it lands, so what it took is all the fall gave, E_start − E_end, less
 /// what the integration itself loses (½ m g² h² a substep, under 0.1 % here), on every engine.
 #[test]
 fn what_the_ground_took_is_what_a_drop_onto_it_lost_on_every_engine() {
-    let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
-    for engine in [
-        EngineChoice::Reference,
-        EngineChoice::Fast,
-        EngineChoice::Newton,
-    ] {
-        let settings = Settings {
-            engine,
-            active: PerFamily::builtin_list("none").unwrap(),
-            settle_edits: false,
-            ..Settings::default()
-        };
-        let mut simulation = Simulation::new(&scene, settings);
+    let settings = Settings {
+        active: PerFamily::builtin_list("none").unwrap(),
+        settle_edits: false,
+        ..Settings::default()
+    };
+    for (engine, mut simulation) in small_cube_on_every_engine(settings) {
         let lifted: Vec<DVec3> = (simulation.positions().iter())
             .map(|p| *p + DVec3::Y)
             .collect();
         simulation.set_positions(&lifted);
-        let mut watch = EnergyWatch::start(&simulation);
-        let start = watch.last().total;
-        for frame in 1..=60 {
-            simulation.step();
-            watch.observe(&simulation, frame);
-        }
-        let end = watch.last().total;
+        let (watch, start, end) = watched_second(&mut simulation);
         let taken = watch.taken();
         let lost = start - end;
         assert!(lost > 0.9 * start, "{engine:?}: {start} J to {end} J");
@@ -193,26 +210,13 @@ fn what_the_ground_took_is_what_a_drop_onto_it_lost_on_every_engine() {
 /// ½ m g² h² a substep; on every engine.
 #[test]
 fn what_damping_took_is_what_it_removed_from_a_free_fall_on_every_engine() {
-    let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
-    for engine in [
-        EngineChoice::Reference,
-        EngineChoice::Fast,
-        EngineChoice::Newton,
-    ] {
-        let settings = Settings {
-            engine,
-            damping: 2.0,
-            ground: false,
-            ..Settings::default()
-        };
-        let mut simulation = Simulation::new(&scene, settings);
-        let mut watch = EnergyWatch::start(&simulation);
-        let start = watch.last().total;
-        for frame in 1..=60 {
-            simulation.step();
-            watch.observe(&simulation, frame);
-        }
-        let end = watch.last().total;
+    let settings = Settings {
+        damping: 2.0,
+        ground: false,
+        ..Settings::default()
+    };
+    for (engine, mut simulation) in small_cube_on_every_engine(settings) {
+        let (watch, start, end) = watched_second(&mut simulation);
         let taken = watch.taken();
         let fall = start - end;
         assert!(

@@ -11,10 +11,13 @@
 #[path = "support/rebuilt_engine.rs"]
 mod rebuilt_engine;
 
+#[path = "support/cantilever.rs"]
+mod cantilever;
+
+use cantilever::cantilever;
 use glam::DVec3;
 use rebuilt_engine::Rebuilt;
 use tetlab_core::constraints::PerFamily;
-use tetlab_core::constraints::material::Material;
 use tetlab_core::scene::{Builtin, Scene};
 use tetlab_core::simulation::newton::{Options, equilibrium};
 use tetlab_core::simulation::{Settings, Simulation};
@@ -33,24 +36,7 @@ fn tip(rest: &[DVec3], x: &[DVec3]) -> f64 {
 /// The cantilever at `substeps`, damped to rest (600 frames, damping 10/s: its motion falls by
 /// e⁻¹⁰⁰), on the reference engine or the rebuilt one: its tip deflection, and the exact one.
 fn at_rest(substeps: u32, rebuilt: bool) -> (f64, f64) {
-    let scene = Scene::builtin(Builtin::Beam, 1).unwrap();
-    let mut settings = Settings {
-        active: PerFamily::builtin_list("neohookean").unwrap(),
-        substeps,
-        iterations: 4,
-        damping: 10.0,
-        ..Settings::default()
-    };
-    // Hanging free: the beam lies on the ground's plane, which would hold it up.
-    settings.ground = false;
-    settings.material = Material {
-        young: 1e7,
-        poisson: 0.3,
-    };
-    let mut simulation = Simulation::new(&scene, settings);
-    if rebuilt {
-        simulation.use_engine(Rebuilt::build, "rebuilt");
-    }
+    let mut simulation = cantilever(substeps, rebuilt);
     for _ in 0..600 {
         simulation.step();
     }
