@@ -190,6 +190,7 @@ pub(crate) fn update_velocities<V: Vector3>(
     V::Real: PartialOrd,
 {
     let keep = V::Real::from_f64((1.0 - damping * h).max(0.0));
+    let damped = damping > 0.0;
     let lost = V::Real::ONE - keep * keep;
     let half = V::Real::from_f64(0.5);
     let pull = V::from_f64s(0.0, -book.gravity * h, 0.0);
@@ -209,15 +210,23 @@ pub(crate) fn update_velocities<V: Vector3>(
             }
         }
         let w = book.inverse_masses[i];
-        if w > V::Real::ZERO {
+        let push = book.pushes[i];
+        let pushed = push.length_squared() > V::Real::ZERO;
+        // Most particles, most substeps, have nothing to book: no ground under them, no
+        // damping, no cap. They pay one test.
+        if w > V::Real::ZERO && (pushed || damped || cap) {
             let half_mass = half / w;
-            let mut added = pull;
-            if let Some(&force) = book.forces.get(i) {
-                added += force * (w * h);
-            }
-            // velocities[i] is still the predicted velocity, v₀ + (g + w f) h.
-            let start = velocities[i] - added;
-            let ground = -(half_mass / h) * book.pushes[i].dot(start + velocity);
+            let ground = if pushed {
+                let mut added = pull;
+                if let Some(&force) = book.forces.get(i) {
+                    added += force * (w * h);
+                }
+                // velocities[i] is still the predicted velocity, v₀ + (g + w f) h.
+                let start = velocities[i] - added;
+                -(half_mass / h) * push.dot(start + velocity)
+            } else {
+                V::Real::ZERO
+            };
             let kept = velocity.length_squared();
             let capped = half_mass * (end.length_squared() - kept);
             book.taken[i] += V::from_array([ground, half_mass * kept * lost, capped]);
