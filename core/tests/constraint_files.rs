@@ -193,10 +193,18 @@ fn every_mistake_names_file_line_and_column() {
         assert!(message.starts_with(at), "{value}: {message}");
         assert!(message.ends_with(quoted), "{value}: {message}");
     }
-    // A tet's matrices on a triangle: the binding's particles counted right.
-    let message = error("name = \"c\"\napplies_to = \"triangles\"\nvalue = \"det(Dm)\"\n");
+    // A tet's volume on a triangle, a tet's matrices on an edge: the binding's particles
+    // counted right, and what has them said.
+    let message = error("name = \"c\"\napplies_to = \"triangles\"\nvalue = \"V0\"\n");
     assert!(
-        message.contains("`Dm` is a tet's: this binding has three particles, p0…p2"),
+        message.contains(
+            "`V0` is a tet's (a triangle has A0): this binding has three particles, p0…p2"
+        ),
+        "{message}"
+    );
+    let message = error("name = \"c\"\napplies_to = \"edges\"\nvalue = \"det(Dm)\"\n");
+    assert!(
+        message.contains("`Dm` is a tet's or a triangle's: this binding has two particles, p0…p1"),
         "{message}"
     );
     let message = error(header);

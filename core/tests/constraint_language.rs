@@ -42,7 +42,10 @@ fn central_difference(file: &ConstraintFile, points: &[DVec3; 2]) -> [DVec3; 2] 
 #[test]
 fn every_function_differentiates_as_central_differences_say_in_both_modes_and_in_lanes() {
     // Each is a scalar of the two points; x, y, z are components, a and b smooth scalars.
-    let define = "d = p1 - p0\nx = d.x\ny = d.y\nz = d.z\na = dot(p0, p1) + 0.5\nb = length(d)";
+    // M is inverted (det M < 0) with distinct singular values, N is not.
+    let define = "d = p1 - p0\nx = d.x\ny = d.y\nz = d.z\na = dot(p0, p1) + 0.5\nb = length(d)
+        M = mat3(vec3(1.2, 0.1, 0) + p0, vec3(0.2, 0.8, 0.1) + p1, vec3(0, 0.3, -0.5) + d)
+        N = mat3(vec3(0.3, 1.1, 0) + p1, vec3(-0.9, 0.2, 0.4) + d, vec3(0.1, 0.3, 1.7) - p0)";
     let cases = [
         "sin(3 * x) + cos(2 * y)",
         "tan(x)",
@@ -57,6 +60,19 @@ fn every_function_differentiates_as_central_differences_say_in_both_modes_and_in
         "length(vec3(x * y, z, 1)) + dot(vec3(1, 2, 3), d)",
         "if(a > 0, length(d), 0) + length(if(y <= x, p0, p1))",
         "atan2(dot(cross(p0, p1), vec3(0, 0, 1)), dot(p0, p1))",
+        "norm(M - polar(M)) + norm(N - polar(N))",
+        "dot(polar(M).c1, vec3(1, 2, 3)) + polar(N).r2.x + polar(N).xy",
+        "dot(singular_values(M), vec3(1, -2, 3)) + singular_values(N).z",
+        "det(polar(N)) * singular_values(M).x * singular_values(M).y * singular_values(M).z",
+        "dot(svd_u(M).c0, p1) + svd_v(M).yz + dot(svd_u(N) * transpose(svd_v(N)) * p0, p1)",
+        "dot(svd_u(N).c2, svd_v(M).c1) + trace(svd_v(N) * svd_u(M))",
+        // Vectors and matrices of two.
+        "dot(vec2(x, y), vec2(z, a)) + length(vec2(x * y, b)) + normalize(vec2(a, z)).y",
+        "det(mat2(vec2(x, y), vec2(z, 1))) + trace(inverse(mat2(vec2(2 + x, y), vec2(z, 3))))",
+        "norm(mat2(d, p0) * inverse(mat2(vec2(1, x), vec2(y, 2))))",
+        "trace(transpose(mat2(d, p1)) * mat2(d, p1)) + det(transpose(mat2(d, p1)) * mat2(p0, d))",
+        "dot(mat2(d, p0) * vec2(x, 1), p1) + (transpose(mat2(d, p0)) * p1).y + mat2(d, p0).zy",
+        "outer(vec2(x, y), d).xz + outer(d, vec2(1, y)).zy + transpose(mat3(vec2(x, 1), vec2(y, z), vec2(1, a))).r2.y",
     ];
     for value in cases {
         let file = edge_file(define, value).unwrap_or_else(|e| panic!("{value}: {e}"));
@@ -97,6 +113,55 @@ fn every_function_differentiates_as_central_differences_say_in_both_modes_and_in
             "{value}: lanes {g} against f32 {}",
             single.gradients[1]
         );
+    }
+}
+
+/// Shapes that do not fit are type errors that name both shapes, at the expression.
+#[test]
+fn vectors_and_matrices_of_two_are_typed_by_their_shape() {
+    let define = "d = p1 - p0\nx = d.x\ny = d.y";
+    for (value, says) in [
+        (
+            "length(mat2(d, p0) * d)",
+            "a 3 × 2 matrix * a vector: the columns of the first (2) must be as many as the rows \
+             of the second (3)",
+        ),
+        (
+            "norm(mat2(d, p0) * mat2(d, p0))",
+            "the columns of the first (2) must be as many as the rows of the second (3)",
+        ),
+        (
+            "length(vec2(x, y) + d)",
+            "type error: a 2-vector + a vector",
+        ),
+        (
+            "length(cross(vec2(x, y), d))",
+            "argument 1 of `cross` must be a vector, and this is a 2-vector",
+        ),
+        (
+            "dot(vec2(x, y), d)",
+            "argument 2 of `dot` is a vector, and argument 1 a 2-vector",
+        ),
+        (
+            "vec2(x, y).z",
+            "a 2-vector has components .x and .y, not .z",
+        ),
+        (
+            "length(mat2(d, p0).c2)",
+            "a 3 × 2 matrix has columns .c0 .c1, rows .r0 .r1 .r2 and entries .xx .xy … .zy",
+        ),
+        (
+            "det(mat2(d, p0))",
+            "argument 1 of `det` must be a square matrix (2 × 2 or 3 × 3), and this is a 3 × 2 matrix",
+        ),
+        (
+            "norm(polar(mat2(d, p0)))",
+            "argument 1 of `polar` must be a matrix, and this is a 3 × 2 matrix",
+        ),
+    ] {
+        let message = edge_file(define, value).unwrap_err();
+        assert!(message.contains(says), "{value}: {message}");
+        assert!(message.starts_with("mine.toml:"), "{message}");
     }
 }
 
@@ -203,7 +268,12 @@ fn a_constraint_against_a_fixed_plane_and_point_can_be_written() {
 fn the_gradient_tape_on_tangents_gives_second_derivatives() {
     use tetlab_core::numbers::dual::Tangent;
     // C = |p0 − p1|: its Hessian block ∂²C/∂p0² = (I − u uᵀ) / |d|, u = d / |d|.
-    let file = edge_file("", "length(p0 - p1) + 0.25 * pow(dot(p0, p0), 2)").unwrap();
+    let file = edge_file(
+        "M = mat3(vec3(1.2, 0.1, 0) + p0, vec3(0.2, 0.8, 0.1) + p1, vec3(0, 0.3, -0.5) + p1 - p0)",
+        "length(p0 - p1) + 0.25 * pow(dot(p0, p0), 2) + dot(polar(M).c0, p1) \
+         + dot(singular_values(M), p0)",
+    )
+    .unwrap();
     let p = POINTS;
     for axis in 0..3 {
         // Tangent along p0's `axis` coordinate.
@@ -432,4 +502,61 @@ fn every_mistake_in_a_file_of_several_constraints_is_named_at_its_place() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("holds 2 constraints (two-a, two-b)"), "{e}");
+}
+
+/// Where F's singular values repeat (F = 2Q, Q a rotation: all three are 2), the polar rotation
+/// and what is symmetric in σ have gradients, in both modes and as central differences say; U
+/// and V are not unique there, and a C that reads them is flagged as undefined, never NaN.
+#[test]
+fn at_repeated_singular_values_the_rotation_and_sums_of_sigma_differentiate_and_u_v_are_flagged() {
+    use tetlab_core::constraints::material::Material;
+    let tet = |value: &str| {
+        let text = format!("name = \"c\"\napplies_to = \"tets\"\nvalue = \"{value}\"\n");
+        ConstraintFile::parse(Path::new("mine.toml"), &text).unwrap()
+    };
+    let shape = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+    let turn = glam::DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 2.0) / 3.0, 0.7);
+    let points = shape.map(|q| turn * q * 2.0 + DVec3::new(0.1, 0.2, 0.3));
+    let material = Material::default();
+    for value in [
+        "trace(polar(F) * transpose(F)) + dot(polar(F).c0, p1)",
+        "dot(singular_values(F), vec3(1, 1, 1)) * singular_values(F).x * singular_values(F).y \
+         * singular_values(F).z",
+    ] {
+        let file = tet(value);
+        let stored = file.store(&shape, &material);
+        let forward = file
+            .evaluate(&points, 0.0, &stored)
+            .automatic
+            .unwrap_or_else(|| panic!("{value}: defined"));
+        let reverse = file.evaluate_vectors(&points, 0.0, &stored);
+        assert!(!reverse.degenerate, "{value}");
+        let h = 1e-6;
+        for i in 0..4 {
+            for axis in 0..3 {
+                let (mut plus, mut minus) = (points, points);
+                plus[i][axis] += h;
+                minus[i][axis] -= h;
+                let numeric = (file.value(&plus, 0.0, &stored) - file.value(&minus, 0.0, &stored))
+                    / (2.0 * h);
+                let scale = numeric.abs().max(1.0);
+                assert!((forward[i][axis] - numeric).abs() < 1e-6 * scale, "{value}");
+                assert!(
+                    (reverse.gradients[i][axis] - numeric).abs() < 1e-6 * scale,
+                    "{value}"
+                );
+            }
+        }
+    }
+    for value in ["svd_u(F).c0.x", "dot(svd_v(F).c1, p2)"] {
+        let file = tet(value);
+        let stored = file.store(&shape, &material);
+        let evaluation = file.evaluate(&points, 0.0, &stored);
+        assert!(evaluation.value.is_finite(), "{value}");
+        assert_eq!(evaluation.automatic, None, "{value}: flagged");
+        assert!(
+            file.evaluate_vectors(&points, 0.0, &stored).degenerate,
+            "{value}"
+        );
+    }
 }

@@ -355,7 +355,7 @@ impl Shared<'_> {
                 ));
             };
             let what = format!("gradient.{}", key.get_ref());
-            given[k] = Some(self.output(&mut program, entry, Type::Vector, &what)?);
+            given[k] = Some(self.output(&mut program, entry, Type::VECTOR, &what)?);
         }
         // The file's own Hessian blocks ∂²C/∂pᵢ∂pⱼ, each a matrix (three outputs).
         let mut blocks = Vec::new();
@@ -389,7 +389,7 @@ impl Shared<'_> {
                 ));
             }
             let what = format!("hessian.{}", key.get_ref());
-            blocks.push((pair, self.output(&mut program, entry, Type::Matrix, &what)?));
+            blocks.push((pair, self.output(&mut program, entry, Type::MATRIX, &what)?));
         }
         // ∇C by AD, compiled: C's tape with it, and the file's own where it gives none.
         program.at(value.span().start);

@@ -15,45 +15,16 @@
 //! assert!((back - f).to_cols_array().iter().all(|e| e.abs() < 1e-12));
 //! ```
 
+use crate::numbers::vector::Real;
 use glam::DMat3;
-use nalgebra::Matrix3;
 
-/// F = U diag(σ) Vᵀ with U and V rotations (det +1): where an SVD's U or V is a reflection, its
-/// column of the smallest |σ| is negated, and σ with it, so that an inverted F has one negative σ.
+/// F = U diag(σ) Vᵀ with U and V rotations (det +1) and |σ₀| ≥ |σ₁| ≥ |σ₂|: an inverted F has
+/// σ₂ < 0 ([`crate::numbers::svd3`], the decomposition constraint files use too).
 pub fn signed_svd(f: &DMat3) -> (DMat3, [f64; 3], DMat3) {
-    let m = Matrix3::from_column_slice(&f.to_cols_array());
-    let svd = m.svd(true, true);
-    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
-        return (
-            DMat3::IDENTITY,
-            [f.x_axis.x, f.y_axis.y, f.z_axis.z],
-            DMat3::IDENTITY,
-        );
-    };
-    let to_glam = |m: Matrix3<f64>| DMat3::from_cols_slice(m.as_slice());
-    let mut u = to_glam(u);
-    let mut v = to_glam(v_t.transpose());
-    let mut sigma = [
-        svd.singular_values[0],
-        svd.singular_values[1],
-        svd.singular_values[2],
-    ];
-    let smallest = (0..3)
-        .min_by(|&a, &b| sigma[a].total_cmp(&sigma[b]))
-        .unwrap_or(2);
-    let negate = |m: &mut DMat3| {
-        let column = m.col(smallest);
-        *m.col_mut(smallest) = -column;
-    };
-    if u.determinant() < 0.0 {
-        negate(&mut u);
-        sigma[smallest] = -sigma[smallest];
-    }
-    if v.determinant() < 0.0 {
-        negate(&mut v);
-        sigma[smallest] = -sigma[smallest];
-    }
-    (u, sigma, v)
+    let columns = [f.x_axis, f.y_axis, f.z_axis].map(|c| c.to_array());
+    let svd = f64::signed_svd(columns);
+    let to_glam = |m: [[f64; 3]; 3]| DMat3::from_cols_array_2d(&m);
+    (to_glam(svd.u), svd.sigma, to_glam(svd.v))
 }
 
 /// How much of an F-space direction `m` is twist, flip and scale in the frame of F = U Σ Vᵀ: the

@@ -7,6 +7,8 @@
 
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 
+use crate::numbers::columns::Columns;
+use crate::numbers::svd3::{self, Svd};
 use crate::numbers::vector::{Real, Vector3};
 
 /// A dual number over any [`Real`] (f64, f32, the fast solver's lanes): `value + slope ε` with
@@ -104,6 +106,16 @@ impl<T: Real> Real for Tangent<T> {
     #[inline]
     fn from_f64(x: f64) -> Self {
         Tangent::new(T::from_f64(x), T::ZERO)
+    }
+    /// The value's SVD with the exact derivatives of U, σ and V ([`svd3`]).
+    #[inline]
+    fn signed_svd(f: Columns<Self>) -> Svd<Self> {
+        svd3::svd_of_tangents(f)
+    }
+    /// The value's polar rotation with its exact derivative ([`svd3`]).
+    #[inline]
+    fn polar(f: Columns<Self>) -> Columns<Self> {
+        svd3::polar_of_tangents(f)
     }
     /// √(a + a′ε) = √a + a′ / (2√a) ε.
     #[inline]

@@ -6,6 +6,8 @@
 //! ([`crate::numbers::lanes::Vec3x8`]). The formulas never branch on a value: a comparison gives a
 //! [`Mask`] (a `bool` for one number, one flag per lane for eight), and [`Real::select`] picks.
 
+use crate::numbers::columns::Columns;
+use crate::numbers::svd3::{self, Svd};
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
 
@@ -90,6 +92,20 @@ pub trait Real:
     fn acos(self) -> Self;
     /// The real cube root.
     fn cbrt(self) -> Self;
+    /// The signed singular value decomposition of the matrix of columns `f`: F = U diag(σ) Vᵀ
+    /// with U and V rotations and σ₂ negative where det F is ([`svd3`]). Dual numbers give its
+    /// exact derivative rather than the iteration's.
+    #[inline]
+    fn signed_svd(f: Columns<Self>) -> Svd<Self> {
+        svd3::jacobi_svd(f)
+    }
+    /// The rotation R of the polar decomposition F = R S of the matrix of columns `f`: the
+    /// rotation nearest F, U Vᵀ of [`Real::signed_svd`] ([`svd3`]). Dual numbers give its exact
+    /// derivative, finite also where singular values repeat.
+    #[inline]
+    fn polar(f: Columns<Self>) -> Columns<Self> {
+        svd3::rotation(&Self::signed_svd(f))
+    }
 }
 
 macro_rules! impl_real {

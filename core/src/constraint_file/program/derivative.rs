@@ -316,8 +316,169 @@ impl Rule<'_> {
                     self.add(into, |r| r.emit(Op::Component(bar, i as u8)))?;
                 }
             }
+            Op::PolarColumn(c0, c1, c2, k) => self.polar_column([c0, c1, c2], k)?,
+            Op::SingularValues(c0, c1, c2) => self.singular_values([c0, c1, c2])?,
+            Op::SvdU(c0, c1, c2, k) => self.singular_vector([c0, c1, c2], k, true)?,
+            Op::SvdV(c0, c1, c2, k) => self.singular_vector([c0, c1, c2], k, false)?,
         }
         Ok(())
+    }
+
+    /// r = column k of F's polar rotation R: with a = Rᵀ r̄, R̄ = r̄ eₖᵀ gives
+    /// vee(RᵀR̄ − R̄ᵀR) = eₖ × a, and F̄ += R [y]ₓ with (tr S · I − S) y = eₖ × a, S = Rᵀ F
+    /// (`numbers::svd3`: ⟨R̄, dR⟩ = ⟨R [y]ₓ, dF⟩). Not finite where two singular values sum to
+    /// zero, where R has no derivative.
+    fn polar_column(&mut self, f: [Reg; 3], k: u8) -> Result<(), CompileError> {
+        if !f.iter().any(|&c| self.varies[c as usize]) {
+            return Ok(());
+        }
+        let [c0, c1, c2] = f;
+        let bar = self.bar;
+        let unit = |j: usize| {
+            let mut e = [0.0; 3];
+            e[j] = 1.0;
+            Op::ConstVector(e)
+        };
+        let mut r = [0; 3];
+        for (j, column) in r.iter_mut().enumerate() {
+            *column = self.emit(Op::PolarColumn(c0, c1, c2, j as u8))?;
+        }
+        let a = self.row_products(r, bar)?;
+        let ek = self.emit(unit(k as usize))?;
+        let b = self.emit(Op::Cross(ek, a))?;
+        // S = Rᵀ F by columns, its trace, M = tr S · I − S, y = M⁻¹ b.
+        let mut s = [0; 3];
+        for (j, column) in s.iter_mut().enumerate() {
+            *column = self.row_products(r, f[j])?;
+        }
+        let mut diagonal = [0; 3];
+        for (j, entry) in diagonal.iter_mut().enumerate() {
+            *entry = self.emit(Op::Component(s[j], j as u8))?;
+        }
+        let partial = self.emit(Op::AddS(diagonal[0], diagonal[1]))?;
+        let trace = self.emit(Op::AddS(partial, diagonal[2]))?;
+        let mut m = [0; 3];
+        for (j, column) in m.iter_mut().enumerate() {
+            let e = self.emit(unit(j))?;
+            let along = self.emit(Op::Scale(e, trace))?;
+            *column = self.emit(Op::SubV(along, s[j]))?;
+        }
+        let mut rows = [0; 3];
+        for (row, (x, y)) in rows
+            .iter_mut()
+            .zip([(m[1], m[2]), (m[2], m[0]), (m[0], m[1])])
+        {
+            *row = self.emit(Op::Cross(x, y))?;
+        }
+        let det = self.emit(Op::Dot(m[0], rows[0]))?;
+        let numerator = self.row_products(rows, b)?;
+        let y = self.emit(Op::Shrink(numerator, det))?;
+        for (j, column) in f.into_iter().enumerate() {
+            self.add(column, |rule| {
+                let e = rule.emit(unit(j))?;
+                let turned = rule.emit(Op::Cross(y, e))?;
+                rule.emit(Op::MatVec(r[0], r[1], r[2], turned))
+            })?;
+        }
+        Ok(())
+    }
+
+    /// r = σ, F's signed singular values: F̄ += U diag(σ̄) Vᵀ, whose column j is
+    /// U (σ̄ᵢ (vᵢ)ⱼ)ᵢ. Exact for what is symmetric in σ also where two σ are equal
+    /// (`numbers::svd3`).
+    fn singular_values(&mut self, f: [Reg; 3]) -> Result<(), CompileError> {
+        if !f.iter().any(|&c| self.varies[c as usize]) {
+            return Ok(());
+        }
+        let [c0, c1, c2] = f;
+        let bar = self.bar;
+        let mut u = [0; 3];
+        let mut v = [0; 3];
+        let mut weight = [0; 3];
+        for i in 0..3 {
+            u[i] = self.emit(Op::SvdU(c0, c1, c2, i as u8))?;
+            v[i] = self.emit(Op::SvdV(c0, c1, c2, i as u8))?;
+            weight[i] = self.emit(Op::Component(bar, i as u8))?;
+        }
+        for (j, column) in f.into_iter().enumerate() {
+            self.add(column, |rule| {
+                let mut scaled = [0; 3];
+                for i in 0..3 {
+                    let entry = rule.emit(Op::Component(v[i], j as u8))?;
+                    scaled[i] = rule.emit(Op::MulS(weight[i], entry))?;
+                }
+                let along = rule.emit(Op::Vec3(scaled[0], scaled[1], scaled[2]))?;
+                rule.emit(Op::MatVec(u[0], u[1], u[2], along))
+            })?;
+        }
+        Ok(())
+    }
+
+    /// r = column k of U (`left`) or of V of F's signed SVD. From dU = U Ω_U, dV = V Ω_V
+    /// (`numbers::svd3`), with aₘ = uₘ·r̄ (or vₘ·r̄) and gₘ = σₖ² − σₘ² for each m ≠ k:
+    /// F̄ += U P̄ Vᵀ, P̄ being zero but for P̄ₘₖ = aₘ σₖ / gₘ and P̄ₖₘ = aₘ σₘ / gₘ (U's; V's
+    /// swaps σₖ and σₘ). Not finite where |σₖ| = |σₘ|, where the column has no derivative.
+    fn singular_vector(&mut self, f: [Reg; 3], k: u8, left: bool) -> Result<(), CompileError> {
+        if !f.iter().any(|&c| self.varies[c as usize]) {
+            return Ok(());
+        }
+        let [c0, c1, c2] = f;
+        let k = k as usize;
+        let bar = self.bar;
+        let mut u = [0; 3];
+        let mut v = [0; 3];
+        let mut sigma = [0; 3];
+        let values = self.emit(Op::SingularValues(c0, c1, c2))?;
+        for i in 0..3 {
+            u[i] = self.emit(Op::SvdU(c0, c1, c2, i as u8))?;
+            v[i] = self.emit(Op::SvdV(c0, c1, c2, i as u8))?;
+            sigma[i] = self.emit(Op::Component(values, i as u8))?;
+        }
+        // P̄ₘₖ and P̄ₖₘ for the two m ≠ k.
+        let others: Vec<usize> = (0..3).filter(|&m| m != k).collect();
+        let square_k = self.emit(Op::MulS(sigma[k], sigma[k]))?;
+        let mut entries = Vec::with_capacity(2);
+        for &m in &others {
+            let a = self.emit(Op::Dot(if left { u[m] } else { v[m] }, bar))?;
+            let square_m = self.emit(Op::MulS(sigma[m], sigma[m]))?;
+            let gap = self.emit(Op::SubS(square_k, square_m))?;
+            let share = self.emit(Op::DivS(a, gap))?;
+            let (first, second) = if left {
+                (sigma[k], sigma[m])
+            } else {
+                (sigma[m], sigma[k])
+            };
+            let mk = self.emit(Op::MulS(share, first))?;
+            let km = self.emit(Op::MulS(share, second))?;
+            entries.push((m, mk, km));
+        }
+        // Column j of U P̄ Vᵀ is U w with wₘ = P̄ₘₖ (vₖ)ⱼ and wₖ = Σₘ P̄ₖₘ (vₘ)ⱼ.
+        for (j, column) in f.into_iter().enumerate() {
+            self.add(column, |rule| {
+                let mut w = [0; 3];
+                let vkj = rule.emit(Op::Component(v[k], j as u8))?;
+                let mut along_k = None;
+                for &(m, mk, km) in &entries {
+                    w[m] = rule.emit(Op::MulS(mk, vkj))?;
+                    let vmj = rule.emit(Op::Component(v[m], j as u8))?;
+                    let term = rule.emit(Op::MulS(km, vmj))?;
+                    along_k = Some(match along_k {
+                        None => term,
+                        Some(sum) => rule.emit(Op::AddS(sum, term))?,
+                    });
+                }
+                w[k] = along_k.expect("two others");
+                let weights = rule.emit(Op::Vec3(w[0], w[1], w[2]))?;
+                rule.emit(Op::MatVec(u[0], u[1], u[2], weights))
+            })?;
+        }
+        Ok(())
+    }
+
+    /// (m₀·x, m₁·x, m₂·x): Mᵀ x for the matrix of columns `m`.
+    fn row_products(&mut self, m: [Reg; 3], x: Reg) -> Result<Reg, CompileError> {
+        let [a, b, c] = m.map(|column| self.emit(Op::Dot(column, x)));
+        self.emit(Op::Vec3(a?, b?, c?))
     }
 
     /// √(1 − a²).

@@ -1,59 +1,102 @@
 //! How an expression of a constraint file becomes instructions of its [`Program`]: the
-//! functions of the language and their types ([`FUNCTIONS`]), the names a file may use without
-//! defining them ([`GIVEN_NAMES`]), and the compilation of numbers, names, members (`v.x`, `M.c0`),
-//! operators and calls, matrices compiled column by column.
+//! functions of the language and their arguments ([`FUNCTIONS`]), and the compilation of
+//! numbers, names, operators and calls, vectors and matrices of two or three typed by their
+//! shape (`shapes.rs`), the names given without a definition in `given.rs`.
 
+use super::given::given_here;
 use super::op::{Op, Reg};
 use super::{CompileError, Program, Type, Value};
 use crate::constraint_file::expression::{BinaryOp, Expr, Span};
 
-/// A type an argument or result can be; `Same` is whatever the other branches of an `if` are.
+/// What an argument can be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Param {
+    /// This type.
     Is(Type),
+    /// A 2- or 3-vector.
+    AnyVector,
+    /// A matrix of any shape.
+    AnyMatrix,
+    /// A 2 × 2 or 3 × 3 matrix.
+    Square,
     /// A comparison `a < b`.
     Condition,
     /// A scalar or a vector, the same as the other `Same` arguments (and the result).
     Same,
 }
 
-use Param::{Condition, Is, Same};
-const S: Param = Is(Type::Scalar);
-const V: Param = Is(Type::Vector);
-const M: Param = Is(Type::Matrix);
+impl Param {
+    /// Whether a value of type `ty` can be this argument (`Condition` and `Same` are checked
+    /// where they are taken).
+    fn admits(self, ty: Type) -> bool {
+        match self {
+            Is(wanted) => ty == wanted,
+            AnyVector => matches!(ty, Type::Vector(_)),
+            AnyMatrix => matches!(ty, Type::Matrix(..)),
+            Square => matches!(ty, Type::Matrix(r, c) if r == c),
+            Condition | Same => true,
+        }
+    }
 
-/// The functions of the language: name, arguments and result (`det` also takes one matrix).
-pub(super) const FUNCTIONS: [(&str, &[Param], Param); 30] = [
-    ("dot", &[V, V], S),
-    ("cross", &[V, V], V),
-    ("length", &[V], S),
-    ("normalize", &[V], V),
-    ("det", &[V, V, V], S),
-    ("vec3", &[S, S, S], V),
-    ("mat3", &[V, V, V], M),
-    ("outer", &[V, V], M),
-    ("transpose", &[M], M),
-    ("inverse", &[M], M),
-    ("trace", &[M], S),
-    ("norm", &[M], S),
-    ("sqrt", &[S], S),
-    ("cbrt", &[S], S),
-    ("pow", &[S, S], S),
-    ("exp", &[S], S),
-    ("log", &[S], S),
-    ("sin", &[S], S),
-    ("cos", &[S], S),
-    ("tan", &[S], S),
-    ("asin", &[S], S),
-    ("acos", &[S], S),
-    ("atan2", &[S, S], S),
-    ("abs", &[S], S),
-    ("sign", &[S], S),
-    ("min", &[S, S], S),
-    ("max", &[S, S], S),
-    ("clamp", &[S, S, S], S),
-    ("if", &[Condition, Same, Same], Same),
-    ("select", &[Condition, Same, Same], Same),
+    /// What it must be, for a message.
+    fn wanted(self) -> String {
+        match self {
+            Is(ty) => ty.article(),
+            AnyVector => "a vector (of 2 or 3)".to_owned(),
+            AnyMatrix => "a matrix".to_owned(),
+            Square => "a square matrix (2 × 2 or 3 × 3)".to_owned(),
+            Condition => "a comparison".to_owned(),
+            Same => "a scalar or a vector".to_owned(),
+        }
+    }
+}
+
+use Param::{AnyMatrix, AnyVector, Condition, Is, Same, Square};
+const S: Param = Is(Type::Scalar);
+const V: Param = AnyVector;
+const V3: Param = Is(Type::VECTOR);
+const M: Param = AnyMatrix;
+const M3: Param = Is(Type::MATRIX);
+
+/// The functions of the language and their arguments (`det` also takes one square matrix).
+/// Vectors and matrices of two as well as three, except where noted by `V3` and `M3`.
+pub(super) const FUNCTIONS: [(&str, &[Param]); 36] = [
+    ("dot", &[V, V]),
+    ("cross", &[V3, V3]),
+    ("length", &[V]),
+    ("normalize", &[V]),
+    ("det", &[V3, V3, V3]),
+    ("vec3", &[S, S, S]),
+    ("vec2", &[S, S]),
+    ("mat3", &[V, V, V]),
+    ("mat2", &[V, V]),
+    ("outer", &[V, V]),
+    ("transpose", &[M]),
+    ("inverse", &[Square]),
+    ("trace", &[Square]),
+    ("norm", &[M]),
+    ("polar", &[M3]),
+    ("singular_values", &[M3]),
+    ("svd_u", &[M3]),
+    ("svd_v", &[M3]),
+    ("sqrt", &[S]),
+    ("cbrt", &[S]),
+    ("pow", &[S, S]),
+    ("exp", &[S]),
+    ("log", &[S]),
+    ("sin", &[S]),
+    ("cos", &[S]),
+    ("tan", &[S]),
+    ("asin", &[S]),
+    ("acos", &[S]),
+    ("atan2", &[S, S]),
+    ("abs", &[S]),
+    ("sign", &[S]),
+    ("min", &[S, S]),
+    ("max", &[S, S]),
+    ("clamp", &[S, S, S]),
+    ("if", &[Condition, Same, Same]),
+    ("select", &[Condition, Same, Same]),
 ];
 
 /// The names of the functions, for the message for an unknown one.
@@ -61,80 +104,7 @@ fn function_names() -> impl Iterator<Item = &'static str> {
     FUNCTIONS.iter().map(|f| f.0).filter(|&f| f != "select")
 }
 
-/// Names a program knows without a definition, made when first used: the rest shape, the
-/// material and the identity. `(name, what it is)`.
-pub(crate) const GIVEN_NAMES: [(&str, &str); 9] = [
-    ("q0", "the rest position of p0 (q1, q2, q3 likewise)"),
-    (
-        "Dm",
-        "the rest edges [q1 - q0, q2 - q0, q3 - q0] as columns",
-    ),
-    ("Ds", "the edges [p1 - p0, p2 - p0, p3 - p0] as columns"),
-    ("F", "the deformation gradient Ds inverse(Dm)"),
-    ("V0", "the rest volume det(Dm) / 6"),
-    (
-        "mu",
-        "the material's shear modulus μ (Lamé's second parameter)",
-    ),
-    ("lambda", "the material's λ (Lamé's first parameter)"),
-    (
-        "gamma",
-        "1 + mu / lambda, the neo-Hookean rest value of det F",
-    ),
-    ("I", "the 3 × 3 identity"),
-];
-
 impl Program {
-    /// `op` applied to each column of matrix `m` (`column` gives the instruction for one).
-    fn columns(
-        &mut self,
-        m: Value,
-        span: Span,
-        what: &'static str,
-        column: impl Fn(Reg) -> Op,
-    ) -> Result<Value, CompileError> {
-        let mut out = [0; 3];
-        for (j, slot) in out.iter_mut().enumerate() {
-            *slot = self.emit(column(m.r[j]), span, what)?;
-        }
-        Ok(Value::matrix(out))
-    }
-
-    /// M v = Σⱼ cⱼ vⱼ, one instruction ([`Op::MatVec`]).
-    fn times_vector(&mut self, m: Value, v: Reg, span: Span) -> Result<Reg, CompileError> {
-        let [c0, c1, c2] = m.r;
-        self.emit(Op::MatVec(c0, c1, c2, v), span, "*")
-    }
-
-    /// Mᵀ: its rows as columns.
-    fn transpose(&mut self, m: Value, span: Span) -> Result<Value, CompileError> {
-        let mut rows = [0; 3];
-        for (i, row) in rows.iter_mut().enumerate() {
-            let mut entries = [0; 3];
-            for (j, entry) in entries.iter_mut().enumerate() {
-                *entry = self.emit(Op::Component(m.r[j], i as u8), span, "transpose")?;
-            }
-            *row = self.emit(
-                Op::Vec3(entries[0], entries[1], entries[2]),
-                span,
-                "transpose",
-            )?;
-        }
-        Ok(Value::matrix(rows))
-    }
-
-    /// M⁻¹: the rows (c₁×c₂, c₂×c₀, c₀×c₁) / det M, transposed into columns.
-    fn inverse(&mut self, m: Value, span: Span) -> Result<Value, CompileError> {
-        let [c0, c1, c2] = m.r;
-        let det = self.emit(Op::Det(c0, c1, c2), span, "inverse")?;
-        let mut rows = [0; 3];
-        for (k, (a, b)) in [(c1, c2), (c2, c0), (c0, c1)].into_iter().enumerate() {
-            let cross = self.emit(Op::Cross(a, b), span, "inverse")?;
-            rows[k] = self.emit(Op::Shrink(cross, det), span, "inverse")?;
-        }
-        self.transpose(Value::matrix(rows), span)
-    }
-
     /// `expr` compiled into instructions: its value, typed.
     pub(super) fn compile(&mut self, expr: &Expr) -> Result<Value, CompileError> {
         use Type::{Matrix as Mx, Scalar as Sc, Vector as Vc};
@@ -169,8 +139,11 @@ impl Program {
                 let a = self.compile(inner)?;
                 match a.ty {
                     Sc => Ok(Value::scalar(self.emit(Op::NegS(a.r[0]), *span, "-")?)),
-                    Vc => Ok(Value::vector(self.emit(Op::NegV(a.r[0]), *span, "-")?)),
-                    Mx => self.columns(a, *span, "-", Op::NegV),
+                    Vc(_) => Ok(Value {
+                        r: [self.emit(Op::NegV(a.r[0]), *span, "-")?; 3],
+                        ty: a.ty,
+                    }),
+                    Mx(..) => self.columns(a, *span, "-", Op::NegV),
                 }
             }
             Expr::Member(inner, component, span) => {
@@ -203,34 +176,49 @@ impl Program {
                     (BinaryOp::Sub, Sc, Sc) => single(self, Op::SubS(x, y), Sc),
                     (BinaryOp::Mul, Sc, Sc) => single(self, Op::MulS(x, y), Sc),
                     (BinaryOp::Div, Sc, Sc) => single(self, Op::DivS(x, y), Sc),
-                    (BinaryOp::Add, Vc, Vc) => single(self, Op::AddV(x, y), Vc),
-                    (BinaryOp::Sub, Vc, Vc) => single(self, Op::SubV(x, y), Vc),
-                    (BinaryOp::Mul, Vc, Sc) => single(self, Op::Scale(x, y), Vc),
-                    (BinaryOp::Mul, Sc, Vc) => single(self, Op::Scale(y, x), Vc),
-                    (BinaryOp::Div, Vc, Sc) => single(self, Op::Shrink(x, y), Vc),
-                    (BinaryOp::Add, Mx, Mx) | (BinaryOp::Sub, Mx, Mx) => {
+                    (BinaryOp::Add, Vc(n), Vc(m)) if n == m => single(self, Op::AddV(x, y), a.ty),
+                    (BinaryOp::Sub, Vc(n), Vc(m)) if n == m => single(self, Op::SubV(x, y), a.ty),
+                    (BinaryOp::Mul, Vc(_), Sc) => single(self, Op::Scale(x, y), a.ty),
+                    (BinaryOp::Mul, Sc, Vc(_)) => single(self, Op::Scale(y, x), b.ty),
+                    (BinaryOp::Div, Vc(_), Sc) => single(self, Op::Shrink(x, y), a.ty),
+                    (BinaryOp::Add | BinaryOp::Sub, Mx(..), Mx(..)) if a.ty == b.ty => {
+                        let (rows, count) = a.ty.shape();
                         let mut out = [0; 3];
-                        for (slot, (&x, &y)) in out.iter_mut().zip(a.r.iter().zip(&b.r)) {
+                        for (j, slot) in out.iter_mut().enumerate().take(count as usize) {
                             let instruction = if *op == BinaryOp::Add {
-                                Op::AddV(x, y)
+                                Op::AddV(a.r[j], b.r[j])
                             } else {
-                                Op::SubV(x, y)
+                                Op::SubV(a.r[j], b.r[j])
                             };
                             *slot = self.emit(instruction, *span, what)?;
                         }
-                        Ok(Value::matrix(out))
+                        self.shaped(rows, &out[..count as usize], *span)
                     }
-                    (BinaryOp::Mul, Mx, Sc) => self.columns(a, *span, what, |c| Op::Scale(c, y)),
-                    (BinaryOp::Mul, Sc, Mx) => self.columns(b, *span, what, |c| Op::Scale(c, x)),
-                    (BinaryOp::Div, Mx, Sc) => self.columns(a, *span, what, |c| Op::Shrink(c, y)),
-                    (BinaryOp::Mul, Mx, Vc) => Ok(Value::vector(self.times_vector(a, y, *span)?)),
-                    (BinaryOp::Mul, Mx, Mx) => {
-                        let mut out = [0; 3];
-                        for (j, slot) in out.iter_mut().enumerate() {
-                            *slot = self.times_vector(a, b.r[j], *span)?;
-                        }
-                        Ok(Value::matrix(out))
+                    (BinaryOp::Mul, Mx(..), Sc) => {
+                        self.columns(a, *span, what, |c| Op::Scale(c, y))
                     }
+                    (BinaryOp::Mul, Sc, Mx(..)) => {
+                        self.columns(b, *span, what, |c| Op::Scale(c, x))
+                    }
+                    (BinaryOp::Div, Mx(..), Sc) => {
+                        self.columns(a, *span, what, |c| Op::Shrink(c, y))
+                    }
+                    (BinaryOp::Mul, Mx(rows, count), Vc(n)) if count == n => Ok(Value {
+                        r: [self.times_vector(a, y, *span)?; 3],
+                        ty: Vc(rows),
+                    }),
+                    (BinaryOp::Mul, Mx(_, count), Mx(rows, _)) if count == rows => {
+                        self.product(a, b, *span)
+                    }
+                    (BinaryOp::Mul, Mx(_, count), Vc(n) | Mx(n, _)) => Err(CompileError {
+                        span: *span,
+                        message: format!(
+                            "type error: {} * {}: the columns of the first ({count}) must be \
+                             as many as the rows of the second ({n})",
+                            a.ty.article(),
+                            b.ty.article()
+                        ),
+                    }),
                     _ => {
                         let hint = match op {
                             BinaryOp::Mul => {
@@ -262,136 +250,6 @@ impl Program {
         }
     }
 
-    /// `a.x` and the like: a vector's components; a matrix's columns `.c0`…, rows `.r0`… and
-    /// entries `.xy` (row x, column y).
-    fn member(&mut self, a: Value, component: &str, span: Span) -> Result<Value, CompileError> {
-        let axis = |c: char| "xyz".find(c);
-        match a.ty {
-            Type::Vector => match component.chars().next().and_then(axis) {
-                Some(i) if component.len() == 1 => Ok(Value::scalar(self.emit(
-                    Op::Component(a.r[0], i as u8),
-                    span,
-                    ".",
-                )?)),
-                _ => Err(CompileError {
-                    span,
-                    message: format!("a vector has components .x, .y and .z, not .{component}"),
-                }),
-            },
-            Type::Matrix => {
-                let mut chars = component.chars();
-                let (first, second) = (chars.next(), chars.next());
-                let digit = |c: Option<char>| c.and_then(|c| c.to_digit(10)).filter(|&d| d < 3);
-                match (first, second, component.len()) {
-                    (Some('c'), d, 2) if digit(d).is_some() => {
-                        Ok(Value::vector(a.r[digit(d).unwrap_or(0) as usize]))
-                    }
-                    (Some('r'), d, 2) if digit(d).is_some() => {
-                        let rows = self.transpose(a, span)?;
-                        Ok(Value::vector(rows.r[digit(d).unwrap_or(0) as usize]))
-                    }
-                    (Some(x), Some(y), 2) if axis(x).is_some() && axis(y).is_some() => {
-                        let (i, j) = (axis(x).unwrap_or(0), axis(y).unwrap_or(0));
-                        Ok(Value::scalar(self.emit(
-                            Op::Component(a.r[j], i as u8),
-                            span,
-                            ".",
-                        )?))
-                    }
-                    _ => Err(CompileError {
-                        span,
-                        message: format!(
-                            "a matrix has columns .c0 .c1 .c2, rows .r0 .r1 .r2 and entries \
-                             .xx .xy … .zz (row, column), not .{component}"
-                        ),
-                    }),
-                }
-            }
-            Type::Scalar => Err(CompileError {
-                span,
-                message: format!(
-                    "type error: .{component} of a scalar (only a vector or a matrix has components)"
-                ),
-            }),
-        }
-    }
-
-    /// A name the program knows without a definition ([`GIVEN_NAMES`]), made now; `None` for
-    /// any other.
-    fn given(&mut self, name: &str, span: Span) -> Result<Option<Value>, CompileError> {
-        let rest_particle = name
-            .strip_prefix('q')
-            .and_then(|k| k.parse::<usize>().ok())
-            .filter(|&k| k < self.arity && name.len() == 2);
-        if let Some(k) = rest_particle {
-            return Ok(Some(Value::vector(self.emit(
-                Op::RestParticle(k as u8),
-                span,
-                "a rest position",
-            )?)));
-        }
-        let material = ["mu", "lambda", "gamma"].iter().position(|&m| m == name);
-        if let Some(k) = material {
-            return Ok(Some(Value::scalar(self.emit(
-                Op::Material(k as u8),
-                span,
-                "the material",
-            )?)));
-        }
-        if name == "I" {
-            let mut columns = [0; 3];
-            for (j, column) in columns.iter_mut().enumerate() {
-                let mut e = [0.0; 3];
-                e[j] = 1.0;
-                *column = self.emit(Op::ConstVector(e), span, "I")?;
-            }
-            return Ok(Some(Value::matrix(columns)));
-        }
-        if !matches!(name, "Dm" | "Ds" | "F" | "V0") {
-            return Ok(None);
-        }
-        if self.arity != 4 {
-            return Err(CompileError {
-                span,
-                message: format!(
-                    "`{name}` is a tet's: this binding has {} particles, p0…p{}",
-                    ["no", "one", "two", "three"][self.arity.min(3)],
-                    self.arity.saturating_sub(1)
-                ),
-            });
-        }
-        let edges = |program: &mut Program, corner: fn(u8) -> Op, what| {
-            let origin = program.emit(corner(0), span, what)?;
-            let mut columns = [0; 3];
-            for (k, column) in columns.iter_mut().enumerate() {
-                let p = program.emit(corner(k as u8 + 1), span, what)?;
-                *column = program.emit(Op::SubV(p, origin), span, what)?;
-            }
-            Ok::<_, CompileError>(Value::matrix(columns))
-        };
-        let value = match name {
-            "Dm" => edges(self, Op::RestParticle, "Dm")?,
-            "Ds" => edges(self, Op::Particle, "Ds")?,
-            "V0" => {
-                let dm = edges(self, Op::RestParticle, "V0")?;
-                let det = self.emit(Op::Det(dm.r[0], dm.r[1], dm.r[2]), span, "V0")?;
-                let six = self.emit(Op::Const(6.0), span, "V0")?;
-                Value::scalar(self.emit(Op::DivS(det, six), span, "V0")?)
-            }
-            _ => {
-                let ds = edges(self, Op::Particle, "F")?;
-                let dm = edges(self, Op::RestParticle, "F")?;
-                let inverse = self.inverse(dm, span)?;
-                let mut columns = [0; 3];
-                for (j, column) in columns.iter_mut().enumerate() {
-                    *column = self.times_vector(ds, inverse.r[j], span)?;
-                }
-                Value::matrix(columns)
-            }
-        };
-        Ok(Some(value))
-    }
-
     /// A call of one of the [`FUNCTIONS`]: its arguments checked against what it takes, then
     /// its instructions (`tan`, `pow`, `clamp` and the matrix functions are made of others).
     fn call(
@@ -401,7 +259,7 @@ impl Program {
         args: &[Expr],
         span: Span,
     ) -> Result<Value, CompileError> {
-        let Some(&(what, params, _)) = FUNCTIONS.iter().find(|f| f.0 == name) else {
+        let Some(&(what, params)) = FUNCTIONS.iter().find(|f| f.0 == name) else {
             return Err(CompileError {
                 span: name_span,
                 message: format!(
@@ -412,7 +270,7 @@ impl Program {
         };
         // det(M) as well as det(a, b, c).
         let params: &[Param] = if name == "det" && args.len() == 1 {
-            &[M]
+            &[Square]
         } else {
             params
         };
@@ -446,15 +304,15 @@ impl Program {
                     }
                     condition = Some((*cmp, a.r[0], b.r[0]));
                 }
-                Is(wanted) => {
+                Is(_) | AnyVector | AnyMatrix | Square => {
                     let value = self.compile(arg)?;
-                    if value.ty != wanted {
+                    if !param.admits(value.ty) {
                         return Err(CompileError {
                             span: arg.span(),
                             message: format!(
                                 "type error: argument {} of `{name}` must be {}, and this is {}",
                                 k + 1,
-                                wanted.article(),
+                                param.wanted(),
                                 value.ty.article()
                             ),
                         });
@@ -463,7 +321,7 @@ impl Program {
                 }
                 Same => {
                     let value = self.compile(arg)?;
-                    if value.ty == Type::Matrix {
+                    if matches!(value.ty, Type::Matrix(..)) {
                         return Err(wrong("a scalar or a vector"));
                     }
                     if same.is_some_and(|t| t != value.ty) {
@@ -477,47 +335,90 @@ impl Program {
         let [a, b, c] = values.map(|v| v.r[0]);
         let scalar = |program: &mut Program, op| Ok(Value::scalar(program.emit(op, span, what)?));
         let vector = |program: &mut Program, op| Ok(Value::vector(program.emit(op, span, what)?));
+        // Vectors that must be of one length: dot's two, mat3's and mat2's columns.
+        let lengths = |count: usize| -> Result<(), CompileError> {
+            let first = values[0].ty;
+            match (1..count).find(|&k| values[k].ty != first) {
+                Some(k) => Err(CompileError {
+                    span: args[k].span(),
+                    message: format!(
+                        "type error: argument {} of `{name}` is {}, and argument 1 {}: they must \
+                         be of one length",
+                        k + 1,
+                        values[k].ty.article(),
+                        first.article()
+                    ),
+                }),
+                None => Ok(()),
+            }
+        };
         match name {
-            "dot" => scalar(self, Op::Dot(a, b)),
+            "dot" => {
+                lengths(2)?;
+                scalar(self, Op::Dot(a, b))
+            }
             "cross" => vector(self, Op::Cross(a, b)),
             "length" => scalar(self, Op::Length(a)),
-            "normalize" => vector(self, Op::Normalize(a)),
-            "det" if values[0].ty == Type::Matrix => {
-                let [c0, c1, c2] = values[0].r;
-                scalar(self, Op::Det(c0, c1, c2))
+            "normalize" => Ok(Value {
+                r: [self.emit(Op::Normalize(a), span, what)?; 3],
+                ty: values[0].ty,
+            }),
+            "det" if matches!(values[0].ty, Type::Matrix(..)) => {
+                Ok(Value::scalar(self.determinant(values[0], span, what)?))
             }
             "det" => scalar(self, Op::Det(a, b, c)),
             "vec3" => vector(self, Op::Vec3(a, b, c)),
-            "mat3" => Ok(Value::matrix([a, b, c])),
+            "vec2" => Ok(Value {
+                r: [self.vector2(a, b, span)?; 3],
+                ty: Type::Vector(2),
+            }),
+            "mat3" | "mat2" => {
+                let count = if name == "mat3" { 3 } else { 2 };
+                lengths(count)?;
+                let (rows, _) = values[0].ty.shape();
+                self.shaped(rows, &[a, b, c][..count], span)
+            }
             "outer" => {
                 // a bᵀ: column j is a bⱼ.
+                let ((rows, _), (count, _)) = (values[0].ty.shape(), values[1].ty.shape());
                 let mut columns = [0; 3];
-                for (j, column) in columns.iter_mut().enumerate() {
+                for (j, column) in columns.iter_mut().enumerate().take(count as usize) {
                     let bj = self.emit(Op::Component(b, j as u8), span, what)?;
                     *column = self.emit(Op::Scale(a, bj), span, what)?;
                 }
-                Ok(Value::matrix(columns))
+                self.shaped(rows, &columns[..count as usize], span)
             }
             "transpose" => self.transpose(values[0], span),
             "inverse" => self.inverse(values[0], span),
-            "trace" => {
+            "polar" => {
+                // R of F = R S, column by column (`numbers::svd3`).
                 let [c0, c1, c2] = values[0].r;
-                let x = self.emit(Op::Component(c0, 0), span, what)?;
-                let y = self.emit(Op::Component(c1, 1), span, what)?;
-                let z = self.emit(Op::Component(c2, 2), span, what)?;
-                let xy = self.emit(Op::AddS(x, y), span, what)?;
-                scalar(self, Op::AddS(xy, z))
+                let mut columns = [0; 3];
+                for (k, column) in columns.iter_mut().enumerate() {
+                    *column = self.emit(Op::PolarColumn(c0, c1, c2, k as u8), span, what)?;
+                }
+                Ok(Value::matrix(columns))
             }
-            "norm" => {
-                // ‖M‖_F = √(Σⱼ cⱼ·cⱼ).
+            "svd_u" | "svd_v" => {
+                // U or V of F = U diag(σ) Vᵀ, column by column (`numbers::svd3`).
                 let [c0, c1, c2] = values[0].r;
-                let x = self.emit(Op::Dot(c0, c0), span, what)?;
-                let y = self.emit(Op::Dot(c1, c1), span, what)?;
-                let z = self.emit(Op::Dot(c2, c2), span, what)?;
-                let xy = self.emit(Op::AddS(x, y), span, what)?;
-                let sum = self.emit(Op::AddS(xy, z), span, what)?;
-                scalar(self, Op::Sqrt(sum))
+                let mut columns = [0; 3];
+                for (k, column) in columns.iter_mut().enumerate() {
+                    let op = if name == "svd_u" {
+                        Op::SvdU(c0, c1, c2, k as u8)
+                    } else {
+                        Op::SvdV(c0, c1, c2, k as u8)
+                    };
+                    *column = self.emit(op, span, what)?;
+                }
+                Ok(Value::matrix(columns))
             }
+            "singular_values" => {
+                let [c0, c1, c2] = values[0].r;
+                vector(self, Op::SingularValues(c0, c1, c2))
+            }
+            "trace" => Ok(Value::scalar(self.trace(values[0], span)?)),
+            "norm" => Ok(Value::scalar(self.norm(values[0], span)?)),
             "sqrt" => scalar(self, Op::Sqrt(a)),
             "cbrt" => scalar(self, Op::Cbrt(a)),
             "exp" => scalar(self, Op::Exp(a)),
@@ -545,7 +446,7 @@ impl Program {
             "pow" => Ok(Value::scalar(self.pow(a, b, span)?)),
             _ => {
                 let (cmp, x, y) = condition.expect("if has a condition");
-                let op = if same == Some(Type::Vector) {
+                let op = if matches!(same, Some(Type::Vector(_))) {
                     Op::IfVector(cmp, x, y, b, c)
                 } else {
                     Op::If(cmp, x, y, b, c)
@@ -617,11 +518,7 @@ impl Program {
         }
         let mut known: Vec<&str> = self.names.keys().map(String::as_str).collect();
         known.sort_unstable();
-        let given: Vec<&str> = GIVEN_NAMES
-            .iter()
-            .map(|g| g.0)
-            .filter(|g| self.arity == 4 || !matches!(*g, "Dm" | "Ds" | "F" | "V0"))
-            .collect();
+        let given: Vec<&str> = given_here(self.arity).collect();
         format!(
             "unknown name `{name}`: the names here are {}, and {} (the rest shape, the material)",
             known.join(", "),

@@ -8,12 +8,15 @@
 //! ([`crate::numbers::dual::Tangent`]).
 //!
 //! # Types
-//! Scalars, 3-vectors and 3×3 matrices. A matrix is compiled into its three columns, each a
-//! vector register, and every matrix operation into vector and scalar instructions (`M v` is
-//! Σⱼ cⱼ vⱼ, one instruction; `inverse(M)` has the rows (c₁×c₂, c₂×c₀, c₀×c₁) / det M), so a
-//! tape knows only scalars and vectors and each instruction's derivative rule covers matrices
-//! too. The same instruction on the same registers is compiled once (common subexpressions),
-//! x·1, x/1 and −(−x) are x, and what a constant gives is folded.
+//! Scalars, vectors of 2 or 3 and matrices of 2 or 3 rows by 2 or 3 columns (a triangle's F is
+//! 3 × 2). A vector is one register (a 2-vector's z is 0) and a matrix its columns, each a vector
+//! register (`shapes.rs`); every matrix operation is compiled into vector and scalar
+//! instructions (`M v` is Σⱼ cⱼ vⱼ, one instruction; `inverse(M)` of a 3 × 3 has the rows
+//! (c₁×c₂, c₂×c₀, c₀×c₁) / det M), so a tape knows only scalars and vectors and each
+//! instruction's derivative rule covers matrices too; the polar decomposition and the SVD are
+//! instructions of their own, one per column of the result (`numbers::svd3`). The same
+//! instruction on the same registers is compiled once (common subexpressions), x·1, x/1 and
+//! −(−x) are x, and what a constant gives is folded.
 //!
 //! # What is worked out once per element
 //! An instruction that reads only the rest shape (`q0`…, `Dm`, `V0`) and the material (`mu`,
@@ -35,11 +38,13 @@
 
 mod derivative;
 mod expressions;
+mod given;
 mod op;
+mod shapes;
 mod tape;
 
 use expressions::FUNCTIONS;
-pub(super) use expressions::GIVEN_NAMES;
+pub(super) use given::GIVEN_NAMES;
 pub(super) use op::{Inputs, MAX_REGISTERS, MAX_STORED, MAX_WRITTEN};
 use tape::InputLayout;
 pub(super) use tape::{Registers, Tape};
@@ -57,18 +62,34 @@ use crate::numbers::vector::Real;
 pub(super) enum Type {
     /// A number.
     Scalar,
-    /// A 3-vector.
-    Vector,
-    /// A 3×3 matrix.
-    Matrix,
+    /// A vector of 2 or 3 components (a 2-vector's register keeps z = 0).
+    Vector(u8),
+    /// A matrix of (rows, columns), each 2 or 3: its columns are vectors of `rows` components.
+    Matrix(u8, u8),
 }
 
 impl Type {
-    fn article(self) -> &'static str {
+    /// A 3-vector: a particle, a gradient entry.
+    pub(super) const VECTOR: Type = Type::Vector(3);
+    /// A 3 × 3 matrix: a tet's F, a Hessian block.
+    pub(super) const MATRIX: Type = Type::Matrix(3, 3);
+
+    fn article(self) -> String {
         match self {
-            Type::Scalar => "a scalar",
-            Type::Vector => "a vector",
-            Type::Matrix => "a matrix",
+            Type::Scalar => "a scalar".to_owned(),
+            Type::VECTOR => "a vector".to_owned(),
+            Type::MATRIX => "a matrix".to_owned(),
+            Type::Vector(n) => format!("a {n}-vector"),
+            Type::Matrix(rows, columns) => format!("a {rows} × {columns} matrix"),
+        }
+    }
+
+    /// (rows, columns) of a matrix; (n, 1) of an n-vector, (1, 1) of a scalar.
+    fn shape(self) -> (u8, u8) {
+        match self {
+            Type::Scalar => (1, 1),
+            Type::Vector(n) => (n, 1),
+            Type::Matrix(rows, columns) => (rows, columns),
         }
     }
 }
@@ -100,14 +121,14 @@ impl Value {
     fn vector(r: Reg) -> Value {
         Value {
             r: [r; 3],
-            ty: Type::Vector,
+            ty: Type::VECTOR,
         }
     }
 
     fn matrix(columns: [Reg; 3]) -> Value {
         Value {
             r: columns,
-            ty: Type::Matrix,
+            ty: Type::MATRIX,
         }
     }
 }
@@ -243,7 +264,7 @@ impl Program {
             });
         }
         let first = self.outputs.len();
-        let columns = if wanted == Type::Matrix { 3 } else { 1 };
+        let columns = if wanted == Type::MATRIX { 3 } else { 1 };
         self.outputs.extend_from_slice(&value.r[..columns]);
         Ok(first)
     }

@@ -4,6 +4,7 @@
 //! ([`super::Program::differentiate`]).
 
 use crate::constraint_file::expression::CompareOp;
+use crate::numbers::columns::{add3, cross, dot, mat_vec, scale, shrink, sub3};
 use crate::numbers::vector::Real;
 use arrayvec::ArrayVec;
 
@@ -80,6 +81,15 @@ pub(super) enum Op {
     If(CompareOp, Reg, Reg, Reg, Reg),
     /// `if(a cmp b, then, otherwise)` of vectors.
     IfVector(CompareOp, Reg, Reg, Reg, Reg),
+    /// Column k of the rotation R of the polar decomposition F = R S, F's columns being the three
+    /// registers ([`Real::polar`]): a matrix result is its three columns, each one instruction.
+    PolarColumn(Reg, Reg, Reg, u8),
+    /// The signed singular values (σ₀, σ₁, σ₂) of F ([`Real::signed_svd`]).
+    SingularValues(Reg, Reg, Reg),
+    /// Column k of U of F's signed SVD ([`Real::signed_svd`]).
+    SvdU(Reg, Reg, Reg, u8),
+    /// Column k of V of F's signed SVD.
+    SvdV(Reg, Reg, Reg, u8),
 }
 
 impl Op {
@@ -123,6 +133,10 @@ impl Op {
                 MatVec(a, b, c, v)
             }
             Vec3(a, b, c) => Vec3(f(a), f(b), f(c)),
+            SingularValues(a, b, c) => SingularValues(f(a), f(b), f(c)),
+            PolarColumn(a, b, c, k) => PolarColumn(f(a), f(b), f(c), k),
+            SvdU(a, b, c, k) => SvdU(f(a), f(b), f(c), k),
+            SvdV(a, b, c, k) => SvdV(f(a), f(b), f(c), k),
             If(cmp, a, b, t, e) => {
                 let (a, b) = (f(a), f(b));
                 let (t, e) = (f(t), f(e));
@@ -178,6 +192,10 @@ impl Op {
                 | Op::MatVec(..)
                 | Op::ConstVector(_)
                 | Op::IfVector(..)
+                | Op::PolarColumn(..)
+                | Op::SingularValues(..)
+                | Op::SvdU(..)
+                | Op::SvdV(..)
         )
     }
 
@@ -280,6 +298,10 @@ impl Op {
                 let (t, e) = (v!(t), v!(e));
                 vector!([0, 1, 2].map(|k| T::select(mask, t[k], e[k])))
             }
+            Op::PolarColumn(a, b, c, k) => vector!(T::polar([v!(a), v!(b), v!(c)])[k as usize]),
+            Op::SingularValues(a, b, c) => vector!(T::signed_svd([v!(a), v!(b), v!(c)]).sigma),
+            Op::SvdU(a, b, c, k) => vector!(T::signed_svd([v!(a), v!(b), v!(c)]).u[k as usize]),
+            Op::SvdV(a, b, c, k) => vector!(T::signed_svd([v!(a), v!(b), v!(c)]).v[k as usize]),
         }
     }
 
@@ -336,47 +358,4 @@ pub(super) fn holds<T: Real>(cmp: CompareOp, a: T, b: T) -> T::Mask {
         CompareOp::Greater => a.gt(b),
         CompareOp::GreaterOrEqual => b.le(a),
     }
-}
-
-#[inline(always)]
-pub(super) fn add3<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-#[inline(always)]
-pub(super) fn sub3<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline(always)]
-pub(super) fn scale<T: Real>(a: [T; 3], k: T) -> [T; 3] {
-    [a[0] * k, a[1] * k, a[2] * k]
-}
-
-#[inline(always)]
-pub(super) fn shrink<T: Real>(a: [T; 3], k: T) -> [T; 3] {
-    [a[0] / k, a[1] / k, a[2] / k]
-}
-
-#[inline(always)]
-pub(super) fn dot<T: Real>(a: [T; 3], b: [T; 3]) -> T {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// The matrix of columns `m` times `v`: m₀ v.x + m₁ v.y + m₂ v.z, summed in that order.
-#[inline(always)]
-pub(super) fn mat_vec<T: Real>(m: [[T; 3]; 3], v: [T; 3]) -> [T; 3] {
-    add3(
-        add3(scale(m[0], v[0]), scale(m[1], v[1])),
-        scale(m[2], v[2]),
-    )
-}
-
-#[inline(always)]
-pub(super) fn cross<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
