@@ -110,8 +110,8 @@ impl ConstraintEditor {
         compiled
     }
 
-    /// The editor's contents, for any container: the text and the examples to start from on the
-    /// left, what the text defines (or its mistake) and the gradient check on the right.
+    /// The editor's contents, for any container: the text on the left; what the text defines (or
+    /// its mistake), the gradient check and the examples to start from on the right.
     /// `exercise`: the text's family is what the open lesson step asks the student to write or
     /// mend; its grade is shown with the status.
     pub fn contents(
@@ -137,13 +137,15 @@ impl ConstraintEditor {
                     .id_salt("constraint status")
                     .max_height(height)
                     .show(ui, |ui| {
-                        if let Some(file) = self.examples(ui) {
-                            compiled = Some(file);
-                        }
-                        ui.separator();
+                        // What the text defines and its grade first, where they stay in view
+                        // however many examples there are.
                         self.status(ui, families);
                         if let Some(family) = self.family.filter(|_| exercise) {
                             super::lesson::show_grade(ui, families, family, 14.0);
+                        }
+                        ui.separator();
+                        if let Some(file) = self.examples(ui) {
+                            compiled = Some(file);
                         }
                     });
             });
