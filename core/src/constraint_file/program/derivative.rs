@@ -320,6 +320,8 @@ impl Rule<'_> {
             Op::SingularValues(c0, c1, c2) => self.singular_values([c0, c1, c2])?,
             Op::SvdU(c0, c1, c2, k) => self.singular_vector([c0, c1, c2], k, true)?,
             Op::SvdV(c0, c1, c2, k) => self.singular_vector([c0, c1, c2], k, false)?,
+            // Made only when a tape is cut, after differentiation.
+            Op::Decomposed(..) | Op::Written => {}
         }
         Ok(())
     }
@@ -392,13 +394,10 @@ impl Rule<'_> {
         }
         let [c0, c1, c2] = f;
         let bar = self.bar;
-        let mut u = [0; 3];
-        let mut v = [0; 3];
+        let (u, v) = self.singular_vectors([c0, c1, c2])?;
         let mut weight = [0; 3];
-        for i in 0..3 {
-            u[i] = self.emit(Op::SvdU(c0, c1, c2, i as u8))?;
-            v[i] = self.emit(Op::SvdV(c0, c1, c2, i as u8))?;
-            weight[i] = self.emit(Op::Component(bar, i as u8))?;
+        for (i, w) in weight.iter_mut().enumerate() {
+            *w = self.emit(Op::Component(bar, i as u8))?;
         }
         for (j, column) in f.into_iter().enumerate() {
             self.add(column, |rule| {
@@ -425,14 +424,11 @@ impl Rule<'_> {
         let [c0, c1, c2] = f;
         let k = k as usize;
         let bar = self.bar;
-        let mut u = [0; 3];
-        let mut v = [0; 3];
+        let (u, v) = self.singular_vectors([c0, c1, c2])?;
         let mut sigma = [0; 3];
         let values = self.emit(Op::SingularValues(c0, c1, c2))?;
-        for i in 0..3 {
-            u[i] = self.emit(Op::SvdU(c0, c1, c2, i as u8))?;
-            v[i] = self.emit(Op::SvdV(c0, c1, c2, i as u8))?;
-            sigma[i] = self.emit(Op::Component(values, i as u8))?;
+        for (i, s) in sigma.iter_mut().enumerate() {
+            *s = self.emit(Op::Component(values, i as u8))?;
         }
         // P̄ₘₖ and P̄ₖₘ for the two m ≠ k.
         let others: Vec<usize> = (0..3).filter(|&m| m != k).collect();
@@ -473,6 +469,21 @@ impl Rule<'_> {
             })?;
         }
         Ok(())
+    }
+
+    /// U's columns, then V's, of F's signed SVD, each three one after the other so that a tape
+    /// runs each matrix as one decomposition (`tape.rs`, `decompose_once`).
+    fn singular_vectors(&mut self, f: [Reg; 3]) -> Result<([Reg; 3], [Reg; 3]), CompileError> {
+        let [c0, c1, c2] = f;
+        let mut u = [0; 3];
+        for (i, column) in u.iter_mut().enumerate() {
+            *column = self.emit(Op::SvdU(c0, c1, c2, i as u8))?;
+        }
+        let mut v = [0; 3];
+        for (i, column) in v.iter_mut().enumerate() {
+            *column = self.emit(Op::SvdV(c0, c1, c2, i as u8))?;
+        }
+        Ok((u, v))
     }
 
     /// (m₀·x, m₁·x, m₂·x): Mᵀ x for the matrix of columns `m`.

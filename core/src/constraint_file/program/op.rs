@@ -90,6 +90,35 @@ pub(super) enum Op {
     SvdU(Reg, Reg, Reg, u8),
     /// Column k of V of F's signed SVD.
     SvdV(Reg, Reg, Reg, u8),
+    /// All three columns of R, U or V of F at once, into this register and the next two: what a
+    /// tape runs for the three column instructions of one matrix (each of which would decompose
+    /// F again), the first replaced by this and the other two by [`Op::Written`].
+    Decomposed(Decomposition, Reg, Reg, Reg),
+    /// Nothing: the value was written by the [`Op::Decomposed`] before it.
+    Written,
+}
+
+/// Which matrix of F's decompositions an [`Op::Decomposed`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Decomposition {
+    /// R of F = R S.
+    Polar,
+    /// U of F = U diag(σ) Vᵀ.
+    U,
+    /// V of F = U diag(σ) Vᵀ.
+    V,
+}
+
+impl Op {
+    /// The column instruction this is, as (which matrix, F's columns, the column), if it is one.
+    pub(super) fn column_of(self) -> Option<(Decomposition, [Reg; 3], u8)> {
+        match self {
+            Op::PolarColumn(a, b, c, k) => Some((Decomposition::Polar, [a, b, c], k)),
+            Op::SvdU(a, b, c, k) => Some((Decomposition::U, [a, b, c], k)),
+            Op::SvdV(a, b, c, k) => Some((Decomposition::V, [a, b, c], k)),
+            _ => None,
+        }
+    }
 }
 
 impl Op {
@@ -97,7 +126,8 @@ impl Op {
     pub(super) fn map_inputs(self, mut f: impl FnMut(Reg) -> Reg) -> Op {
         use Op::*;
         match self {
-            Const(_) | ConstVector(_) | Particle(_) | RestParticle(_) | Material(_) | Rest => self,
+            Const(_) | ConstVector(_) | Particle(_) | RestParticle(_) | Material(_) | Rest
+            | Written => self,
             NegS(a) => NegS(f(a)),
             NegV(a) => NegV(f(a)),
             Length(a) => Length(f(a)),
@@ -137,6 +167,7 @@ impl Op {
             PolarColumn(a, b, c, k) => PolarColumn(f(a), f(b), f(c), k),
             SvdU(a, b, c, k) => SvdU(f(a), f(b), f(c), k),
             SvdV(a, b, c, k) => SvdV(f(a), f(b), f(c), k),
+            Decomposed(which, a, b, c) => Decomposed(which, f(a), f(b), f(c)),
             If(cmp, a, b, t, e) => {
                 let (a, b) = (f(a), f(b));
                 let (t, e) = (f(t), f(e));
@@ -196,6 +227,8 @@ impl Op {
                 | Op::SingularValues(..)
                 | Op::SvdU(..)
                 | Op::SvdV(..)
+                | Op::Decomposed(..)
+                | Op::Written
         )
     }
 
@@ -302,6 +335,18 @@ impl Op {
             Op::SingularValues(a, b, c) => vector!(T::signed_svd([v!(a), v!(b), v!(c)]).sigma),
             Op::SvdU(a, b, c, k) => vector!(T::signed_svd([v!(a), v!(b), v!(c)]).u[k as usize]),
             Op::SvdV(a, b, c, k) => vector!(T::signed_svd([v!(a), v!(b), v!(c)]).v[k as usize]),
+            Op::Decomposed(which, a, b, c) => {
+                let f = [v!(a), v!(b), v!(c)];
+                let columns = match which {
+                    Decomposition::Polar => T::polar(f),
+                    Decomposition::U => T::signed_svd(f).u,
+                    Decomposition::V => T::signed_svd(f).v,
+                };
+                for (j, column) in columns.iter().enumerate() {
+                    r[at + 3 * j..at + 3 * j + 3].copy_from_slice(column);
+                }
+            }
+            Op::Written => {}
         }
     }
 

@@ -86,6 +86,26 @@ impl<T: Copy> Registers<'_, T> {
     }
 }
 
+/// `ops` with each run of a matrix's three column instructions (R's, U's or V's columns 0, 1, 2
+/// of the same F, one after the other: their values side by side) run as one decomposition
+/// ([`Op::Decomposed`], then [`Op::Written`] twice): the same numbers, a third of the work.
+fn decompose_once(mut ops: Vec<Op>) -> Vec<Op> {
+    for i in 0..ops.len().saturating_sub(2) {
+        let columns = [ops[i], ops[i + 1], ops[i + 2]].map(Op::column_of);
+        if let [Some((which, f, 0)), Some((w1, f1, 1)), Some((w2, f2, 2))] = columns
+            && which == w1
+            && which == w2
+            && f == f1
+            && f == f2
+        {
+            ops[i] = Op::Decomposed(which, f[0], f[1], f[2]);
+            ops[i + 1] = Op::Written;
+            ops[i + 2] = Op::Written;
+        }
+    }
+    ops
+}
+
 /// Where a tape's value stops being finite ([`Tape::undefined_at`]).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Undefined {
@@ -141,6 +161,7 @@ impl Tape {
         let reads_element = ops
             .iter()
             .any(|op| matches!(op, Op::RestParticle(_) | Op::Material(_)));
+        let ops = decompose_once(ops);
         let mut slots = 3 * arity + 1 + loads.len() + constants.len();
         let mut starts = Vec::with_capacity(ops.len());
         for &wide in &vector {
@@ -361,6 +382,80 @@ impl Tape {
         let first = 3 * self.arity + 1 + self.loads.len();
         for (k, &x) in self.constants.iter().enumerate() {
             r[first + k] = T::from_f64(x);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraint_file::expression::parse_expression;
+    use crate::constraint_file::program::op::Decomposition;
+    use crate::constraint_file::program::{Program, Type};
+
+    /// A matrix's three column instructions run as one decomposition, to the same bits as three.
+    #[test]
+    fn three_columns_of_one_decomposition_are_worked_out_once() {
+        for (value, which) in [
+            (
+                "norm(polar(mat3(p0, p1, cross(p0, p1) + vec3(0.2, -0.1, 0.3))))",
+                "polar",
+            ),
+            (
+                "norm(svd_u(mat3(p0, p1, p0 - p1 + vec3(0.5, 0, 0.1))))",
+                "U",
+            ),
+            (
+                "trace(svd_v(mat3(p0, p1, p0 - p1 + vec3(0.5, 0, 0.1))))",
+                "V",
+            ),
+        ] {
+            let mut program = Program::new(2, true);
+            let c = program
+                .output(&parse_expression(value).unwrap(), Type::Scalar, "value")
+                .unwrap();
+            let gradient = program.differentiate(c).unwrap();
+            let mut outputs = vec![c];
+            outputs.extend(&gradient);
+            let tape = program.tape(&outputs);
+            let decompositions = tape
+                .ops
+                .iter()
+                .filter(|op| matches!(op, Op::Decomposed(..)))
+                .count();
+            let columns = tape
+                .ops
+                .iter()
+                .filter(|op| op.column_of().is_some())
+                .count();
+            assert!(decompositions >= 1, "{which}: {:?}", tape.ops);
+            assert_eq!(columns, 0, "{which}: every column runs in a decomposition");
+            // The same numbers as the three columns one by one.
+            let points = [[0.9, 0.2, -0.3], [0.1, 1.1, 0.4]];
+            let fused = tape.run(&Inputs::of(&points, 0.0), |r| {
+                (0..3)
+                    .map(|k| r.vector(k).map(f64::to_bits))
+                    .collect::<Vec<_>>()
+            });
+            let mut unfused = tape.clone();
+            for (k, op) in unfused.ops.clone().iter().enumerate() {
+                if let Op::Decomposed(kind, a, b, c) = *op {
+                    let column = |j: u8| match kind {
+                        Decomposition::Polar => Op::PolarColumn(a, b, c, j),
+                        Decomposition::U => Op::SvdU(a, b, c, j),
+                        Decomposition::V => Op::SvdV(a, b, c, j),
+                    };
+                    for j in 0..3 {
+                        unfused.ops[k + j] = column(j as u8);
+                    }
+                }
+            }
+            let apart = unfused.run(&Inputs::of(&points, 0.0), |r| {
+                (0..3)
+                    .map(|k| r.vector(k).map(f64::to_bits))
+                    .collect::<Vec<_>>()
+            });
+            assert_eq!(fused, apart, "{which}");
         }
     }
 }
