@@ -956,3 +956,79 @@ fn modes_prints_the_classified_eigenmodes_and_their_checks() {
         assert_usage_error(&tetlab(args), names);
     }
 }
+
+/// A file that reads where the particles were at the start of the substep (`start0`…) and h:
+/// `--start` and `--h` give them, C and ∇C follow by hand, and they are refused (status 2, named)
+/// where nothing reads them or where they do not fit.
+#[test]
+fn the_start_of_the_substep_and_h_are_given_to_a_file_that_reads_them() {
+    let damper = asset("edge-damper.toml");
+    // The edge was along x, 0.9 long; now 1 long: it grew by 0.1 in h = 0.01 s, C = 10 m/s, and
+    // ∇p1 C = n / h = (100, 0, 0).
+    let out = json(&[
+        "gradient",
+        "--constraint-file",
+        &damper,
+        "--points",
+        "0,0,0",
+        "1,0,0",
+        "--start",
+        "0,0,0",
+        "0.9,0,0",
+        "--h",
+        "0.01",
+        "--json",
+    ]);
+    assert!(
+        (out["value"].as_f64().unwrap() - 10.0).abs() < 1e-12,
+        "{out}"
+    );
+    assert_close(
+        &vectors(&out["automatic"]),
+        &[[-100.0, 0.0, 0.0], [100.0, 0.0, 0.0]],
+        1e-9,
+    );
+    for (args, says) in [
+        (
+            vec![
+                "gradient",
+                "--constraint",
+                "edges",
+                "--points",
+                "0,0,0",
+                "1,0,0",
+                "--h",
+                "0.01",
+            ],
+            "--start, --h",
+        ),
+        (
+            vec![
+                "gradient",
+                "--constraint-file",
+                &damper,
+                "--points",
+                "0,0,0",
+                "1,0,0",
+                "--start",
+                "0,0,0",
+            ],
+            "--start: 1 points, as many as --points (2)",
+        ),
+        (
+            vec![
+                "gradient",
+                "--constraint-file",
+                &damper,
+                "--points",
+                "0,0,0",
+                "1,0,0",
+                "--h",
+                "0",
+            ],
+            "--h",
+        ),
+    ] {
+        assert_usage_error(&tetlab(&args), says);
+    }
+}

@@ -11,6 +11,7 @@ use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::{Family, PerFamily};
 use tetlab_core::constraints::{distance, height, volume};
 use tetlab_core::numbers::lanes::{F32x8, LANES, Vec3x8};
+use tetlab_core::numbers::vector::Real;
 use tetlab_core::scene::{Builtin, Scene};
 use tetlab_core::simulation::fast::{FastSimulation, Order};
 use tetlab_core::simulation::projection::project_kernel;
@@ -163,18 +164,40 @@ fn file_in_lanes(c: &mut Criterion) {
     let material = Material::default();
     let mut group = c.benchmark_group("sixteen constraints in lanes");
     group.bench_function("volume, built-in", |b| {
-        b.iter(|| volume::Volume.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]))
+        b.iter(|| {
+            volume::Volume.evaluate_batches(
+                black_box(&p),
+                rest,
+                &shape,
+                [&[]; GROUP],
+                (&p, F32x8::ONE),
+            )
+        })
     });
     let file = ConstraintFile::load(&folder.join("volume.toml")).expect("the example file");
     let file = FileConstraint::<4>(std::sync::Arc::new(file));
     group.bench_function("volume, file", |b| {
-        b.iter(|| file.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]))
+        b.iter(|| {
+            file.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP], (&p, F32x8::ONE))
+        })
     });
     group.bench_function("neo-Hookean pair, built-in", |b| {
         b.iter(|| {
             (
-                Deviatoric.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]),
-                Hydrostatic.evaluate_batches(black_box(&p), rest, &shape, [&[]; GROUP]),
+                Deviatoric.evaluate_batches(
+                    black_box(&p),
+                    rest,
+                    &shape,
+                    [&[]; GROUP],
+                    (&p, F32x8::ONE),
+                ),
+                Hydrostatic.evaluate_batches(
+                    black_box(&p),
+                    rest,
+                    &shape,
+                    [&[]; GROUP],
+                    (&p, F32x8::ONE),
+                ),
             )
         })
     });
@@ -194,14 +217,34 @@ fn file_in_lanes(c: &mut Criterion) {
         .map(|file| FileConstraint(std::sync::Arc::new(file)))
         .collect();
     group.bench_function("neo-Hookean deviatoric alone, file", |b| {
-        b.iter(|| files[0].evaluate_batches(black_box(&p), rest, &shape, [&stored[0]; GROUP]))
+        b.iter(|| {
+            files[0].evaluate_batches(
+                black_box(&p),
+                rest,
+                &shape,
+                [&stored[0]; GROUP],
+                (&p, F32x8::ONE),
+            )
+        })
     });
     group.bench_function("neo-Hookean pair, file", |b| {
         b.iter(|| {
             let [a, b] = [&files[0], &files[1]];
             (
-                a.evaluate_batches(black_box(&p), rest, &shape, [&stored[0]; GROUP]),
-                b.evaluate_batches(black_box(&p), rest, &shape, [&stored[1]; GROUP]),
+                a.evaluate_batches(
+                    black_box(&p),
+                    rest,
+                    &shape,
+                    [&stored[0]; GROUP],
+                    (&p, F32x8::ONE),
+                ),
+                b.evaluate_batches(
+                    black_box(&p),
+                    rest,
+                    &shape,
+                    [&stored[1]; GROUP],
+                    (&p, F32x8::ONE),
+                ),
             )
         })
     });

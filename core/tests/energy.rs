@@ -44,6 +44,10 @@ fn every_energy() -> Vec<(String, Families, PerFamily<bool>)> {
     for path in example_files() {
         let mut families = Families::builtin();
         let files = ConstraintFile::load_all(&path).unwrap_or_else(|e| panic!("{e}"));
+        // A damper (it reads where the particles were) has no energy of the positions.
+        if files.iter().any(ConstraintFile::reads_motion) {
+            continue;
+        }
         let added = families.register_all(files).unwrap();
         let mut active = PerFamily::default();
         for family in added {

@@ -9,7 +9,7 @@ mod example_files;
 use example_files::example_files;
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::file::FileConstraint;
-use tetlab_core::constraints::{Constraint, Evaluation, GROUP};
+use tetlab_core::constraints::{Constraint, Evaluation, GROUP, SubstepStart};
 use tetlab_core::numbers::lanes::{F32x8, LANES, Vec3x8};
 use tetlab_core::numbers::random::SplitMix64;
 use tetlab_core::numbers::vector::Vector3;
@@ -37,6 +37,7 @@ fn same_bits<const N: usize>(file: &ConstraintFile) -> usize {
     for round in 0..50 {
         let mut p = [[Vec3x8::ZERO; N]; GROUP];
         let mut shape = [[Vec3x8::ZERO; N]; GROUP];
+        let mut start = [[Vec3x8::ZERO; N]; GROUP];
         for j in 0..GROUP {
             for k in 0..N {
                 let mut point = || Vec3x8 {
@@ -46,6 +47,7 @@ fn same_bits<const N: usize>(file: &ConstraintFile) -> usize {
                 };
                 p[j][k] = point();
                 shape[j][k] = point();
+                start[j][k] = point();
             }
         }
         if round % 5 == 0 {
@@ -61,9 +63,16 @@ fn same_bits<const N: usize>(file: &ConstraintFile) -> usize {
             })
             .collect();
         let rows: [&[F32x8]; GROUP] = std::array::from_fn(|j| stored[j].as_slice());
-        let grouped = constraint.evaluate_batches(&p, rest, &shape, rows);
+        // Where the particles were at the start of the substep, and h: what a file that reads
+        // them gets (the others ignore it).
+        let h = lanes(&mut random, 1e-4, 1e-2);
+        let grouped = constraint.evaluate_batches(&p, rest, &shape, rows, (&start, h));
         for j in 0..GROUP {
-            let alone = constraint.evaluate_stored(&p[j], rest[j], &shape[j], rows[j]);
+            let moving = SubstepStart {
+                start: &start[j],
+                h,
+            };
+            let alone = constraint.evaluate_stored(&p[j], rest[j], &shape[j], rows[j], moving);
             assert_eq!(
                 bits(&grouped[j]),
                 bits(&alone),

@@ -227,10 +227,10 @@ fn run_one_file(
     if report.compared == 0 {
         // Where it is undefined, at the first configuration that the check drew.
         let mut rng = tetlab_core::numbers::random::SplitMix64::new(args.seed);
-        let (points, shape, _) = tetlab_core::constraints::verify::draw(&mut rng, file);
+        let (points, around, _) = tetlab_core::constraints::verify::draw(&mut rng, file);
         let material = tetlab_core::constraints::material::Material::default();
-        let stored = file.store(&shape, &material);
-        let rest = file.rest_value(&shape, &material);
+        let stored = file.store(&around.rest_shape, &material);
+        let rest = file.rest_value(&around.rest_shape, &material);
         let why = file
             .undefined_at(&points, rest, &stored)
             .map_or_else(String::new, |e| format!(": {e}"));
@@ -277,9 +277,12 @@ fn file_output(
                         .collect::<Vec<_>>()
                         .join(" ")
                 };
-                let shape = (w.rest_shape.as_deref())
+                let mut shape = (w.rest_shape.as_deref())
                     .map(|shape| format!(" --rest-shape {}", points(shape)))
                     .unwrap_or_default();
+                if let Some((start, h)) = &w.moving {
+                    shape += &format!(" --start {} --h {h:?}", points(start));
+                }
                 format!(
                     "tetlab gradient --constraint-file {} --points {}{shape} --rest {:?}",
                     shell_word(path),

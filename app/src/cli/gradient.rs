@@ -32,6 +32,14 @@ pub struct Args {
     /// The rest value: distance d, signed height d or signed volume V.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = args::finite_number)]
     rest: f64,
+    /// Where the particles were at the start of the substep, for a constraint file that reads
+    /// them (start0, …); the same number as --points. Without it, --points (no motion).
+    #[arg(long, value_name = "X,Y,Z", num_args = 1.., value_parser = args::point)]
+    start: Vec<DVec3>,
+    /// The substep's length h in seconds, for a constraint file that reads it [default: 1/6000,
+    /// the default substep].
+    #[arg(long, value_name = "SECONDS", value_parser = args::finite_number)]
+    h: Option<f64>,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
@@ -59,6 +67,13 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let Some(family) = args.constraint else {
         return run_file(args, out);
     };
+    if !args.start.is_empty() || args.h.is_some() {
+        return Err(UsageError(
+            "--start, --h: a built-in family reads neither where the particles were nor h; \
+             they are for a constraint file that names start0… or h"
+                .to_owned(),
+        ));
+    }
     let families = Families::builtin();
     if args.points.len() != families.arity(family) {
         return Err(UsageError(format!(
@@ -199,6 +214,43 @@ fn rest_shape<'a>(args: &'a Args, reads: bool, why: &str) -> Result<&'a [DVec3],
     }
 }
 
+/// Where the particles were at the start of the substep and h: `--start` (or `--points`) and
+/// `--h` (or the default substep), refused for a file that reads neither, and unless `--start`
+/// has as many points as `--points` and h is positive.
+fn moving<'a>(
+    args: &'a Args,
+    file: &ConstraintFile,
+) -> Result<tetlab_core::constraint_file::Moving<'a>, UsageError> {
+    let given = !args.start.is_empty() || args.h.is_some();
+    if given && !file.reads_motion() {
+        return Err(UsageError(format!(
+            "--start, --h: {} reads neither where the particles were (start0…) nor h",
+            file.name
+        )));
+    }
+    if !args.start.is_empty() && args.start.len() != args.points.len() {
+        return Err(UsageError(format!(
+            "--start: {} points, as many as --points ({})",
+            args.start.len(),
+            args.points.len()
+        )));
+    }
+    let h = args.h.unwrap_or(tetlab_core::constraint_file::RESTING_H);
+    if h <= 0.0 {
+        return Err(UsageError(format!(
+            "--h: {h} s; the substep is longer than 0"
+        )));
+    }
+    Ok(tetlab_core::constraint_file::Moving {
+        start: if args.start.is_empty() {
+            &args.points
+        } else {
+            &args.start
+        },
+        h,
+    })
+}
+
 /// Every constraint of the file (one, or each of its `[[constraint]]` tables in turn).
 fn run_file(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let path = args
@@ -242,8 +294,11 @@ fn run_one_file(
         rest_shape,
         &tetlab_core::constraints::material::Material::default(),
     );
-    let evaluation = file.evaluate(&args.points, args.rest, &stored);
-    let numeric = central_difference(&args.points, |p| file.value(p, args.rest, &stored));
+    let moving = moving(args, file)?;
+    let evaluation = file.evaluate_moving(&args.points, moving, args.rest, &stored);
+    let numeric = central_difference(&args.points, |p| {
+        file.value_moving(p, moving, args.rest, &stored)
+    });
     // At a kink of abs, min, max, sign or if, AD takes one side and central differences
     // average the two: say so, where.
     let scale = args.points.iter().map(|p| p.length()).fold(1.0, f64::max);

@@ -6,7 +6,7 @@
 
 use super::ConstraintFile;
 use crate::constraints::material::Material;
-use crate::constraints::verify::GradientSource;
+use crate::constraints::verify::{Around, GradientSource};
 use glam::DVec3;
 
 pub use crate::constraints::verify::{
@@ -25,22 +25,29 @@ impl GradientSource for ConstraintFile {
         self.reads_rest_shape()
     }
 
-    fn value(&self, points: &[DVec3], rest: f64, shape: &[DVec3]) -> f64 {
-        ConstraintFile::value(self, points, rest, &self.store(shape, &Material::default()))
+    fn uses_motion(&self) -> bool {
+        self.reads_motion()
     }
 
-    fn given(&self, points: &[DVec3], rest: f64, shape: &[DVec3]) -> Vec<Option<DVec3>> {
-        let stored = self.store(shape, &Material::default());
-        self.yours(points, rest, &stored)[..ConstraintFile::arity(self)].to_vec()
+    fn value(&self, points: &[DVec3], rest: f64, around: &Around) -> f64 {
+        let stored = self.store(&around.rest_shape, &Material::default());
+        self.value_moving(points, around.moving(), rest, &stored)
     }
 
-    fn automatic(&self, points: &[DVec3], rest: f64, shape: &[DVec3]) -> Option<Vec<DVec3>> {
-        self.evaluate(points, rest, &self.store(shape, &Material::default()))
+    fn given(&self, points: &[DVec3], rest: f64, around: &Around) -> Vec<Option<DVec3>> {
+        let stored = self.store(&around.rest_shape, &Material::default());
+        self.yours_moving(points, around.moving(), rest, &stored)[..ConstraintFile::arity(self)]
+            .to_vec()
+    }
+
+    fn automatic(&self, points: &[DVec3], rest: f64, around: &Around) -> Option<Vec<DVec3>> {
+        let stored = self.store(&around.rest_shape, &Material::default());
+        self.evaluate_moving(points, around.moving(), rest, &stored)
             .automatic
     }
 
-    fn natural_rest(&self, _: &[DVec3], shape: &[DVec3]) -> f64 {
-        self.rest_value(shape, &Material::default())
+    fn natural_rest(&self, _: &[DVec3], around: &Around) -> f64 {
+        self.rest_value(&around.rest_shape, &Material::default())
     }
 }
 
@@ -92,9 +99,10 @@ pub fn kinks(file: &ConstraintFile, lines: usize, seed: u64) -> Vec<Kink> {
     let material = Material::default();
     let mut found: Vec<Kink> = Vec::new();
     for _ in 0..lines {
-        let (points, shape, size) = crate::constraints::verify::draw(&mut rng, file);
-        let stored = file.store(&shape, &material);
-        let rest = file.rest_value(&shape, &material) * rng.range(-1.5, 1.5);
+        // At rest: where the particles were at the start of the substep is not drawn here.
+        let (points, around, size) = crate::constraints::verify::draw(&mut rng, file);
+        let stored = file.store(&around.rest_shape, &material);
+        let rest = file.rest_value(&around.rest_shape, &material) * rng.range(-1.5, 1.5);
         let direction: Vec<DVec3> = points.iter().map(|_| rng.in_cube(size)).collect();
         let along = |t: f64| -> Vec<DVec3> {
             points

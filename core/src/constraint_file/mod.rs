@@ -34,6 +34,7 @@ pub mod expression;
 pub mod grade;
 mod parse;
 mod program;
+pub use program::RESTING_H;
 
 use crate::constraints::Binding;
 use crate::constraints::material::Material;
@@ -161,6 +162,27 @@ pub struct Evaluation {
     pub automatic: Option<Vec<DVec3>>,
     /// The file's gradient for each particle it gives one for.
     pub yours: Vec<Option<DVec3>>,
+}
+
+/// Where the particles were at the start of the substep (`start0`, `start1`, … of a file) and
+/// the substep's length (`h`): what a constraint on velocities reads besides the particles.
+#[derive(Clone, Copy, Debug)]
+pub struct Moving<'a> {
+    /// Each particle at the start of the substep, in the constraint's order.
+    pub start: &'a [DVec3],
+    /// The substep's length in seconds.
+    pub h: f64,
+}
+
+impl<'a> Moving<'a> {
+    /// No motion: the particles were where they are, and h is [`RESTING_H`] (the default
+    /// substep): how a file is evaluated outside a substep.
+    pub fn at_rest(points: &'a [DVec3]) -> Moving<'a> {
+        Moving {
+            start: points,
+            h: RESTING_H,
+        }
+    }
 }
 
 /// An example constraint file that comes with tetlab: a file of `assets/constraints`, built into
@@ -346,6 +368,14 @@ impl ConstraintFile {
         self.prelude.reads_rest_shape() || self.rest.as_ref().is_some_and(Tape::reads_rest_shape)
     }
 
+    /// Whether C reads where the particles were at the start of the substep (`start0`…) or the
+    /// substep's length `h`: then a solver gathers them for it.
+    pub fn reads_motion(&self) -> bool {
+        [&self.value, &self.gradient, &self.yours]
+            .iter()
+            .any(|tape| tape.reads_motion())
+    }
+
     /// What an element at rest at `rest_shape` stores: the parts of C that depend only on the
     /// rest shape and `material`, worked out once (for `F = Ds inverse(Dm)`, inverse(Dm)).
     pub fn store(&self, rest_shape: &[DVec3], material: &Material) -> Stored {
@@ -378,35 +408,76 @@ impl ConstraintFile {
     }
 
     /// C at `points` with rest value `rest` and what the element stores (NaN where it is
-    /// undefined).
+    /// undefined), at rest ([`Moving::at_rest`]).
     pub fn value(&self, points: &[DVec3], rest: f64, stored: &[f64]) -> f64 {
+        self.value_moving(points, Moving::at_rest(points), rest, stored)
+    }
+
+    /// [`ConstraintFile::value`] with the particles where `moving` says they were at the start
+    /// of the substep, and its h.
+    pub fn value_moving(
+        &self,
+        points: &[DVec3],
+        moving: Moving<'_>,
+        rest: f64,
+        stored: &[f64],
+    ) -> f64 {
         let points = self.coordinates(points);
-        self.value
-            .run(&self.inputs(&points, rest, stored), |r| r.scalar(0))
+        let start = self.coordinates(moving.start);
+        self.value.run(
+            &self.inputs(&points, (&start, moving.h), rest, stored),
+            |r| r.scalar(0),
+        )
     }
 
     /// C, its gradient by forward-mode AD and the file's own, at `points` with rest value `rest`
     /// and what the element stores: what `tetlab check-gradients` and `tetlab gradient`
-    /// compare.
+    /// compare. At rest ([`Moving::at_rest`]).
     pub fn evaluate(&self, points: &[DVec3], rest: f64, stored: &[f64]) -> Evaluation {
-        let value = self.value(points, rest, stored);
+        self.evaluate_moving(points, Moving::at_rest(points), rest, stored)
+    }
+
+    /// [`ConstraintFile::evaluate`] with the particles where `moving` says they were at the
+    /// start of the substep, and its h (the gradient is C's with respect to the particles now).
+    pub fn evaluate_moving(
+        &self,
+        points: &[DVec3],
+        moving: Moving<'_>,
+        rest: f64,
+        stored: &[f64],
+    ) -> Evaluation {
+        let value = self.value_moving(points, moving, rest, stored);
         let automatic = match self.arity() {
-            2 => self.forward_mode::<2>(points, rest, stored),
-            3 => self.forward_mode::<3>(points, rest, stored),
-            _ => self.forward_mode::<4>(points, rest, stored),
+            2 => self.forward_mode::<2>(points, moving, rest, stored),
+            3 => self.forward_mode::<3>(points, moving, rest, stored),
+            _ => self.forward_mode::<4>(points, moving, rest, stored),
         };
         Evaluation {
             value,
             automatic: automatic.filter(|_| value.is_finite()),
-            yours: self.yours(points, rest, stored)[..self.arity()].to_vec(),
+            yours: self.yours_moving(points, moving, rest, stored)[..self.arity()].to_vec(),
         }
     }
 
     /// The file's own gradient for each particle it gives one for, at `points` with rest value
-    /// `rest` and what the element stores.
+    /// `rest` and what the element stores, at rest.
     pub fn yours(&self, points: &[DVec3], rest: f64, stored: &[f64]) -> [Option<DVec3>; 4] {
+        self.yours_moving(points, Moving::at_rest(points), rest, stored)
+    }
+
+    /// [`ConstraintFile::yours`] with the particles where `moving` says they were at the start
+    /// of the substep, and its h.
+    pub fn yours_moving(
+        &self,
+        points: &[DVec3],
+        moving: Moving<'_>,
+        rest: f64,
+        stored: &[f64],
+    ) -> [Option<DVec3>; 4] {
         let points = self.coordinates(points);
-        self.yours.run(&self.inputs(&points, rest, stored), |r| {
+        let start = self.coordinates(moving.start);
+        let inputs = self.inputs(&points, (&start, moving.h), rest, stored);
+        self.yours.run(&inputs, |r| {
             std::array::from_fn(|k| self.gives[k].then(|| DVec3::from_array(r.vector(1 + k))))
         })
     }
@@ -444,8 +515,15 @@ impl ConstraintFile {
         })
     }
 
-    /// The inputs of a tape that runs at each projection.
-    fn inputs<'a, T: Real>(&self, points: &'a [[T; 3]], rest: T, stored: &'a [T]) -> Inputs<'a, T> {
+    /// The inputs of a tape that runs at each projection: the particles, where they were at the
+    /// start of the substep and its h, the rest value and what the element stores.
+    fn inputs<'a, T: Real>(
+        &self,
+        points: &'a [[T; 3]],
+        (start, h): (&'a [[T; 3]], T),
+        rest: T,
+        stored: &'a [T],
+    ) -> Inputs<'a, T> {
         assert!(
             stored.len() >= self.stored,
             "{} stores {} numbers per element, and {} are given",
@@ -455,6 +533,8 @@ impl ConstraintFile {
         );
         Inputs {
             stored,
+            start,
+            h,
             ..Inputs::of(points, rest)
         }
     }
@@ -503,14 +583,33 @@ impl ConstraintFile {
         stored: &[V::Real],
         own: bool,
     ) -> crate::constraints::Evaluation<V, N> {
+        let h = V::Real::from_f64(RESTING_H);
+        self.evaluate_by_moving(p, (p, h), rest, stored, own)
+    }
+
+    /// [`ConstraintFile::evaluate_by`] with the particles at `start` at the start of the substep
+    /// and its length `h`: what the solvers call for a file that reads them
+    /// ([`ConstraintFile::reads_motion`]).
+    #[inline(always)]
+    pub fn evaluate_by_moving<V: Vector3, const N: usize>(
+        &self,
+        p: &[V; N],
+        (start, h): (&[V; N], V::Real),
+        rest: V::Real,
+        stored: &[V::Real],
+        own: bool,
+    ) -> crate::constraints::Evaluation<V, N> {
         let coordinates: [[V::Real; 3]; N] = std::array::from_fn(|i| p[i].to_array());
-        let (value, gradients) = self.value_and_gradient(&coordinates, rest, stored, own);
+        let start: [[V::Real; 3]; N] = std::array::from_fn(|i| start[i].to_array());
+        let (value, gradients) =
+            self.value_and_gradient(&coordinates, (&start, h), rest, stored, own);
         sound(value, gradients)
     }
 
     /// C and ∇C at the particles `points` (coordinates in any [`Real`]: a number, lanes, a
-    /// [`crate::numbers::block::Block`] of lanes), as they come, not finite where they are
-    /// undefined: what [`ConstraintFile::evaluate_by`] makes an evaluation of.
+    /// [`crate::numbers::block::Block`] of lanes), the particles having been at `start` at the
+    /// start of the substep of length h, as they come, not finite where they are undefined: what
+    /// [`ConstraintFile::evaluate_by`] makes an evaluation of.
     ///
     /// # Panics
     /// When `N` is not the file's arity.
@@ -518,6 +617,7 @@ impl ConstraintFile {
     pub(crate) fn value_and_gradient<T: Real, const N: usize>(
         &self,
         points: &[[T; 3]; N],
+        motion: (&[[T; 3]], T),
         rest: T,
         stored: &[T],
         own: bool,
@@ -529,7 +629,7 @@ impl ConstraintFile {
             self.name,
             self.arity()
         );
-        let inputs = self.inputs(points, rest, stored);
+        let inputs = self.inputs(points, motion, rest, stored);
         let tape = if own { &self.yours } else { &self.gradient };
         tape.run(&inputs, read_gradient)
     }
@@ -552,11 +652,12 @@ impl ConstraintFile {
     pub(crate) fn gradient_placed<T: Real, R>(
         &self,
         (own, registers): (bool, &mut [T]),
+        motion: (&[[T; 3]], T),
         place: impl FnOnce(&mut [T], &[u8]),
         read: impl FnOnce(&program::Registers<'_, T>) -> R,
     ) -> R {
         let tape = if own { &self.yours } else { &self.gradient };
-        tape.run_placed(registers, place, read)
+        tape.run_placed(registers, motion, place, read)
     }
 
     /// ∇C in f64 as `ConstraintFile::evaluate_by` gives it (the file's own with `own`, else
@@ -591,19 +692,27 @@ impl ConstraintFile {
     fn forward_mode<const N: usize>(
         &self,
         points: &[DVec3],
+        moving: Moving<'_>,
         rest: f64,
         stored: &[f64],
     ) -> Option<Vec<DVec3>> {
         let tangent_rest = Tangent::new(rest, 0.0);
         let tangents: ArrayVec<Tangent<f64>, MAX_STORED> =
             stored.iter().map(|&x| Tangent::new(x, 0.0)).collect();
+        // Where the particles were is given, not differentiated by.
+        let start: Vec<[Tangent<f64>; 3]> = moving
+            .start
+            .iter()
+            .map(|q| q.to_array().map(|x| Tangent::new(x, 0.0)))
+            .collect();
+        let h = Tangent::new(moving.h, 0.0);
         let gradients = crate::numbers::dual::gradient(points, |p| {
             let p: [[Tangent<f64>; 3]; N] = std::array::from_fn(|k| p[k].to_array());
-            self.value
-                .run(&self.inputs(&p, tangent_rest, &tangents), |r| r.scalar(0))
+            let inputs = self.inputs(&p, (&start, h), tangent_rest, &tangents);
+            self.value.run(&inputs, |r| r.scalar(0))
         })?;
         let gradients: [[f64; 3]; N] = std::array::from_fn(|k| gradients[k].to_array());
-        let e = sound::<DVec3, N>(self.value(points, rest, stored), gradients);
+        let e = sound::<DVec3, N>(self.value_moving(points, moving, rest, stored), gradients);
         (!e.degenerate).then(|| e.gradients.to_vec())
     }
 
@@ -634,7 +743,13 @@ impl ConstraintFile {
         rest: T,
         stored: &[T],
     ) -> (T, [[T; 3]; N]) {
-        self.value_and_gradient(points, rest, stored, false)
+        self.value_and_gradient(
+            points,
+            (points, T::from_f64(RESTING_H)),
+            rest,
+            stored,
+            false,
+        )
     }
 
     /// Where and why C is undefined at `points` with rest value `rest`: the first expression, in
@@ -647,9 +762,9 @@ impl ConstraintFile {
         stored: &[f64],
     ) -> Option<ConstraintFileError> {
         let points = self.coordinates(points);
-        let u = self
-            .value
-            .undefined_at(&self.inputs(&points, rest, stored))?;
+        let u =
+            self.value
+                .undefined_at(&self.inputs(&points, (&points, RESTING_H), rest, stored))?;
         Some(ConstraintFileError {
             path: self.path.clone(),
             at: Some(self.place(u.base, u.offset)),
@@ -667,7 +782,7 @@ impl ConstraintFile {
     ) -> Vec<((usize, usize), &'static str, f64)> {
         let points = self.coordinates(points);
         self.value
-            .switches_at(&self.inputs(&points, rest, stored))
+            .switches_at(&self.inputs(&points, (&points, RESTING_H), rest, stored))
             .into_iter()
             .map(|s| (self.place(s.base, s.offset), s.what, s.decides))
             .collect()

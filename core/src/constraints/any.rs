@@ -5,7 +5,7 @@
 //! numbers, reach the type itself through [`super::Families::visit`].
 
 use super::material::Material;
-use super::{Constraint, Evaluation, Stored};
+use super::{Constraint, Evaluation, Stored, SubstepStart};
 use glam::DVec3;
 
 /// What every family's constraint answers in f64, whatever its arity: points and rest shapes are
@@ -87,8 +87,11 @@ impl<const N: usize, C: Constraint<N> + Send> AnyConstraint for Typed<N, C> {
         rest_shape: &[DVec3],
         stored: &[f64],
     ) -> Evaluation<DVec3, 4> {
-        let shape = points(rest_shape);
-        padded(self.0.evaluate_stored(&points(p), rest, &shape, stored))
+        let (shape, p) = (points(rest_shape), points(p));
+        padded(
+            self.0
+                .evaluate_stored(&p, rest, &shape, stored, SubstepStart::at_rest(&p)),
+        )
     }
 
     fn rest_value(&self, rest_shape: &[DVec3], material: &Material) -> f64 {

@@ -4,7 +4,7 @@
 //! differentiate. For a constraint file, ∇C is its compiled AD, never the file's own gradient: the
 //! derivative of the energy is the derivative of C.
 
-use super::{Constraint, Families, Family, Visit};
+use super::{Constraint, Families, Family, SubstepStart, Visit};
 use crate::numbers::dual::{DualVec3, Tangent};
 use crate::numbers::vector::{Real, Vector3};
 use glam::DVec3;
@@ -21,13 +21,35 @@ pub fn value_and_gradient<T: Real<Mask = bool>, const N: usize>(
     families: &Families,
     family: Family,
     x: &[[T; 3]; N],
+    rest: (f64, &[f64]),
+    rest_shape: &[DVec3; N],
+) -> (T, [[T; 3]; N]) {
+    value_and_gradient_moving(families, family, x, rest, rest_shape, None)
+}
+
+/// [`value_and_gradient`] with the particles at `start` at the start of the substep of length h:
+/// for a family that reads them ([`Constraint::reads_motion`]), the Newton reference's substep.
+/// `None` is at rest: the particles were where they are (`x`'s values, held, not differentiated
+/// with it), h the default substep.
+pub fn value_and_gradient_moving<T: Real<Mask = bool>, const N: usize>(
+    families: &Families,
+    family: Family,
+    x: &[[T; 3]; N],
     (rest, stored): (f64, &[f64]),
     rest_shape: &[DVec3; N],
+    moving: Option<(&[DVec3; N], f64)>,
 ) -> (T, [[T; 3]; N]) {
     let stored: arrayvec::ArrayVec<T, { super::MAX_STORED }> =
         stored.iter().map(|&s| T::from_f64(s)).collect();
+    let start: [[T; 3]; N] = match moving {
+        Some((start, _)) => std::array::from_fn(|k| start[k].to_array().map(T::from_f64)),
+        // Where the particles are, held: not differentiated with them.
+        None => x.map(|c| c.map(T::constant)),
+    };
+    let h = T::from_f64(moving.map_or(crate::constraint_file::RESTING_H, |(_, h)| h));
     if let Some(file) = families.file(family) {
-        let (value, gradients) = file.automatic_gradient(x, T::from_f64(rest), &stored);
+        let (value, gradients) =
+            file.value_and_gradient(x, (&start, h), T::from_f64(rest), &stored, false);
         let sound = crate::constraint_file::sound::<DualVec3<T>, N>(value, gradients);
         return (sound.value, sound.gradients.map(|g| g.0));
     }
@@ -38,6 +60,7 @@ pub fn value_and_gradient<T: Real<Mask = bool>, const N: usize>(
             rest: T::from_f64(rest),
             stored: &stored,
             rest_shape,
+            start: (&start, h),
         },
     )
 }
@@ -64,23 +87,48 @@ pub fn of_constraint(
     x: &[DVec3],
     rest_positions: &[DVec3],
 ) -> (f64, [[f64; 3]; 4]) {
+    of_constraint_moving(families, family, particles, rest, (x, rest_positions), None)
+}
+
+/// [`of_constraint`] with every particle at `start` at the start of the substep of length h
+/// (`None`: at rest): the Newton reference's constraint values in its substep.
+pub fn of_constraint_moving(
+    families: &Families,
+    family: Family,
+    particles: &[u32],
+    rest: (f64, &[f64]),
+    (x, rest_positions): (&[DVec3], &[DVec3]),
+    moving: Option<(&[DVec3], f64)>,
+) -> (f64, [[f64; 3]; 4]) {
     fn at<const N: usize>(
         (families, family, particles, rest): (&Families, Family, &[u32], (f64, &[f64])),
         x: &[DVec3],
         rest_positions: &[DVec3],
+        moving: Option<(&[DVec3], f64)>,
     ) -> (f64, [[f64; 3]; 4]) {
         let p: [[f64; 3]; N] = std::array::from_fn(|k| x[particles[k] as usize].to_array());
         let shape: [DVec3; N] = std::array::from_fn(|k| rest_positions[particles[k] as usize]);
-        let (value, gradients) = value_and_gradient(families, family, &p, rest, &shape);
+        let start = moving.map(|(start, h)| {
+            let at: [DVec3; N] = std::array::from_fn(|k| start[particles[k] as usize]);
+            (at, h)
+        });
+        let (value, gradients) = value_and_gradient_moving(
+            families,
+            family,
+            &p,
+            rest,
+            &shape,
+            start.as_ref().map(|(at, h)| (at, *h)),
+        );
         let mut padded = [[0.0; 3]; 4];
         padded[..N].copy_from_slice(&gradients);
         (value, padded)
     }
     let constraint = (families, family, particles, rest);
     match particles.len() {
-        2 => at::<2>(constraint, x, rest_positions),
-        3 => at::<3>(constraint, x, rest_positions),
-        _ => at::<4>(constraint, x, rest_positions),
+        2 => at::<2>(constraint, x, rest_positions, moving),
+        3 => at::<3>(constraint, x, rest_positions, moving),
+        _ => at::<4>(constraint, x, rest_positions, moving),
     }
 }
 
@@ -90,6 +138,7 @@ struct At<'a, T, const M: usize> {
     rest: T,
     stored: &'a [T],
     rest_shape: &'a [DVec3; M],
+    start: (&'a [[T; 3]; M], T),
 }
 
 impl<T: Real<Mask = bool>, const M: usize> Visit for At<'_, T, M> {
@@ -102,7 +151,12 @@ impl<T: Real<Mask = bool>, const M: usize> Visit for At<'_, T, M> {
             let q = self.rest_shape[k];
             DualVec3::<T>::from_f64s(q.x, q.y, q.z)
         });
-        let e = c.evaluate_stored(&p, self.rest, &shape, self.stored);
+        let start: [DualVec3<T>; N] = std::array::from_fn(|k| DualVec3(self.start.0[k]));
+        let moving = SubstepStart {
+            start: &start,
+            h: self.start.1,
+        };
+        let e = c.evaluate_stored(&p, self.rest, &shape, self.stored, moving);
         (e.value, std::array::from_fn(|k| e.gradients[k].to_array()))
     }
 }
@@ -128,8 +182,22 @@ pub fn second_order<const N: usize>(
     families: &Families,
     family: Family,
     x: &[DVec3; N],
+    rest: (f64, &[f64]),
+    rest_shape: &[DVec3; N],
+) -> (f64, [f64; 12], Matrix12) {
+    let at_rest = Some((x, crate::constraint_file::RESTING_H));
+    second_order_moving(families, family, x, rest, rest_shape, at_rest)
+}
+
+/// [`second_order`] with the particles at `start` at the start of the substep of length h
+/// ([`value_and_gradient_moving`]).
+pub fn second_order_moving<const N: usize>(
+    families: &Families,
+    family: Family,
+    x: &[DVec3; N],
     (rest, stored): (f64, &[f64]),
     rest_shape: &[DVec3; N],
+    moving: Option<(&[DVec3; N], f64)>,
 ) -> (f64, [f64; 12], Matrix12) {
     let mut value = 0.0;
     let mut gradient = [0.0; 12];
@@ -138,7 +206,14 @@ pub fn second_order<const N: usize>(
         let seeded: [[Tangent<f64>; 3]; N] = std::array::from_fn(|k| {
             std::array::from_fn(|a| Tangent::new(x[k][a], if 3 * k + a == j { 1.0 } else { 0.0 }))
         });
-        let (c, g) = value_and_gradient(families, family, &seeded, (rest, stored), rest_shape);
+        let (c, g) = value_and_gradient_moving(
+            families,
+            family,
+            &seeded,
+            (rest, stored),
+            rest_shape,
+            moving,
+        );
         value = c.value;
         for (i, gi) in g.iter().flatten().enumerate() {
             gradient[i] = gi.value;

@@ -1,7 +1,7 @@
 //! A constraint file's family as a [`Constraint`]: its compiled tape gives C and ∇C. The file
 //! joins the table of families in [`super::Families`].
 
-use super::{Constraint, Evaluation};
+use super::{Constraint, Evaluation, SubstepStart};
 use super::{GROUP, MAX_STORED, Stored};
 use crate::constraint_file::{ConstraintFile, sound};
 use crate::constraints::material::Material;
@@ -41,6 +41,10 @@ impl<const N: usize> Constraint<N> for FileConstraint<N> {
         self.0.evaluate_vectors(p, rest, &stored)
     }
 
+    fn reads_motion(&self) -> bool {
+        self.0.reads_motion()
+    }
+
     #[inline(always)]
     fn evaluate_stored<V: Vector3>(
         &self,
@@ -48,8 +52,11 @@ impl<const N: usize> Constraint<N> for FileConstraint<N> {
         rest: V::Real,
         _: &[V; N],
         stored: &[V::Real],
+        motion: SubstepStart<'_, V, N>,
     ) -> Evaluation<V, N> {
-        self.0.evaluate_vectors(p, rest, stored)
+        let own = self.0.use_gradient;
+        self.0
+            .evaluate_by_moving(p, (motion.start, motion.h), rest, stored, own)
     }
 
     /// The GROUP batches as one `Block` of lanes through the tape, then each batch's lanes
@@ -63,13 +70,14 @@ impl<const N: usize> Constraint<N> for FileConstraint<N> {
         rest: [F32x8; GROUP],
         _: &[[Vec3x8; N]; GROUP],
         stored: [&[F32x8]; GROUP],
+        motion: (&[[Vec3x8; N]; GROUP], F32x8),
     ) -> [Evaluation<Vec3x8, N>; GROUP] {
         let mut out = [Evaluation {
             value: F32x8::ZERO,
             gradients: [Vec3x8::ZERO; N],
             degenerate: F32x8::ZERO.finite(),
         }; GROUP];
-        through_tape(&self.0, p, (rest, stored), &mut out);
+        through_tape(&self.0, p, (rest, stored), motion, &mut out);
         out
     }
 
@@ -97,9 +105,26 @@ fn through_tape<const N: usize>(
     file: &ConstraintFile,
     p: &[[Vec3x8; N]; GROUP],
     (rest, stored): ([F32x8; GROUP], [&[F32x8]; GROUP]),
+    (start, h): (&[[Vec3x8; N]; GROUP], F32x8),
     out: &mut [Evaluation<Vec3x8, N>; GROUP],
 ) {
     let own = file.use_gradient;
+    // Where the particles were, as blocks of the GROUP batches' lanes (read by the instructions
+    // that name them; the particles again for a file that names none).
+    let mut start_blocks = [[Block::<F32x8, GROUP>::ZERO; 3]; N];
+    if file.reads_motion() {
+        for j in 0..GROUP {
+            for k in 0..N {
+                let v = start[j][k];
+                (
+                    start_blocks[k][0].0[j],
+                    start_blocks[k][1].0[j],
+                    start_blocks[k][2].0[j],
+                ) = (v.x, v.y, v.z);
+            }
+        }
+    }
+    let h = Block([h; GROUP]);
     SCRATCH.with_borrow_mut(|scratch| {
         let slots = file.gradient_slots(own);
         if scratch.len() < slots {
@@ -121,7 +146,7 @@ fn through_tape<const N: usize>(
                 }
             }
         };
-        file.gradient_placed((own, scratch), place, |r| {
+        file.gradient_placed((own, scratch), (&start_blocks, h), place, |r| {
             for j in 0..GROUP {
                 let mut g = [[F32x8::ZERO; 3]; N];
                 for k in 0..N {

@@ -65,6 +65,30 @@ pub const MAX_STORED: usize = 48;
 /// What an element stores ([`Constraint::store`]).
 pub type Stored = arrayvec::ArrayVec<f64, MAX_STORED>;
 
+/// Where a constraint's particles were at the start of the substep, and the substep's length h:
+/// what a constraint on velocities reads besides the particles (a constraint file's `start0`…
+/// and `h`, [`Constraint::reads_motion`]). The solvers gather it only for a family that reads
+/// it; elsewhere (and outside a substep: the metrics, the readers) it is [`SubstepStart::at_rest`].
+#[derive(Clone, Copy, Debug)]
+pub struct SubstepStart<'a, V: Vector3, const N: usize> {
+    /// Each particle at the start of the substep.
+    pub start: &'a [V; N],
+    /// The substep's length in seconds.
+    pub h: V::Real,
+}
+
+impl<'a, V: Vector3, const N: usize> SubstepStart<'a, V, N> {
+    /// No motion: the particles were at `p`, and h is the default substep
+    /// ([`crate::constraint_file::RESTING_H`]).
+    #[inline(always)]
+    pub fn at_rest(p: &'a [V; N]) -> Self {
+        SubstepStart {
+            start: p,
+            h: V::Real::from_f64(crate::constraint_file::RESTING_H),
+        }
+    }
+}
+
 /// A constraint on N particles: C and ∇C at any configuration, in any precision (f64, f32, or
 /// eight constraints at once in SIMD lanes).
 pub trait Constraint<const N: usize>: Sync {
@@ -79,6 +103,13 @@ pub trait Constraint<const N: usize>: Sync {
     /// something per call whatever the lanes (a constraint file's tape pays its dispatch on each
     /// instruction once per call).
     const GROUPED: bool = false;
+
+    /// Whether [`Constraint::evaluate_stored`] reads where the particles were at the start of
+    /// the substep or its h ([`SubstepStart`]): a constraint file that names `start0`… or `h`. The
+    /// solvers gather the start positions only then.
+    fn reads_motion(&self) -> bool {
+        false
+    }
 
     /// C and ∇C at `p`, with rest value `rest` (d, V) and the particles' rest positions
     /// `rest_shape`: the one formula a family must write.
@@ -108,7 +139,8 @@ pub trait Constraint<const N: usize>: Sync {
     }
 
     /// C and ∇C at `p` given what the element stores ([`Constraint::store`], in the precision of
-    /// `V`): what the solvers call. Unless the family stores something, [`Constraint::evaluate`].
+    /// `V`) and the substep's [`SubstepStart`]: what the solvers call. Unless the family stores
+    /// something or reads the motion, [`Constraint::evaluate`].
     #[inline(always)]
     fn evaluate_stored<V: Vector3>(
         &self,
@@ -116,8 +148,9 @@ pub trait Constraint<const N: usize>: Sync {
         rest: V::Real,
         rest_shape: &[V; N],
         stored: &[V::Real],
+        motion: SubstepStart<'_, V, N>,
     ) -> Evaluation<V, N> {
-        let _ = stored;
+        let _ = (stored, motion);
         self.evaluate(p, rest, rest_shape)
     }
 
@@ -132,8 +165,15 @@ pub trait Constraint<const N: usize>: Sync {
         rest: [F32x8; GROUP],
         rest_shape: &[[Vec3x8; N]; GROUP],
         stored: [&[F32x8]; GROUP],
+        (start, h): (&[[Vec3x8; N]; GROUP], F32x8),
     ) -> [Evaluation<Vec3x8, N>; GROUP] {
-        std::array::from_fn(|j| self.evaluate_stored(&p[j], rest[j], &rest_shape[j], stored[j]))
+        std::array::from_fn(|j| {
+            let motion = SubstepStart {
+                start: &start[j],
+                h,
+            };
+            self.evaluate_stored(&p[j], rest[j], &rest_shape[j], stored[j], motion)
+        })
     }
 
     /// What else a reader should see of the constraint's particles at `p` (rest shape

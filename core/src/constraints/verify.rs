@@ -40,6 +40,9 @@ pub struct Worst {
     pub points: Vec<DVec3>,
     /// Its rest shape, for a constraint that reads one (Dm, F, V0); `None` otherwise.
     pub rest_shape: Option<Vec<DVec3>>,
+    /// Where the particles were at the start of the substep, and h, for a constraint that reads
+    /// them (`start0`…, `h`); `None` otherwise.
+    pub moving: Option<(Vec<DVec3>, f64)>,
     /// Its rest value.
     pub rest: f64,
     /// That particle's error: |yours − AD|∞ / maxⱼ |∇ⱼC|; where AD's gradient is zero, the
@@ -227,11 +230,46 @@ pub fn well_conditioned(points: &[DVec3]) -> bool {
     true
 }
 
+/// What a check evaluates C with besides the points: the rest shape, and where the particles were
+/// at the start of the substep and its length h.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Around {
+    /// The rest shape (the points themselves for a constraint that reads none).
+    pub rest_shape: Vec<DVec3>,
+    /// Where the particles were at the start of the substep (the points for a constraint that
+    /// does not read them).
+    pub start: Vec<DVec3>,
+    /// The substep's length.
+    pub h: f64,
+}
+
+impl Around {
+    /// At rest shape `rest_shape`, with no motion: the particles were at `points`, h the default
+    /// substep.
+    pub fn at_rest(points: &[DVec3], rest_shape: &[DVec3]) -> Around {
+        Around {
+            rest_shape: rest_shape.to_vec(),
+            start: points.to_vec(),
+            h: crate::constraint_file::RESTING_H,
+        }
+    }
+
+    /// The motion, as a constraint file reads it.
+    pub fn moving(&self) -> crate::constraint_file::Moving<'_> {
+        crate::constraint_file::Moving {
+            start: &self.start,
+            h: self.h,
+        }
+    }
+}
+
 /// A random configuration of `source`'s particles: uniform in a cube of random size
 /// 10^U(−2, 2) around a random centre; for a source that reads a rest shape (the neo-Hookean
 /// pair's Dm), a rest shape drawn the same way around the same centre, otherwise the points
-/// themselves. Gives the points, the rest shape and the size.
-pub fn draw(rng: &mut SplitMix64, source: &impl GradientSource) -> (Vec<DVec3>, Vec<DVec3>, f64) {
+/// themselves; for one that reads where the particles were at the start of the substep, each
+/// moved from there by up to 0.3 of the size, and h = 10^U(−4, −2). Gives the points, what C
+/// reads besides them, and the size.
+pub fn draw(rng: &mut SplitMix64, source: &impl GradientSource) -> (Vec<DVec3>, Around, f64) {
     let size = 10f64.powf(rng.range(-2.0, 2.0));
     let centre = rng.in_cube(size);
     let mut points = || -> Vec<DVec3> {
@@ -245,7 +283,15 @@ pub fn draw(rng: &mut SplitMix64, source: &impl GradientSource) -> (Vec<DVec3>, 
     } else {
         current.clone()
     };
-    (current, rest_shape, size)
+    let mut around = Around::at_rest(&current, &rest_shape);
+    if source.uses_motion() {
+        around.start = current
+            .iter()
+            .map(|p| *p - rng.in_cube(0.3 * size))
+            .collect();
+        around.h = 10f64.powf(rng.range(-4.0, -2.0));
+    }
+    (current, around, size)
 }
 
 /// What the check needs of a constraint: C, the gradient it gives, and ∇C by forward-mode AD.
@@ -256,15 +302,21 @@ pub trait GradientSource {
     fn arity(&self) -> usize;
     /// Whether C reads a rest shape (then one is drawn beside the points).
     fn uses_rest_shape(&self) -> bool;
-    /// C at `points` with rest value `rest` and rest shape `rest_shape` (NaN where undefined).
-    fn value(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> f64;
+    /// Whether C reads where the particles were at the start of the substep or h (then they are
+    /// drawn beside the points).
+    fn uses_motion(&self) -> bool {
+        false
+    }
+    /// C at `points` with rest value `rest` and the rest shape and motion `around` (NaN where
+    /// undefined).
+    fn value(&self, points: &[DVec3], rest: f64, around: &Around) -> f64;
     /// The gradient the source gives, per particle; `None` for a particle it gives none for.
-    fn given(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Vec<Option<DVec3>>;
+    fn given(&self, points: &[DVec3], rest: f64, around: &Around) -> Vec<Option<DVec3>>;
     /// ∇C by forward-mode AD; `None` where it is undefined.
-    fn automatic(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Option<Vec<DVec3>>;
+    fn automatic(&self, points: &[DVec3], rest: f64, around: &Around) -> Option<Vec<DVec3>>;
     /// A rest value of the size C's own would have at `points` (a file's rest expression where
     /// it gives one, otherwise C with rest value 0).
-    fn natural_rest(&self, points: &[DVec3], rest_shape: &[DVec3]) -> f64;
+    fn natural_rest(&self, points: &[DVec3], around: &Around) -> f64;
 }
 
 /// A family of a table, as the check sees it: C by the family's formula, its analytic gradient,
@@ -286,26 +338,26 @@ impl GradientSource for TableFamily<'_> {
         self.families.row(self.family).reads_rest_shape
     }
 
-    fn value(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> f64 {
+    fn value(&self, points: &[DVec3], rest: f64, around: &Around) -> f64 {
         let constraint = self.families.constraint(self.family);
-        constraint.evaluate(points, rest, rest_shape).value
+        constraint.evaluate(points, rest, &around.rest_shape).value
     }
 
-    fn given(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Vec<Option<DVec3>> {
+    fn given(&self, points: &[DVec3], rest: f64, around: &Around) -> Vec<Option<DVec3>> {
         let constraint = self.families.constraint(self.family);
-        let evaluation = constraint.evaluate(points, rest, rest_shape);
+        let evaluation = constraint.evaluate(points, rest, &around.rest_shape);
         evaluation.gradients[..points.len()]
             .iter()
             .map(|&g| Some(g))
             .collect()
     }
 
-    fn automatic(&self, points: &[DVec3], rest: f64, rest_shape: &[DVec3]) -> Option<Vec<DVec3>> {
-        automatic_gradient(self.families, self.family, points, rest, rest_shape)
+    fn automatic(&self, points: &[DVec3], rest: f64, around: &Around) -> Option<Vec<DVec3>> {
+        automatic_gradient(self.families, self.family, points, rest, &around.rest_shape)
     }
 
-    fn natural_rest(&self, points: &[DVec3], rest_shape: &[DVec3]) -> f64 {
-        self.value(points, 0.0, rest_shape)
+    fn natural_rest(&self, points: &[DVec3], around: &Around) -> f64 {
+        self.value(points, 0.0, around)
     }
 }
 
@@ -342,12 +394,13 @@ pub fn random_check(
     let (mut compared, mut skipped) = (0, 0);
     let (mut max_error, mut sum_error, mut max_automatic) = (0.0_f64, 0.0, 0.0_f64);
     while compared < samples {
-        let (points, rest_shape, _) = draw(&mut rng, &source);
+        let (points, around, _) = draw(&mut rng, &source);
+        let rest_shape = around.rest_shape.clone();
         if !well_conditioned(&points) || !well_conditioned(&rest_shape) {
             skipped += 1;
             continue;
         }
-        let rest = source.natural_rest(&points, &rest_shape) * rng.range(-1.5, 1.5);
+        let rest = source.natural_rest(&points, &around) * rng.range(-1.5, 1.5);
         let (analytic, numeric) =
             analytic_and_numeric(families, family, &points, rest, &rest_shape);
         let error = relative_error(&analytic, &numeric);
@@ -385,7 +438,7 @@ pub fn random_check(
 /// property of C, the size of ∇C itself) stays far above the floor.
 fn rounding_floor<S: GradientSource>(
     source: &S,
-    (points, rest, shape): (&[DVec3], f64, &[DVec3]),
+    (points, rest, around): (&[DVec3], f64, &Around),
     automatic: &[DVec3],
     scale: f64,
 ) -> f64 {
@@ -397,10 +450,15 @@ fn rounding_floor<S: GradientSource>(
     let moved: Vec<DVec3> = points.iter().map(|p| *p + shift).collect();
     // The rest shape too (by another shift): the rounding of what is worked out from it (Dm⁻¹)
     // is as much the configuration's as that of the points.
-    let reshaped: Vec<DVec3> = shape
-        .iter()
-        .map(|p| *p + DVec3::new(shift.z, shift.x, shift.y))
-        .collect();
+    let reshaped = Around {
+        rest_shape: around
+            .rest_shape
+            .iter()
+            .map(|p| *p + DVec3::new(shift.z, shift.x, shift.y))
+            .collect(),
+        start: around.start.iter().map(|p| *p + shift).collect(),
+        h: around.h,
+    };
     let noise = match source.automatic(&moved, rest, &reshaped) {
         Some(again) => max_abs_error(&again, automatic) / scale,
         None => 0.0,
@@ -440,7 +498,7 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
     while report.compared < configs && attempts < configs.saturating_mul(100).max(1000) {
         attempts += 1;
         let (points, shape, size) = draw(&mut rng, source);
-        if !well_conditioned(&points) || !well_conditioned(&shape) {
+        if !well_conditioned(&points) || !well_conditioned(&shape.rest_shape) {
             report.skipped += 1;
             continue;
         }
@@ -501,7 +559,8 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
                 report.worst = Some(Worst {
                     particle: k,
                     points: points.clone(),
-                    rest_shape: source.uses_rest_shape().then(|| shape.clone()),
+                    rest_shape: source.uses_rest_shape().then(|| shape.rest_shape.clone()),
+                    moving: source.uses_motion().then(|| (shape.start.clone(), shape.h)),
                     rest,
                     relative_error: error,
                     absolute: scale == 0.0,
@@ -542,8 +601,9 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
     };
     for points in near_degenerate(arity, &mut rng, 200) {
         report.near_degenerate += 1;
-        let value = source.value(&points, 0.0, &points);
-        if !value.is_finite() || source.automatic(&points, 0.0, &points).is_none() {
+        let around = Around::at_rest(&points, &points);
+        let value = source.value(&points, 0.0, &around);
+        if !value.is_finite() || source.automatic(&points, 0.0, &around).is_none() {
             report.undefined += 1;
         }
     }

@@ -4,7 +4,7 @@
 //! family alone, or the two of a pair as one constraint of two values, [`Projected`], [`Pair`]).
 //! The dispatch itself is [`super::Families::visit`] and [`super::Families::visit_unit`].
 
-use super::{Constraint, Evaluation, Family, GROUP};
+use super::{Constraint, Evaluation, Family, GROUP, SubstepStart};
 use crate::numbers::lanes::{F32x8, Vec3x8};
 use crate::numbers::vector::Vector3;
 
@@ -36,6 +36,10 @@ pub trait Projected<const N: usize, const K: usize>: Sync {
     /// ([`Projected::evaluate_batches`]).
     const GROUPED: bool;
 
+    /// Whether any of the `K` reads where the particles were at the start of the substep or its
+    /// h ([`Constraint::reads_motion`]): the solvers gather the start positions only then.
+    fn reads_motion(&self) -> bool;
+
     /// C and ∇C of each of the `K` constraints at `p`, each with its rest value and what its
     /// element stores.
     fn evaluate_stored<V: Vector3>(
@@ -44,6 +48,7 @@ pub trait Projected<const N: usize, const K: usize>: Sync {
         rest: [V::Real; K],
         rest_shape: &[V; N],
         stored: [&[V::Real]; K],
+        motion: SubstepStart<'_, V, N>,
     ) -> [Evaluation<V, N>; K];
 
     /// [`Projected::evaluate_stored`] of [`GROUP`] batches of lanes at once: value k of batch j
@@ -54,12 +59,17 @@ pub trait Projected<const N: usize, const K: usize>: Sync {
         rest: [[F32x8; GROUP]; K],
         rest_shape: &[[Vec3x8; N]; GROUP],
         stored: [[&[F32x8]; GROUP]; K],
+        motion: (&[[Vec3x8; N]; GROUP], F32x8),
     ) -> [[Evaluation<Vec3x8, N>; GROUP]; K];
 }
 
 impl<const N: usize, C: Constraint<N>> Projected<N, 1> for C {
     const READS_REST_SHAPE: bool = C::STORED_USES_REST_SHAPE;
     const GROUPED: bool = C::GROUPED;
+
+    fn reads_motion(&self) -> bool {
+        Constraint::reads_motion(self)
+    }
 
     #[inline(always)]
     fn evaluate_stored<V: Vector3>(
@@ -68,9 +78,10 @@ impl<const N: usize, C: Constraint<N>> Projected<N, 1> for C {
         [rest]: [V::Real; 1],
         rest_shape: &[V; N],
         [stored]: [&[V::Real]; 1],
+        motion: SubstepStart<'_, V, N>,
     ) -> [Evaluation<V, N>; 1] {
         [Constraint::evaluate_stored(
-            self, p, rest, rest_shape, stored,
+            self, p, rest, rest_shape, stored, motion,
         )]
     }
 
@@ -81,9 +92,10 @@ impl<const N: usize, C: Constraint<N>> Projected<N, 1> for C {
         [rest]: [[F32x8; GROUP]; 1],
         rest_shape: &[[Vec3x8; N]; GROUP],
         [stored]: [[&[F32x8]; GROUP]; 1],
+        motion: (&[[Vec3x8; N]; GROUP], F32x8),
     ) -> [[Evaluation<Vec3x8, N>; GROUP]; 1] {
         [Constraint::evaluate_batches(
-            self, p, rest, rest_shape, stored,
+            self, p, rest, rest_shape, stored, motion,
         )]
     }
 }
@@ -95,6 +107,10 @@ impl<const N: usize, A: Constraint<N>, B: Constraint<N>> Projected<N, 2> for Pai
     const READS_REST_SHAPE: bool = A::STORED_USES_REST_SHAPE || B::STORED_USES_REST_SHAPE;
     const GROUPED: bool = A::GROUPED && B::GROUPED;
 
+    fn reads_motion(&self) -> bool {
+        self.0.reads_motion() || self.1.reads_motion()
+    }
+
     #[inline(always)]
     fn evaluate_stored<V: Vector3>(
         &self,
@@ -102,10 +118,13 @@ impl<const N: usize, A: Constraint<N>, B: Constraint<N>> Projected<N, 2> for Pai
         [rest_a, rest_b]: [V::Real; 2],
         rest_shape: &[V; N],
         [stored_a, stored_b]: [&[V::Real]; 2],
+        motion: SubstepStart<'_, V, N>,
     ) -> [Evaluation<V, N>; 2] {
         [
-            self.0.evaluate_stored(p, rest_a, rest_shape, stored_a),
-            self.1.evaluate_stored(p, rest_b, rest_shape, stored_b),
+            self.0
+                .evaluate_stored(p, rest_a, rest_shape, stored_a, motion),
+            self.1
+                .evaluate_stored(p, rest_b, rest_shape, stored_b, motion),
         ]
     }
 
@@ -116,10 +135,13 @@ impl<const N: usize, A: Constraint<N>, B: Constraint<N>> Projected<N, 2> for Pai
         [rest_a, rest_b]: [[F32x8; GROUP]; 2],
         rest_shape: &[[Vec3x8; N]; GROUP],
         [stored_a, stored_b]: [[&[F32x8]; GROUP]; 2],
+        motion: (&[[Vec3x8; N]; GROUP], F32x8),
     ) -> [[Evaluation<Vec3x8, N>; GROUP]; 2] {
         [
-            self.0.evaluate_batches(p, rest_a, rest_shape, stored_a),
-            self.1.evaluate_batches(p, rest_b, rest_shape, stored_b),
+            self.0
+                .evaluate_batches(p, rest_a, rest_shape, stored_a, motion),
+            self.1
+                .evaluate_batches(p, rest_b, rest_shape, stored_b, motion),
         ]
     }
 }

@@ -5,7 +5,7 @@
 //! block by block.
 
 use crate::constraint_file::ConstraintFile;
-use crate::constraints::differentiable::value_and_gradient as constraint;
+use crate::constraints::differentiable::value_and_gradient_moving;
 use crate::constraints::material::Material;
 use crate::constraints::verify::{TableFamily, draw, well_conditioned};
 use crate::constraints::{Families, Family};
@@ -52,12 +52,25 @@ fn forward<const N: usize>(
     let mut h = DMatrix::zeros(n, n);
     for j in 0..n {
         let p = seed_one(&x.map(|q| q.to_array()), j);
-        let (_, g) = constraint(families, family, &p, (rest, stored), shape);
+        let (_, g) = constraint(families, family, &p, (rest, stored), (shape, x));
         for i in 0..n {
             h[(i, j)] = g[i / 3][i % 3].slope;
         }
     }
     h
+}
+
+/// C and ∇C of one constraint at the dual numbers `p`, at rest: where the particles were at the
+/// start of the substep is `x` itself (their values, not differentiated by), h the default.
+fn constraint<T: crate::numbers::vector::Real<Mask = bool>, const N: usize>(
+    families: &Families,
+    family: Family,
+    p: &[[T; 3]; N],
+    rest: (f64, &[f64]),
+    (shape, x): (&[DVec3; N], &[DVec3; N]),
+) -> (T, [[T; 3]; N]) {
+    let start = Some((x, crate::constraint_file::RESTING_H));
+    value_and_gradient_moving(families, family, p, rest, shape, start)
 }
 
 /// ∇²C by dual numbers of dual numbers on C alone.
@@ -71,25 +84,27 @@ fn second_order<const N: usize>(
     let n = 3 * N;
     DMatrix::from_fn(n, n, |i, j| {
         let p = seed_two(&x.map(|q| q.to_array()), i, j);
-        constraint(families, family, &p, (rest, stored), shape)
+        constraint(families, family, &p, (rest, stored), (shape, x))
             .0
             .slope
             .slope
     })
 }
 
-/// ∇C by forward mode over C alone.
+/// ∇C by forward mode over C alone, at `x`, the particles having been at `start` (held there
+/// while `x` moves for a difference quotient).
 fn gradient<const N: usize>(
     families: &Families,
     family: Family,
     x: &[DVec3; N],
     (rest, stored): (f64, &[f64]),
     shape: &[DVec3; N],
+    start: &[DVec3; N],
 ) -> Vec<f64> {
     (0..3 * N)
         .map(|j| {
             let p = seed_one(&x.map(|q| q.to_array()), j);
-            constraint(families, family, &p, (rest, stored), shape)
+            constraint(families, family, &p, (rest, stored), (shape, start))
                 .0
                 .slope
         })
@@ -137,13 +152,13 @@ fn check_on<const N: usize>(
     let mut tries = 0;
     while report.compared < wanted && tries < 20 * wanted + 100 {
         tries += 1;
-        let (points, shape, size) = draw(&mut rng, &source);
-        if !well_conditioned(&points) || !well_conditioned(&shape) {
+        let (points, around, size) = draw(&mut rng, &source);
+        if !well_conditioned(&points) || !well_conditioned(&around.rest_shape) {
             continue;
         }
         let x: [DVec3; N] = std::array::from_fn(|k| points[k]);
-        let shape: [DVec3; N] = std::array::from_fn(|k| shape[k]);
-        let rest = source.natural_rest(&points, &shape);
+        let shape: [DVec3; N] = std::array::from_fn(|k| around.rest_shape[k]);
+        let rest = source.natural_rest(&points, &around);
         let stored = families.constraint(family).store(&shape, &material);
         let at = (rest, &stored[..]);
         let h = forward(families, family, &x, at, &shape);
@@ -158,8 +173,8 @@ fn check_on<const N: usize>(
             plus[j / 3][j % 3] += step;
             minus[j / 3][j % 3] -= step;
             let (a, b) = (
-                gradient(families, family, &plus, at, &shape),
-                gradient(families, family, &minus, at, &shape),
+                gradient(families, family, &plus, at, &shape, &x),
+                gradient(families, family, &minus, at, &shape, &x),
             );
             for i in 0..3 * N {
                 fd[(i, j)] = (a[i] - b[i]) / (2.0 * step);

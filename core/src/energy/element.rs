@@ -62,8 +62,10 @@ pub struct ElementEnergy {
 
 impl ElementEnergy {
     /// The energy of the `active` families of `families` on a tet at rest at `rest_shape`, with
-    /// the compliances and material of `settings`. An error when none of them has a constraint
-    /// on a tet (no family is active).
+    /// the compliances and material of `settings`. A family that reads where its particles were
+    /// at the start of the substep (a damper: `start0`…, `h`) is left out: its ½ C² / α is a
+    /// potential of the motion, not an energy of the positions alone. An error when no family
+    /// with an energy has a constraint on a tet.
     pub fn new(
         families: &Families,
         active: &PerFamily<bool>,
@@ -77,7 +79,8 @@ impl ElementEnergy {
         let material = &settings.material;
         let mut terms = Vec::new();
         let mut compliances = Vec::new();
-        for family in families.all().filter(|&f| active[f]) {
+        let of_positions = |f: Family| !families.file(f).is_some_and(|file| file.reads_motion());
+        for family in families.all().filter(|&f| active[f] && of_positions(f)) {
             let compliance = match families.row(family).compliance_from_material {
                 Some(from) => Compliance::Given(from(material)),
                 None if settings.compliance[family] > 0.0 => {
@@ -106,7 +109,9 @@ impl ElementEnergy {
         }
         if terms.is_empty() {
             return Err(
-                "no family is active: name one (--constraints or --constraint-file)".into(),
+                "no family with an energy of the positions is active: name one \
+                        (--constraints or --constraint-file; a damper's has none)"
+                    .into(),
             );
         }
         Ok(ElementEnergy {

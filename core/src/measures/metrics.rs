@@ -4,7 +4,7 @@
 //! nothing that is not a number is ever printed, plotted or recorded.
 
 use crate::constraints::volume::signed_volume;
-use crate::constraints::{Constraint, Families, Family, PerFamily, Visit};
+use crate::constraints::{Constraint, Families, Family, PerFamily, SubstepStart, Visit};
 use crate::simulation::divergence::{Cause, Divergence};
 use crate::simulation::{ConstraintSet, Simulation};
 use glam::DVec3;
@@ -187,8 +187,15 @@ impl Visit for Rms<'_> {
                 let idx: [u32; N] = std::array::from_fn(|k| set.particles(c)[k]);
                 let p = idx.map(|i| self.positions[i as usize]);
                 let shape = idx.map(|i| self.rest_positions[i as usize]);
+                // Outside a substep: a constraint on velocities is measured at rest.
                 constraint
-                    .evaluate_stored(&p, set.rest()[c], &shape, set.stored(c))
+                    .evaluate_stored(
+                        &p,
+                        set.rest()[c],
+                        &shape,
+                        set.stored(c),
+                        SubstepStart::at_rest(&p),
+                    )
                     .value
                     .powi(2)
             })

@@ -107,6 +107,11 @@ impl<T: Real> Real for Tangent<T> {
     fn from_f64(x: f64) -> Self {
         Tangent::new(T::from_f64(x), T::ZERO)
     }
+    /// The value, itself without slopes, and slope 0.
+    #[inline]
+    fn constant(self) -> Self {
+        Tangent::new(self.value.constant(), T::ZERO)
+    }
     /// The value's SVD with the exact derivatives of U, σ and V ([`svd3`]).
     #[inline]
     fn signed_svd(f: Columns<Self>) -> Svd<Self> {

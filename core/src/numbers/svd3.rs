@@ -25,7 +25,7 @@
 //! what is symmetric in σ (their sum, their product) is smooth, and its derivative above is exact
 //! there because it does not depend on which basis of the pair's plane was picked.
 //!
-//! The polar rotation is smoother: dR = R [w]ₓ, where (tr S · I − S) w = vee(Rᵀ dF − dFᵀ R).
+//! The polar rotation is smoother: dR = R \[w\]ₓ, where (tr S · I − S) w = vee(Rᵀ dF − dFᵀ R).
 //! It is finite at repeated singular values (at F = I, dR is dF's antisymmetric part) and fails
 //! only where σᵢ + σⱼ = 0, an inverted F whose two smallest |σ| are equal: there R jumps
 //! between rotations and no derivative exists.
@@ -191,7 +191,7 @@ pub(crate) fn svd_of_tangents<T: Real>(f: Columns<Tangent<T>>) -> Svd<Tangent<T>
     }
 }
 
-/// The polar rotation of a matrix of dual numbers: the value's, and dR = R [w]ₓ with
+/// The polar rotation of a matrix of dual numbers: the value's, and dR = R \[w\]ₓ with
 /// (tr S · I − S) w = vee(Rᵀ dF − dFᵀ R), S = Rᵀ F (the module's documentation).
 pub(crate) fn polar_of_tangents<T: Real>(f: Columns<Tangent<T>>) -> Columns<Tangent<T>> {
     let (value, slope) = parts(f);
@@ -199,7 +199,7 @@ pub(crate) fn polar_of_tangents<T: Real>(f: Columns<Tangent<T>>) -> Columns<Tang
     join(r, polar_slope(r, value, slope))
 }
 
-/// dR of the polar rotation R of F along dF: R [w]ₓ, (tr S · I − S) w = vee(Rᵀ dF − dFᵀ R).
+/// dR of the polar rotation R of F along dF: R \[w\]ₓ, (tr S · I − S) w = vee(Rᵀ dF − dFᵀ R).
 fn polar_slope<T: Real>(r: Columns<T>, f: Columns<T>, df: Columns<T>) -> Columns<T> {
     let s = transpose_mul(r, f);
     let trace = s[0][0] + s[1][1] + s[2][2];

@@ -92,6 +92,12 @@ pub trait Real:
     fn acos(self) -> Self;
     /// The real cube root.
     fn cbrt(self) -> Self;
+    /// The number with nothing of a derivative: a dual number's slopes dropped (at every level),
+    /// the number itself otherwise. What holds a value fixed while others are differentiated.
+    #[inline]
+    fn constant(self) -> Self {
+        self
+    }
     /// The signed singular value decomposition of the matrix of columns `f`: F = U diag(σ) Vᵀ
     /// with U and V rotations and σ₂ negative where det F is ([`svd3`]). Dual numbers give its
     /// exact derivative rather than the iteration's.

@@ -169,12 +169,14 @@ impl<R: Fn(Family) -> Rule<f64>> VisitProjected for Describe<'_, R> {
         );
         let rules = families.map(&self.rule);
         let reach = simulation.settings.reach;
+        let h = simulation.settings.dt / f64::from(simulation.settings.substeps);
         let unit = project_unit(
             constraint,
             families,
             &body.sets,
             &state.lambdas,
             arrays,
+            (&state.previous, h),
             rules,
             reach,
             c,

@@ -10,7 +10,7 @@ use super::projection::{Correction, Rule, SkipCounts, correct_in_reach};
 use super::state::{Body, State};
 use super::substep::{self, GrabbedParticle, Plan, Substeps};
 use crate::constraints::{
-    Evaluation, Families, Family, PerFamily, Projected, Unit, VisitProjected,
+    Evaluation, Families, Family, PerFamily, Projected, SubstepStart, Unit, VisitProjected,
 };
 use glam::DVec3;
 
@@ -88,6 +88,7 @@ impl<'a> OnState<'a> {
             positions: &mut self.state.positions,
             rest_positions: &self.body.rest_positions,
             inverse_masses: &self.state.inverse_masses,
+            previous: (&self.state.previous, plan.h),
             rules: &plan.rules,
             which,
             skipped: &mut self.skipped,
@@ -240,6 +241,7 @@ pub(super) fn project_unit<const N: usize, const K: usize, P: Projected<N, K>>(
     sets: &PerFamily<ConstraintSet>,
     lambdas: &PerFamily<Vec<f64>>,
     (positions, rest_positions, inverse_masses): (&[DVec3], &[DVec3], &[f64]),
+    (previous, h): (&[DVec3], f64),
     rules: [Rule<f64>; K],
     reach: f64,
     c: usize,
@@ -254,7 +256,14 @@ pub(super) fn project_unit<const N: usize, const K: usize, P: Projected<N, K>>(
     };
     let rest = families.map(|f| sets[f].rest()[c]);
     let stored = families.map(|f| sets[f].stored(c));
-    let evaluations = constraint.evaluate_stored(&p, rest, &shape, stored);
+    // Where the particles were at the start of the substep, for a family that reads it.
+    let start = if constraint.reads_motion() {
+        particles.map(|i| previous[i as usize])
+    } else {
+        p
+    };
+    let motion = SubstepStart { start: &start, h };
+    let evaluations = constraint.evaluate_stored(&p, rest, &shape, stored, motion);
     let weights = particles.map(|i| inverse_masses[i as usize]);
     let lambda = families.map(|f| lambdas[f][c]);
     let size = (reach, lead.size()[c]);
@@ -276,6 +285,8 @@ struct Sweep<'a> {
     positions: &'a mut [DVec3],
     rest_positions: &'a [DVec3],
     inverse_masses: &'a [f64],
+    /// Where the particles were at the start of the substep, and h.
+    previous: (&'a [DVec3], f64),
     rules: &'a PerFamily<Rule<f64>>,
     which: Which,
     skipped: &'a mut PerFamily<SkipCounts>,
@@ -302,6 +313,7 @@ impl VisitProjected for Sweep<'_> {
                 self.sets,
                 self.lambdas,
                 arrays,
+                self.previous,
                 rules,
                 self.reach,
                 c,

@@ -2,7 +2,7 @@
 //! constraint file with a built-in family evaluate at each constraint.
 
 use glam::{DVec3, Vec3};
-use tetlab_core::constraints::{Constraint, Family, Visit};
+use tetlab_core::constraints::{Constraint, Family, SubstepStart, Visit};
 
 /// One constraint: its points, rest value, rest shape and what its element stores (empty for a
 /// family that stores nothing).
@@ -21,15 +21,17 @@ impl Visit for Both<'_> {
     fn visit<const N: usize, C: Constraint<N>>(self, _: Family, c: &C) -> Self::Output {
         let p: [DVec3; N] = std::array::from_fn(|k| self.points[k]);
         let q: [DVec3; N] = std::array::from_fn(|k| self.shape[k]);
-        let e = c.evaluate_stored(&p, self.rest, &q, self.stored);
+        let e = c.evaluate_stored(&p, self.rest, &q, self.stored, SubstepStart::at_rest(&p));
         let mut g64 = [DVec3::ZERO; 4];
         g64[..N].copy_from_slice(&e.gradients);
         let stored32: Vec<f32> = self.stored.iter().map(|&x| x as f32).collect();
+        let p32 = p.map(|v| v.as_vec3());
         let e32 = c.evaluate_stored(
-            &p.map(|v| v.as_vec3()),
+            &p32,
             self.rest as f32,
             &q.map(|v| v.as_vec3()),
             &stored32,
+            SubstepStart::at_rest(&p32),
         );
         let mut g32 = [DVec3::ZERO; 4];
         for (g, v) in g32.iter_mut().zip(e32.gradients.iter()) {

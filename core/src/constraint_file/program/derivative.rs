@@ -142,6 +142,8 @@ impl Rule<'_> {
             | Op::Rest
             | Op::Sign(_)
             | Op::RestParticle(_)
+            | Op::Start(_)
+            | Op::Step
             | Op::Material(_)
             | Op::Particle(_) => {}
             Op::NegS(a) => self.subtract(a, s)?,
@@ -327,8 +329,8 @@ impl Rule<'_> {
     }
 
     /// r = column k of F's polar rotation R: with a = Rᵀ r̄, R̄ = r̄ eₖᵀ gives
-    /// vee(RᵀR̄ − R̄ᵀR) = eₖ × a, and F̄ += R [y]ₓ with (tr S · I − S) y = eₖ × a, S = Rᵀ F
-    /// (`numbers::svd3`: ⟨R̄, dR⟩ = ⟨R [y]ₓ, dF⟩). Not finite where two singular values sum to
+    /// vee(RᵀR̄ − R̄ᵀR) = eₖ × a, and F̄ += R \[y\]ₓ with (tr S · I − S) y = eₖ × a, S = Rᵀ F
+    /// (`numbers::svd3`: ⟨R̄, dR⟩ = ⟨R \[y\]ₓ, dF⟩). Not finite where two singular values sum to
     /// zero, where R has no derivative.
     fn polar_column(&mut self, f: [Reg; 3], k: u8) -> Result<(), CompileError> {
         if !f.iter().any(|&c| self.varies[c as usize]) {

@@ -1,6 +1,7 @@
 //! The names a file may use without defining them ([`GIVEN_NAMES`]), compiled when first used:
-//! the rest positions, the material, the identity, and what a tet or a surface triangle is at
-//! rest and now (`Dm`, `Ds`, `F`, `V0`, `A0`).
+//! the rest positions, where the particles were at the start of the substep and its length h,
+//! the material, the identity, and what a tet or a surface triangle is at rest and now (`Dm`,
+//! `Ds`, `F`, `V0`, `A0`).
 //!
 //! # A triangle's F
 //! A surface triangle's rest edges e₁ = q1 − q0 and e₂ = q2 − q0 are written in the triangle's
@@ -16,8 +17,13 @@ use crate::constraint_file::expression::Span;
 
 /// Names a program knows without a definition, made when first used: the rest shape, the
 /// material and the identity. `(name, what it is)`.
-pub(crate) const GIVEN_NAMES: [(&str, &str); 10] = [
+pub(crate) const GIVEN_NAMES: [(&str, &str); 12] = [
     ("q0", "the rest position of p0 (q1, q2, q3 likewise)"),
+    (
+        "start0",
+        "where p0 was at the start of the substep (start1, start2, start3 likewise)",
+    ),
+    ("h", "the substep's length in seconds"),
     (
         "Dm",
         "the rest edges [q1 - q0, q2 - q0, q3 - q0] as columns (a triangle's: 2 × 2, in its own frame)",
@@ -65,6 +71,21 @@ impl Program {
                 span,
                 "a rest position",
             )?)));
+        }
+        let start = name
+            .strip_prefix("start")
+            .filter(|k| k.len() == 1)
+            .and_then(|k| k.parse::<usize>().ok())
+            .filter(|&k| k < self.arity);
+        if let Some(k) = start {
+            return Ok(Some(Value::vector(self.emit(
+                Op::Start(k as u8),
+                span,
+                "a position at the start of the substep",
+            )?)));
+        }
+        if name == "h" {
+            return Ok(Some(Value::scalar(self.emit(Op::Step, span, "h")?)));
         }
         let material = ["mu", "lambda", "gamma"].iter().position(|&m| m == name);
         if let Some(k) = material {

@@ -45,6 +45,7 @@ mod tape;
 
 use expressions::FUNCTIONS;
 pub(super) use given::GIVEN_NAMES;
+pub use op::RESTING_H;
 pub(super) use op::{Inputs, MAX_REGISTERS, MAX_STORED, MAX_WRITTEN};
 use tape::InputLayout;
 pub(super) use tape::{Registers, Tape};
@@ -222,9 +223,14 @@ impl Program {
         name_span: Span,
         expr: &Expr,
     ) -> Result<(), CompileError> {
-        let given = GIVEN_NAMES
-            .iter()
-            .find(|g| g.0 == name || (name.len() == 2 && name.starts_with('q') && g.0 == "q0"));
+        // q1 is q0's kind, start2 start0's.
+        let numbered = |prefix: &str| {
+            name.strip_prefix(prefix)
+                .is_some_and(|k| k.len() == 1 && k.parse::<usize>().is_ok())
+        };
+        let given = GIVEN_NAMES.iter().find(|g| {
+            g.0 == name || (numbered("q") && g.0 == "q0") || (numbered("start") && g.0 == "start0")
+        });
         if self.names.contains_key(name) || FUNCTIONS.iter().any(|f| f.0 == name) {
             return Err(CompileError {
                 span: name_span,
@@ -444,7 +450,7 @@ impl Program {
         let depends = match op {
             Op::Const(_) | Op::ConstVector(_) => Depends::Nothing,
             Op::RestParticle(_) | Op::Material(_) => Depends::Element,
-            Op::Particle(_) | Op::Rest => Depends::Projection,
+            Op::Particle(_) | Op::Rest | Op::Start(_) | Op::Step => Depends::Projection,
             _ => op
                 .inputs()
                 .iter()

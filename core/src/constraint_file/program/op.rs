@@ -36,6 +36,10 @@ pub(super) enum Op {
     Particle(u8),
     /// A particle's rest position.
     RestParticle(u8),
+    /// A particle's position at the start of the substep.
+    Start(u8),
+    /// The substep's length h.
+    Step,
     /// μ, λ or γ = 1 + μ/λ of the material.
     Material(u8),
     Rest,
@@ -127,7 +131,7 @@ impl Op {
         use Op::*;
         match self {
             Const(_) | ConstVector(_) | Particle(_) | RestParticle(_) | Material(_) | Rest
-            | Written => self,
+            | Start(_) | Step | Written => self,
             NegS(a) => NegS(f(a)),
             NegV(a) => NegV(f(a)),
             Length(a) => Length(f(a)),
@@ -212,6 +216,7 @@ impl Op {
             self,
             Op::Particle(_)
                 | Op::RestParticle(_)
+                | Op::Start(_)
                 | Op::NegV(_)
                 | Op::AddV(..)
                 | Op::SubV(..)
@@ -276,6 +281,8 @@ impl Op {
             Op::ConstVector(x) => vector!(x.map(T::from_f64)),
             Op::Particle(k) => vector!(inputs.points[k as usize]),
             Op::RestParticle(k) => vector!(inputs.shape[k as usize]),
+            Op::Start(k) => vector!(inputs.start[k as usize]),
+            Op::Step => scalar!(inputs.h),
             Op::Material(k) => scalar!(inputs.material[k as usize]),
             Op::Rest => scalar!(inputs.rest),
             Op::NegS(a) => scalar!(-s!(a)),
@@ -365,14 +372,24 @@ impl Op {
     }
 }
 
-/// What a tape reads besides its instructions: the particles, their rest positions, the rest
-/// value, the material (μ, λ, γ) and the numbers stored for the element.
+/// h where no substep gives one (the check, a reader of the rest state): the default substep,
+/// 1/60 s over 100 substeps (`core/tests/constraint_language.rs` checks it against the defaults).
+pub const RESTING_H: f64 = 1.0 / 6000.0;
+
+/// What a tape reads besides its instructions: the particles, their rest positions, where they
+/// were at the start of the substep and its length h, the rest value, the material (μ, λ, γ) and
+/// the numbers stored for the element.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Inputs<'a, T> {
     /// p0, p1, …
     pub points: &'a [[T; 3]],
     /// q0, q1, …: the rest positions (the points again, for a tape that reads none).
     pub shape: &'a [[T; 3]],
+    /// start0, start1, …: the positions at the start of the substep (the points again where no
+    /// substep gives them).
+    pub start: &'a [[T; 3]],
+    /// `h`, the substep's length in seconds ([`RESTING_H`] where no substep gives one).
+    pub h: T,
     /// `rest`.
     pub rest: T,
     /// μ, λ and γ = 1 + μ/λ.
@@ -382,11 +399,14 @@ pub(crate) struct Inputs<'a, T> {
 }
 
 impl<'a, T: Real> Inputs<'a, T> {
-    /// The inputs of a tape that reads only the particles and `rest`.
+    /// The inputs of a tape that reads only the particles and `rest`: at rest (the particles
+    /// where they were at the start of the substep, h = [`RESTING_H`]).
     pub(crate) fn of(points: &'a [[T; 3]], rest: T) -> Self {
         Inputs {
             points,
             shape: points,
+            start: points,
+            h: T::from_f64(RESTING_H),
             rest,
             material: [T::ZERO; 3],
             stored: &[],

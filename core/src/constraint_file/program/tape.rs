@@ -189,6 +189,13 @@ impl Tape {
         self.ops.iter().any(|op| matches!(op, Op::RestParticle(_)))
     }
 
+    /// Whether it reads where the particles were at the start of the substep or h.
+    pub(crate) fn reads_motion(&self) -> bool {
+        self.ops
+            .iter()
+            .any(|op| matches!(op, Op::Start(_) | Op::Step))
+    }
+
     /// How many numbers its registers are, inputs included: what [`Tape::run_in`]'s slice must
     /// hold.
     pub(crate) fn slots(&self) -> usize {
@@ -243,6 +250,7 @@ impl Tape {
     pub(crate) fn run_placed<T: Real, R>(
         &self,
         r: &mut [T],
+        (start, h): (&[[T; 3]], T),
         place: impl FnOnce(&mut [T], &[u8]),
         read: impl FnOnce(&Registers<'_, T>) -> R,
     ) -> R {
@@ -252,7 +260,11 @@ impl Tape {
         );
         place(r, &self.loads);
         self.load_constants(r);
-        let none = Inputs::of(&[], T::ZERO);
+        let none = Inputs {
+            start,
+            h,
+            ..Inputs::of(&[], T::ZERO)
+        };
         for (op, &at) in self.ops.iter().zip(&self.starts) {
             op.apply(r, at as usize, &none);
         }

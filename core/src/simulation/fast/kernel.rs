@@ -10,7 +10,7 @@ use super::batches::{Batches, Layout, RestRows, Typed};
 use super::particles::Particles;
 use super::schedule::sweep;
 use super::team::Team;
-use crate::constraints::{GROUP, Projected};
+use crate::constraints::{GROUP, Projected, SubstepStart};
 use crate::numbers::lanes::{F32x8, LANES, Vec3x8};
 use crate::numbers::vector::{Real, Vector3};
 use crate::simulation::projection::{Rule, SkipCounts, correct_in_reach};
@@ -56,6 +56,9 @@ fn scatter_add(positions: Particles, indices: [u32; LANES], delta: Vec3x8) {
 struct Access<'a> {
     read: Particles<'a>,
     rest_shape: Particles<'a>,
+    /// Where the particles were at the start of the substep, and h: gathered only for a family
+    /// that reads them ([`Projected::reads_motion`]).
+    start: (Particles<'a>, F32x8),
     /// The Jacobi sums, when projecting in Jacobi order.
     sums: Option<Particles<'a>>,
 }
@@ -76,6 +79,7 @@ fn project_batches<const N: usize, const K: usize, P: Projected<N, K>>(
     rules: [Rule<F32x8>; K],
 ) -> [SkipCounts; K] {
     let mut skips = [SkipCounts::default(); K];
+    let moving = constraint.reads_motion();
     let read = access.read;
     let write = access.sums.unwrap_or(read);
     // A macro rather than a closure, so that the correction is inlined at both of its places
@@ -107,12 +111,18 @@ fn project_batches<const N: usize, const K: usize, P: Projected<N, K>>(
         // writing any changes nothing.
         while b + GROUP <= particles.len() {
             let (p, shape) = gather_group((access, P::READS_REST_SHAPE), particles, b);
+            let start = if moving {
+                std::array::from_fn(|j| gather_batch(access.start.0, &particles[b + j]))
+            } else {
+                p
+            };
             let rows = rest.map(|rest| rest.group(b));
             let evaluations = constraint.evaluate_batches(
                 &p,
                 rows.map(|(rest, _)| rest),
                 &shape,
                 rows.map(|(_, stored)| stored),
+                (&start, access.start.1),
             );
             // Batch j's values are column j of the K rows.
             #[allow(clippy::needless_range_loop)]
@@ -135,11 +145,20 @@ fn project_batches<const N: usize, const K: usize, P: Projected<N, K>>(
         } else {
             p
         };
+        let start = if moving {
+            gather_batch(access.start.0, &particles[b])
+        } else {
+            p
+        };
         let evaluations = constraint.evaluate_stored(
             &p,
             rows.map(|(rest, _)| rest),
             &shape,
             rows.map(|(_, stored)| stored),
+            SubstepStart {
+                start: &start,
+                h: access.start.1,
+            },
         );
         project!(b, evaluations);
         b += 1;
@@ -182,7 +201,7 @@ pub(crate) fn project<const N: usize, const K: usize, P: Projected<N, K>>(
     order: &[u32],
     batches: [&mut Batches; K],
     (positions, residuals): (&mut [Vec3A], &mut [Vec3A]),
-    rest_positions: &mut [Vec3A],
+    (rest_positions, (previous, h)): (&mut [Vec3A], (&mut [Vec3A], f64)),
     sums: Option<&mut [Vec3A]>,
     (rules, reach): ([Rule<f64>; K], f64),
     team: Option<&Team>,
@@ -202,6 +221,7 @@ pub(crate) fn project<const N: usize, const K: usize, P: Projected<N, K>>(
     let access = Access {
         read: Particles::compensated(positions, residuals, particle_count),
         rest_shape: Particles::new(rest_positions, particle_count),
+        start: (Particles::new(previous, particle_count), F32x8::from_f64(h)),
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let skips = sweep(layout, order, team, lambdas, |range, lambdas| {

@@ -3,7 +3,7 @@
 //! soundness, its memory, and the timings `tetlab bench` reports.
 
 use super::{Batches, FamilyBatches, FastSimulation, POSITION_LIMIT, Team, Timings, share_timers};
-use crate::constraints::{Constraint, Family, PerFamily, Visit};
+use crate::constraints::{Constraint, Family, PerFamily, SubstepStart, Visit};
 use crate::input::limits::SOUND_LIMIT;
 use crate::simulation::Resolved;
 use crate::simulation::divergence::Divergence;
@@ -63,12 +63,14 @@ impl FastSimulation {
                     let at = |positions: &[Vec3A]| -> [Vec3A; N] {
                         std::array::from_fn(|k| positions[particles[k] as usize])
                     };
+                    let p = at(self.positions);
                     let value = c
                         .evaluate_stored(
-                            &at(self.positions),
+                            &p,
                             rest,
                             &at(self.rest_positions),
                             &stored,
+                            SubstepStart::at_rest(&p),
                         )
                         .value;
                     let scale = if rest == 0.0 { 1.0 } else { rest.abs() };

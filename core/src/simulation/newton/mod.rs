@@ -220,6 +220,7 @@ impl Substeps for Implicit<'_> {
                 .map(|(particle, target, compliance)| (particle, target, 1.0 / compliance)),
             ground: plan.motion.ground,
             dofs: &dofs,
+            start: Some((&state.previous, plan.h)),
         };
         let heaviest = masses.iter().fold(0.0f64, |a, &m| a.max(m));
         let scales = Scales {
@@ -283,6 +284,7 @@ pub fn equilibrium(start: Start<'_>, options: &Options) -> Result<(Vec<DVec3>, R
         grab: None,
         ground: resolved.settings.ground.then_some(0.0),
         dofs: &dofs,
+        start: None,
     };
     let stiffness = families
         .all()

@@ -20,7 +20,7 @@
 //! definite and every Newton step goes down.
 
 use super::super::state::Body;
-use crate::constraints::differentiable::{Matrix12, of_constraint, second_order};
+use crate::constraints::differentiable::{Matrix12, of_constraint_moving, second_order_moving};
 use crate::constraints::{Families, Family, PerFamily};
 use glam::DVec3;
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -108,6 +108,9 @@ pub(super) struct Objective<'a> {
     /// The ground's height, when there is one.
     pub(super) ground: Option<f64>,
     pub(super) dofs: &'a Dofs,
+    /// Where every particle was at the start of the substep, and h: what a constraint on
+    /// velocities reads (`None` in a static problem: at rest).
+    pub(super) start: Option<(&'a [DVec3], f64)>,
 }
 
 /// The system at a point: Φ's gradient on the free coordinates, and the Hessian's values in the
@@ -226,13 +229,13 @@ impl Objective<'_> {
         let set = &self.body.sets[family];
         let rest = (set.rest()[c], set.stored(c));
         let particles = set.particles(c);
-        of_constraint(
+        of_constraint_moving(
             self.families,
             family,
             particles,
             rest,
-            x,
-            &self.body.rest_positions,
+            (x, &self.body.rest_positions),
+            self.start,
         )
         .0
     }
@@ -297,12 +300,17 @@ impl Objective<'_> {
             let idx = set.particles(c);
             let p: [DVec3; N] = std::array::from_fn(|k| x[idx[k] as usize]);
             let shape: [DVec3; N] = std::array::from_fn(|k| o.body.rest_positions[idx[k] as usize]);
-            second_order(
+            let start = o.start.map(|(start, h)| {
+                let at: [DVec3; N] = std::array::from_fn(|k| start[idx[k] as usize]);
+                (at, h)
+            });
+            second_order_moving(
                 o.families,
                 family,
                 &p,
                 (set.rest()[c], set.stored(c)),
                 &shape,
+                start.as_ref().map(|(at, h)| (at, *h)),
             )
         }
         match arity {
