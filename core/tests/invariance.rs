@@ -24,6 +24,9 @@ fn invariant_files() -> Vec<(String, ConstraintFile)> {
                 .into_iter()
                 .map(move |f| (example.file.to_owned(), f))
         })
+        // Turning the particles while where they were is held is a motion, which a damper
+        // answers (core/tests/edge_damper_file.rs checks it is translation invariant only).
+        .filter(|(_, f)| !f.reads_motion())
         .collect();
     files.push((
         "det F − 1".into(),

@@ -109,8 +109,8 @@ impl ElementEnergy {
         }
         if terms.is_empty() {
             return Err(
-                "no family with an energy of the positions is active: name one \
-                        (--constraints or --constraint-file; a damper's has none)"
+                "no family is active that has an energy of the positions (a damper has \
+                 none): name one (--constraints or --constraint-file)"
                     .into(),
             );
         }
