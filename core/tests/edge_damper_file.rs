@@ -38,30 +38,41 @@ fn table() -> (Families, Family) {
     (families, damper)
 }
 
+/// Soft edges (compliance 10⁻⁴) on `scene`, with the damper (10⁻⁴) or without, run `frames`
+/// frames on `engine`. Beside rigid edges a stiff damper is unstable (docs/gradients.md): a
+/// length the edges restore is a speed along the edge, which the damper takes back, and
+/// Gauss–Seidel feeds that back (a body in free fall picks up 6·10⁻⁵ m/s sideways in 2 frames
+/// from rounding, and flies off).
+fn run(
+    (families, damper): &(Families, Family),
+    (scene, ground, frames): (&Scene, bool, usize),
+    engine: EngineChoice,
+    with_damper: bool,
+) -> Simulation {
+    let mut compliance = Settings::default().compliance;
+    compliance[Family::EDGES] = 1e-4;
+    compliance[*damper] = 1e-4;
+    let settings = Settings {
+        active: families.per_family(|f| f == Family::EDGES || (with_damper && f == *damper)),
+        compliance,
+        engine,
+        ground,
+        ..Settings::default()
+    };
+    let mut simulation = Simulation::with_families(scene, settings, families.clone());
+    for _ in 0..frames {
+        simulation.step();
+    }
+    simulation
+}
+
 #[test]
 fn a_rigid_motion_is_not_damped() {
-    let (families, damper) = table();
+    let table = table();
     let scene = Scene::builtin(Builtin::Cube, 2).unwrap();
     for engine in [EngineChoice::Reference, EngineChoice::Fast] {
-        let fall = |with_damper: bool| {
-            // Soft edges and a damper of compliance 10⁻⁴, as below. Beside rigid edges a stiff
-            // damper is unstable (docs/gradients.md): a length the edges restore is a speed along
-            // the edge, which the damper takes back, and Gauss–Seidel feeds that back (a body in
-            // free fall picks up 6·10⁻⁵ m/s sideways in 2 frames from rounding, and flies off).
-            let mut compliance = Settings::default().compliance;
-            compliance[Family::EDGES] = 1e-4;
-            compliance[damper] = 1e-4;
-            let settings = Settings {
-                active: families.per_family(|f| f == Family::EDGES || (with_damper && f == damper)),
-                compliance,
-                engine,
-                ground: false,
-                ..Settings::default()
-            };
-            let mut simulation = Simulation::with_families(&scene, settings, families.clone());
-            for _ in 0..30 {
-                simulation.step();
-            }
+        let fall = |with_damper| {
+            let simulation = run(&table, (&scene, false, 30), engine, with_damper);
             simulation.positions().to_vec()
         };
         let (with, without) = (fall(true), fall(false));
@@ -77,23 +88,11 @@ fn a_rigid_motion_is_not_damped() {
 
 #[test]
 fn a_soft_beam_comes_to_rest_with_the_damper_on_both_engines() {
-    let (families, damper) = table();
+    let table = table();
     let scene = Scene::builtin(Builtin::Beam, 2).unwrap();
     for engine in [EngineChoice::Reference, EngineChoice::Fast] {
-        let swing = |with_damper: bool| {
-            let mut compliance = Settings::default().compliance;
-            compliance[Family::EDGES] = 1e-4;
-            compliance[damper] = 1e-4;
-            let settings = Settings {
-                active: families.per_family(|f| f == Family::EDGES || (with_damper && f == damper)),
-                compliance,
-                engine,
-                ..Settings::default()
-            };
-            let mut simulation = Simulation::with_families(&scene, settings, families.clone());
-            for _ in 0..90 {
-                simulation.step();
-            }
+        let swing = |with_damper| {
+            let simulation = run(&table, (&scene, true, 90), engine, with_damper);
             let metrics = Metrics::measure_sound(&simulation).unwrap();
             let kinetic =
                 tetlab_core::measures::energy_account::Energy::measure(&simulation).kinetic;
