@@ -91,6 +91,7 @@ fn a_file_family_evaluated_in_groups_gives_each_batch_its_own_bits() {
     for path in example_files() {
         for file in ConstraintFile::load_all(&path).unwrap() {
             let checked = match file.arity() {
+                1 => same_bits::<1>(&file),
                 2 => same_bits::<2>(&file),
                 3 => same_bits::<3>(&file),
                 4 => same_bits::<4>(&file),

@@ -384,12 +384,20 @@ fn write_file_report(
             "  yours is not checked for it: it does not give every particle's gradient"
         )?,
     }
-    writeln!(
-        out,
-        "rotation invariant (sum of p x gradient = 0): {} ({})",
-        yes(o.rotation_invariant),
-        against_rounding(report.rotation, report.rotation_excess)
-    )?;
+    if o.max_relative_error.len() == 1 {
+        // About its own place, one particle cannot turn: Σ p × ∇C is 0 whatever C is.
+        writeln!(
+            out,
+            "rotation invariant: not asked of one particle (it turns about itself)"
+        )?;
+    } else {
+        writeln!(
+            out,
+            "rotation invariant (sum of p x gradient = 0): {} ({})",
+            yes(o.rotation_invariant),
+            against_rounding(report.rotation, report.rotation_excess)
+        )?;
+    }
     match report.reflection {
         Reflection::Untried => writeln!(out, "a reflection (x -> -x): {}", o.reflection)?,
         _ => writeln!(out, "a reflection (x -> -x) leaves C {}", o.reflection)?,
@@ -399,7 +407,7 @@ fn write_file_report(
         "near-degenerate configurations: {}; C or its gradient undefined at {} (flagged, never NaN)",
         o.near_degenerate, o.undefined_near_degenerate
     )?;
-    write_file_hessian(&o.hessian, out)?;
+    write_file_hessian(&o.hessian, o.max_relative_error.len(), out)?;
     writeln!(out)?;
     match &o.worst {
         None if o
@@ -475,7 +483,11 @@ fn write_file_report(
 }
 
 /// The Hessian lines of a file's report.
-fn write_file_hessian(h: &HessianOutput, out: &mut impl Write) -> std::io::Result<()> {
+fn write_file_hessian(
+    h: &HessianOutput,
+    arity: usize,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
     writeln!(
         out,
         "Hessian (∇²C) on {} configurations: forward mode over AD's ∇C against second-order AD \
@@ -483,9 +495,13 @@ fn write_file_hessian(h: &HessianOutput, out: &mut impl Write) -> std::io::Resul
         h.compared, h.against_second_order, h.against_finite_differences
     )?;
     if h.yours.is_empty() {
+        let block = match arity {
+            1 => "p0p0",
+            _ => "p0p1",
+        };
         return writeln!(
             out,
-            "  the file gives no Hessian: nothing of yours to check (add [hessian] p0p1 = \"...\")"
+            "  the file gives no Hessian: nothing of yours to check (add [hessian] {block} = \"...\")"
         );
     }
     for (block, error) in &h.yours {

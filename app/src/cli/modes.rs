@@ -73,6 +73,8 @@ struct FSpaceOutput {
 #[derive(Debug, Serialize)]
 struct Output {
     constraints: String,
+    /// The active families with no energy on one tet (a damper, a pin), left out.
+    left_out: Vec<String>,
     /// Per family: its α and whether it is rigid, taken with α = 1.
     compliances: Vec<(String, f64, bool)>,
     energy: f64,
@@ -131,8 +133,14 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     let check = convergence(&energy, &at, &h);
     let modes = Modes::of_matrix(h, &x, &rest, energy.corner_mass());
     let f_space = neohookean_pair(&families, &settings).then(|| f_space(&settings, &rest, &x));
+    let in_energy = families.per_family(|f| energy.compliances.iter().any(|&(g, _)| g == f));
     let output = Output {
-        constraints: families.describe(&settings.active),
+        constraints: families.describe(&in_energy),
+        left_out: families
+            .all()
+            .filter(|&f| settings.active[f] && !in_energy[f])
+            .map(|f| families.name(f).to_owned())
+            .collect(),
         compliances: energy
             .compliances
             .iter()
@@ -242,6 +250,14 @@ fn write_table(o: &Output, check: &Convergence, out: &mut impl Write) -> std::io
             ""
         };
         writeln!(out, "            {name}: α = {}{note}", alpha.show())?;
+    }
+    if !o.left_out.is_empty() {
+        writeln!(
+            out,
+            "            left out: {} (no energy on one tet: a damper's is of the motion, a \
+             family on single particles ties the body to the world)",
+            o.left_out.join(", ")
+        )?;
     }
     writeln!(out, "            E = {} at these points", o.energy.show())?;
     let against = match o.against_second_order {

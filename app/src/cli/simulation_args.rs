@@ -245,6 +245,14 @@ impl SolverArgs {
                     families.name(family),
                     file.path.display()
                 );
+                // Which particles a `where` chose on this mesh: none is said, not left silent.
+                if families.binding(family) == tetlab_core::constraints::Binding::Particles {
+                    text += &format!(
+                        " on {} of {} particles",
+                        simulation.constraint_count(family),
+                        simulation.positions().len()
+                    );
+                }
             }
         }
         text

@@ -318,6 +318,7 @@ pub fn update(
         visual::inverted_tets(positions, tets, &mut scratch.inverted);
         let colours = &mut scratch.colours;
         visual::particle_colours(positions.len(), tets, &scratch.inverted, colours);
+        visual::held_particle_colours(simulation, colours);
         let radius = (0.012 * cache.size) as f32;
         for (i, p) in positions.iter().enumerate() {
             let colour = if hovered == Some(i) {

@@ -184,6 +184,7 @@ impl<'a> Recorder<'a> {
             &self.inverted,
             &mut self.colours,
         );
+        visual::held_particle_colours(simulation, &mut self.colours);
         let colours_changed = self.logged_colours.as_ref() != Some(&self.colours);
 
         let mut particles =

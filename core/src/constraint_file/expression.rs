@@ -1,7 +1,8 @@
 //! The expression language of constraint files, parsed into a syntax tree ([`Expr`]). The grammar
 //! is `expression.pest` (the pest crate): numbers, names, calls `f(a, b)`, components `v.x`,
 //! unary −, `+ − * /` with the usual precedence, left to right, and comparisons `< <= > >=` as
-//! the condition of `if(…)`. An expression may span lines. Types are checked later, when the
+//! the condition of `if(…)`, and in a `where` joined by `and` and `or` (`parse_condition`).
+//! An expression may span lines. Types are checked later, when the
 //! tree is compiled (`super::program`).
 //!
 //! # Nothing the parser reads can crash it
@@ -252,6 +253,25 @@ pub(crate) fn parse_expression(text: &str) -> Result<Expr, SyntaxError> {
     Ok(build(expr))
 }
 
+/// Parses a `where`: comparisons joined by `and` and `or`, `and` first; as the `or` of
+/// conjunctions, each a list of [`Expr::Compare`].
+pub(crate) fn parse_condition(text: &str) -> Result<Vec<Vec<Expr>>, SyntaxError> {
+    check_depth(text)?;
+    let mut pairs = Grammar::parse(Rule::condition, text).map_err(|e| syntax_error(text, e))?;
+    let root = pairs.next().expect("the grammar's root");
+    Ok(root
+        .into_inner()
+        .filter(|p| p.as_rule() == Rule::conjunction)
+        .map(|conjunction| {
+            conjunction
+                .into_inner()
+                .filter(|p| p.as_rule() == Rule::clause)
+                .map(argument)
+                .collect()
+        })
+        .collect())
+}
+
 /// Parses `define`: one `name = expression` per line, in order.
 pub(crate) fn parse_definitions(text: &str) -> Result<Vec<(String, Span, Expr)>, SyntaxError> {
     check_depth(text)?;
@@ -306,6 +326,8 @@ fn describe(rule: &Rule) -> Option<&'static str> {
         | Rule::paren => "a number, a name or (",
         Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::member => "an operator",
         Rule::le | Rule::lt | Rule::ge | Rule::gt => "a comparison",
+        Rule::and_ | Rule::or_ => "`and` or `or`",
+        Rule::clause | Rule::conjunction => "a comparison (`q0.y > 0.5`)",
         Rule::assignment => "`name = expression`",
         Rule::EOI => "the end of the expression",
         _ => return None,
@@ -413,5 +435,18 @@ mod examples {
         let e = check_depth(&deep).unwrap_err();
         assert_eq!(e.offset, MAX_DEPTH);
         assert!(e.message.contains("too deeply"));
+    }
+
+    /// `parse_condition`: `and` binds before `or`; a where is comparisons, not a value.
+    #[test]
+    fn parse_condition_example() {
+        use crate::constraint_file::expression::{Expr, parse_condition};
+        let c = parse_condition("q0.y > 1 and q0.x < 0 or q0.z >= 2").unwrap();
+        assert_eq!(c.iter().map(Vec::len).collect::<Vec<_>>(), [2, 1]);
+        assert!(matches!(c[1][0], Expr::Compare(..)));
+        assert!(parse_condition("q0.y + 1").is_err());
+        assert!(parse_condition("q0.y > 1 andq0.x < 0").is_err());
+        let e = parse_condition("q0.y > 1 and").unwrap_err();
+        assert_eq!(e.offset, 12, "{}", e.message);
     }
 }

@@ -7,7 +7,7 @@
 //! TOML, e.g. `assets/constraints/height.toml`:
 //! ```toml
 //! name = "my-height"
-//! applies_to = "tet-vertices"   # or edges, tets, triangles, hinges
+//! applies_to = "tet-vertices"   # or edges, tets, triangles, hinges, particles
 //! define = """
 //! e1 = p1 - p0
 //! c = cross(p2 - p0, p3 - p0)
@@ -23,7 +23,8 @@
 //! normalize det vec3 mat3 outer transpose inverse trace norm sqrt cbrt pow exp log sin cos tan
 //! asin acos atan2 abs sign min max clamp if`, the rest shape (`q0`…, `Dm`, `Ds`, `F`, `V0`) and
 //! the material (`mu`, `lambda`, `gamma`). The bindings are `edges`, `tets`, `tet-vertices`,
-//! `triangles` and `hinges` ([`Binding`]). Several constraints go in `[[constraint]]` tables,
+//! `triangles`, `hinges` and `particles` ([`Binding`]), the last with a `where` that chooses
+//! which by their rest positions ([`ConstraintFile::chooses`]). Several constraints go in `[[constraint]]` tables,
 //! each with its `stiffness`, two of them projected together as a `pair`
 //! ([`ConstraintFile::parse_all`];
 //! `assets/constraints/neohookean.toml`). Every mistake is reported at file:line:column; the
@@ -35,6 +36,7 @@ pub mod grade;
 mod moving;
 mod parse;
 mod program;
+mod selection;
 pub use moving::Moving;
 pub use program::RESTING_H;
 
@@ -116,6 +118,8 @@ pub struct ConstraintFile {
     /// The particles (i, j) of each block: ∂²C/∂pᵢ∂pⱼ.
     hessian_blocks: Vec<(usize, usize)>,
     rest: Option<Tape>,
+    /// Which particles it applies to, when it binds to single particles (`where`).
+    selection: Option<selection::Selection>,
     /// Its grade as an exercise, worked out the first time it is asked for ([`ConstraintFile::grade`]).
     grade: GradeOnce,
 }
@@ -585,11 +589,9 @@ impl ConstraintFile {
             let e = file.evaluate_by(&p, rest, stored, own);
             std::array::from_fn(|k| e.gradients.get(k).copied().unwrap_or(DVec3::ZERO))
         }
-        match self.arity() {
-            2 => padded::<2>(self, points, rest, stored, own),
-            3 => padded::<3>(self, points, rest, stored, own),
-            _ => padded::<4>(self, points, rest, stored, own),
-        }
+        crate::constraints::for_arity!(self.arity(), |N| padded::<N>(
+            self, points, rest, stored, own
+        ))
     }
 
     /// The rest value for particles at rest at `rest_points`: `rest = "…"` when the file gives

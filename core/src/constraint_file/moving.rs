@@ -72,11 +72,8 @@ impl ConstraintFile {
         stored: &[f64],
     ) -> Evaluation {
         let value = self.value_moving(points, moving, rest, stored);
-        let automatic = match self.arity() {
-            2 => self.forward_mode::<2>(points, moving, rest, stored),
-            3 => self.forward_mode::<3>(points, moving, rest, stored),
-            _ => self.forward_mode::<4>(points, moving, rest, stored),
-        };
+        let automatic = crate::constraints::for_arity!(self.arity(), |N| self
+            .forward_mode::<N>(points, moving, rest, stored));
         Evaluation {
             value,
             automatic: automatic.filter(|_| value.is_finite()),

@@ -9,6 +9,7 @@
 
 use super::expression;
 use super::program::{CompileError, Program, Type};
+use super::selection::{Selection, SelectionError};
 use super::{ConstraintFile, ConstraintFileError, GradeOnce, Stiffness};
 use crate::constraints::Binding;
 use crate::input::text_file;
@@ -21,6 +22,9 @@ use toml::Spanned;
 struct Raw {
     name: Spanned<String>,
     applies_to: Spanned<String>,
+    /// Which particles, of a file on single particles: a condition on the rest position.
+    #[serde(default, rename = "where")]
+    condition: Option<Spanned<String>>,
     #[serde(default)]
     define: Option<Spanned<String>>,
     // A file of one constraint says it here; see RawConstraint.
@@ -107,14 +111,15 @@ pub(super) fn parse_all(
         "tet-vertices" => Binding::TetVertices,
         "triangles" => Binding::Triangles,
         "hinges" => Binding::Hinges,
+        "particles" => Binding::Particles,
         other => {
             return Err(error(
                 Some(raw.applies_to.span().start),
                 format!(
                     "applies_to is \"{other}\": expected \"edges\" (p0 p1), \"tets\" \
                      (p0..p3), \"tet-vertices\" (p0..p3, four per tet), \"triangles\" (p0 p1 \
-                     p2, the surface's, wound outwards) or \"hinges\" (p0 p1 an edge of the \
-                     surface, p2 p3 the wings)"
+                     p2, the surface's, wound outwards), \"hinges\" (p0 p1 an edge of the \
+                     surface, p2 p3 the wings) or \"particles\" (p0, those `where` chooses)"
                 ),
             ));
         }
@@ -136,11 +141,42 @@ pub(super) fn parse_all(
         Ok(trimmed)
     };
     let file_name = checked_name(&raw.name)?;
+    let selection = match &raw.condition {
+        None => None,
+        Some(condition) if binding != Binding::Particles => {
+            return Err(error(
+                Some(condition.span().start),
+                format!(
+                    "`where` chooses single particles, and this file applies to \"{}\": write \
+                     applies_to = \"particles\"",
+                    raw.applies_to.get_ref()
+                ),
+            ));
+        }
+        Some(condition) => {
+            let at = condition.span().start;
+            let source = condition.get_ref();
+            Some(Selection::compile(source).map_err(|e| match e {
+                SelectionError::Syntax(e) => error(
+                    Some(file_offset(text, at, e.offset)),
+                    format!("in where: {}", e.message),
+                ),
+                SelectionError::Compile(e) => {
+                    let snippet = source.get(e.span.start..e.span.end).unwrap_or("").trim();
+                    error(
+                        Some(file_offset(text, at, e.span.start)),
+                        format!("in where: {} (`{snippet}`)", e.message),
+                    )
+                }
+            })?)
+        }
+    };
     let shared = Shared {
         path,
         text,
         binding,
         define: raw.define.as_ref(),
+        selection,
     };
     let single = RawConstraint {
         value: raw.value.clone(),
@@ -258,6 +294,8 @@ struct Shared<'a> {
     text: &'a str,
     binding: Binding,
     define: Option<&'a Spanned<String>>,
+    /// The particles a file on single particles applies to (`where`).
+    selection: Option<Selection>,
 }
 
 impl Shared<'_> {
@@ -348,9 +386,9 @@ impl Shared<'_> {
                 return Err(self.error(
                     Some(key.span().start),
                     format!(
-                        "gradient entry `{}`: this binding has particles p0…p{} only",
+                        "gradient entry `{}`: this binding has {} only",
                         key.get_ref(),
-                        arity - 1
+                        particle_names(arity)
                     ),
                 ));
             };
@@ -364,10 +402,10 @@ impl Shared<'_> {
                 self.error(
                     Some(key.span().start),
                     format!(
-                        "hessian entry `{}`: name a block of two particles, pIpJ with I and J in \
-                         0…{} (`p0p1` is ∂²C/∂p0∂p1, a matrix)",
+                        "hessian entry `{}`: name a block pIpJ, I and J of the binding's {} \
+                         (`p0p1` is ∂²C/∂p0∂p1, a matrix)",
                         key.get_ref(),
-                        arity - 1
+                        particle_names(arity)
                     ),
                 )
             })?;
@@ -474,8 +512,17 @@ impl Shared<'_> {
             hessian: (!blocks.is_empty()).then_some(hessian),
             hessian_blocks: blocks.iter().map(|&(pair, _)| pair).collect(),
             rest,
+            selection: self.selection.clone(),
             grade: GradeOnce::default(),
         })
+    }
+}
+
+/// The particles of a binding of `arity`: `particle p0` or `particles p0…p3`.
+fn particle_names(arity: usize) -> String {
+    match arity {
+        1 => "particle p0".to_owned(),
+        _ => format!("particles p0…p{}", arity - 1),
     }
 }
 

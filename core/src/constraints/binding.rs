@@ -1,8 +1,35 @@
 //! How a family's constraints lay on a tet mesh ([`Binding`]): one per edge, per tet, per tet
-//! and vertex, per surface triangle or per surface hinge, and so how many a mesh has and which
-//! particles each touches.
+//! and vertex, per surface triangle, per surface hinge or per particle, and so how many a mesh
+//! has and which particles each touches.
 
 use crate::scene::mesh::{TET_EDGES, TetMesh};
+
+/// `body` with `N` the constant arity `arity` (1 to 4; 4 above): the one place where a
+/// binding's arity, a number at run time, becomes the const generic that a constraint's code is
+/// compiled for. `for_arity!(arity, |N| f::<N>(x))`.
+macro_rules! for_arity {
+    ($arity:expr, |$n:ident| $body:expr) => {
+        match $arity {
+            1 => {
+                const $n: usize = 1;
+                $body
+            }
+            2 => {
+                const $n: usize = 2;
+                $body
+            }
+            3 => {
+                const $n: usize = 3;
+                $body
+            }
+            _ => {
+                const $n: usize = 4;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use for_arity;
 
 /// How a family's constraints bind to a tet mesh, and so how many it has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,12 +50,17 @@ pub enum Binding {
     /// is (p1, p0, p3), both wound outwards ([`crate::scene::mesh::TetMesh::surface_hinges`]).
     /// An edge of one surface triangle or of three or more (non-manifold) makes no hinge.
     Hinges,
+    /// One per particle: (p0). A constraint file's `where` keeps those it chooses by their rest
+    /// positions (a pin set, a handle, the particles above a plane); without one, every
+    /// particle ([`crate::constraint_file::ConstraintFile::chooses`]).
+    Particles,
 }
 
 impl Binding {
     /// How many particles each of its constraints has.
     pub fn arity(self) -> usize {
         match self {
+            Binding::Particles => 1,
             Binding::Edges => 2,
             Binding::Triangles => 3,
             Binding::Tets | Binding::TetVertices | Binding::Hinges => 4,
@@ -43,6 +75,7 @@ impl Binding {
             Binding::Tets => mesh.tets.iter().flatten().copied().collect(),
             Binding::Triangles => mesh.surface_faces().into_iter().flatten().collect(),
             Binding::Hinges => mesh.surface_hinges().into_iter().flatten().collect(),
+            Binding::Particles => (0..mesh.positions.len() as u32).collect(),
             Binding::TetVertices => mesh
                 .tets
                 .iter()
@@ -68,8 +101,8 @@ impl Binding {
             Binding::Edges => (0..0, true),
             Binding::Tets => (tet..tet + 1, false),
             Binding::TetVertices => (4 * tet..4 * tet + 4, false),
-            // Of the surface, not of a tet.
-            Binding::Triangles | Binding::Hinges => (0..0, false),
+            // Of the surface or of single particles, not of a tet.
+            Binding::Triangles | Binding::Hinges | Binding::Particles => (0..0, false),
         };
         let pairs = pairs(edges);
         let looked_up = TET_EDGES

@@ -125,11 +125,12 @@ pub fn of_constraint_moving(
         (value, padded)
     }
     let constraint = (families, family, particles, rest);
-    match particles.len() {
-        2 => at::<2>(constraint, x, rest_positions, moving),
-        3 => at::<3>(constraint, x, rest_positions, moving),
-        _ => at::<4>(constraint, x, rest_positions, moving),
-    }
+    super::for_arity!(particles.len(), |N| at::<N>(
+        constraint,
+        x,
+        rest_positions,
+        moving
+    ))
 }
 
 /// One constraint of a built-in family evaluated at `x`, in the number type of `x`.

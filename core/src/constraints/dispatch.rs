@@ -16,6 +16,7 @@ impl Families {
             return builtin::visit(family, visitor);
         }
         match self.file_code(family) {
+            FileCode::One(c) => visitor.visit(family, &c.0),
             FileCode::Two(c) => visitor.visit(family, &c.0),
             FileCode::Three(c) => visitor.visit(family, &c.0),
             FileCode::Four(c) => visitor.visit(family, &c.0),
@@ -47,6 +48,9 @@ impl Families {
             return builtin::visit_pair(lead, partner, visitor);
         }
         match (self.file_code(lead), self.file_code(partner)) {
+            (FileCode::One(a), FileCode::One(b)) => {
+                visitor.visit([lead, partner], &Pair(&a.0, &b.0))
+            }
             (FileCode::Two(a), FileCode::Two(b)) => {
                 visitor.visit([lead, partner], &Pair(&a.0, &b.0))
             }

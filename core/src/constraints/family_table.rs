@@ -15,6 +15,7 @@ use super::file::FileConstraint;
 use super::row::Formula;
 use super::{Binding, Family, MAX_FAMILIES, PerFamily, Row, TABLE, builtin};
 use crate::constraint_file::ConstraintFile;
+use crate::scene::mesh::TetMesh;
 use std::borrow::Cow;
 use std::sync::Arc;
 
@@ -64,6 +65,8 @@ struct FileFamily {
 
 /// A constraint file as the [`super::Constraint`] type of its arity.
 pub(super) enum FileCode {
+    /// On one particle (a pin, a handle).
+    One(Typed<1, FileConstraint<1>>),
     /// On two particles (edges, hinges' ends).
     Two(Typed<2, FileConstraint<2>>),
     /// On three (surface triangles).
@@ -77,6 +80,7 @@ impl FileFamily {
         let row = row_of(&file, slot);
         let file = Arc::new(file);
         let code = match row.arity {
+            1 => FileCode::One(Typed(FileConstraint(file.clone()))),
             2 => FileCode::Two(Typed(FileConstraint(file.clone()))),
             3 => FileCode::Three(Typed(FileConstraint(file.clone()))),
             _ => FileCode::Four(Typed(FileConstraint(file.clone()))),
@@ -494,6 +498,7 @@ impl Families {
             return builtin::constraint(family);
         }
         match self.file_code(family) {
+            FileCode::One(c) => c,
             FileCode::Two(c) => c,
             FileCode::Three(c) => c,
             FileCode::Four(c) => c,
@@ -517,5 +522,15 @@ impl Families {
     /// How `family` binds to a mesh.
     pub fn binding(&self, family: Family) -> Binding {
         self.row(family).binding
+    }
+
+    /// The particles of every constraint of `family` on `mesh`, flat, its arity per constraint:
+    /// its binding's ([`Binding::particles`]); of a file on single particles, those its `where`
+    /// chooses ([`ConstraintFile::chooses`]).
+    pub fn particles_on(&self, family: Family, mesh: &TetMesh) -> Vec<u32> {
+        match (self.binding(family), self.file(family)) {
+            (Binding::Particles, Some(file)) => file.chooses(&mesh.positions),
+            (binding, _) => binding.particles(mesh),
+        }
     }
 }

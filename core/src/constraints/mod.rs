@@ -43,6 +43,7 @@ pub mod volume;
 
 pub use any::{AnyConstraint, Typed};
 pub use binding::Binding;
+pub(crate) use binding::for_arity;
 pub use builtin::TABLE;
 pub use family_table::{COLOURS, Families, MAX_FILE_FAMILIES, Named};
 pub use per_family::PerFamily;

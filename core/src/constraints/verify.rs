@@ -200,9 +200,13 @@ pub fn automatic_gradient(
 }
 
 /// Whether `points` are far from degenerate: no two closer than [`CONDITIONING`] times the
-/// largest distance, and no face of three of them with an angle's sine below it.
+/// largest distance, and no face of three of them with an angle's sine below it. A point
+/// alone always is.
 pub fn well_conditioned(points: &[DVec3]) -> bool {
     let n = points.len();
+    if n == 1 {
+        return true;
+    }
     let mut longest: f64 = 0.0;
     for i in 0..n {
         for j in i + 1..n {
@@ -611,12 +615,17 @@ pub fn check<S: GradientSource>(source: &S, configs: usize, seed: u64) -> Report
 }
 
 /// Configurations at or near degeneracy: two points coincident, all coincident, all on a line,
-/// p3 on the plane of p0, p1, p2 (for four), and the same moved by 10⁻⁹ of their size.
+/// p3 on the plane of p0, p1, p2 (for four), and the same moved by 10⁻⁹ of their size. One
+/// particle alone is checked at rest, where the caller puts it (p0 = q0: a pin at its place).
 fn near_degenerate(arity: usize, rng: &mut SplitMix64, count: usize) -> Vec<Vec<DVec3>> {
     let mut shapes = Vec::with_capacity(count);
     while shapes.len() < count {
         let size = 10f64.powf(rng.range(-2.0, 2.0));
         let mut points: Vec<DVec3> = (0..arity).map(|_| rng.in_cube(size)).collect();
+        if arity == 1 {
+            shapes.push(points);
+            continue;
+        }
         match shapes.len() % 4 {
             0 => points[arity - 1] = points[0],
             1 => {

@@ -124,11 +124,9 @@ pub fn check(
     samples: usize,
     seed: u64,
 ) -> HessianReport {
-    match families.arity(family) {
-        2 => check_on::<2>(families, family, file, samples, seed),
-        3 => check_on::<3>(families, family, file, samples, seed),
-        _ => check_on::<4>(families, family, file, samples, seed),
-    }
+    crate::constraints::for_arity!(families.arity(family), |N| check_on::<N>(
+        families, family, file, samples, seed
+    ))
 }
 
 fn check_on<const N: usize>(

@@ -7,7 +7,7 @@
 //! of the surface, the tet's own four faces and six hinges, as if it stood alone.
 
 use crate::constraints::differentiable::value_and_gradient;
-use crate::constraints::{Families, Family, PerFamily, Stored};
+use crate::constraints::{Binding, Families, Family, PerFamily, Stored};
 use crate::numbers::vector::Real;
 use crate::scene::mesh::TetMesh;
 use crate::simulation::{DENSITY, Settings, Simulation};
@@ -64,7 +64,10 @@ impl ElementEnergy {
     /// The energy of the `active` families of `families` on a tet at rest at `rest_shape`, with
     /// the compliances and material of `settings`. A family that reads where its particles were
     /// at the start of the substep (a damper: `start0`…, `h`) is left out: its ½ C² / α is a
-    /// potential of the motion, not an energy of the positions alone. An error when no family
+    /// potential of the motion, not an energy of the positions alone. A family on single
+    /// particles (a pin: C = |p0 − q0|) is left out too: it ties the body to the world, not a
+    /// tet's corners to each other, and a tet alone has none of the mesh's chosen particles.
+    /// An error when no family
     /// with an energy has a constraint on a tet.
     pub fn new(
         families: &Families,
@@ -80,7 +83,8 @@ impl ElementEnergy {
         let mut terms = Vec::new();
         let mut compliances = Vec::new();
         let of_positions = |f: Family| !families.file(f).is_some_and(|file| file.reads_motion());
-        for family in families.all().filter(|&f| active[f] && of_positions(f)) {
+        let of_the_body = |f: Family| families.binding(f) != Binding::Particles;
+        for family in (families.all()).filter(|&f| active[f] && of_positions(f) && of_the_body(f)) {
             let compliance = match families.row(family).compliance_from_material {
                 Some(from) => Compliance::Given(from(material)),
                 None if settings.compliance[family] > 0.0 => {
@@ -109,8 +113,8 @@ impl ElementEnergy {
         }
         if terms.is_empty() {
             return Err(
-                "no family is active that has an energy of the positions (a damper has \
-                 none): name one (--constraints or --constraint-file)"
+                "no family is active that has an energy of the positions (a damper or a pin \
+                 has none on a tet): name one (--constraints or --constraint-file)"
                     .into(),
             );
         }
@@ -193,11 +197,7 @@ impl ElementEnergy {
             }
             (value, out)
         }
-        match term.arity {
-            2 => on::<T, 2>(self, term, x),
-            3 => on::<T, 3>(self, term, x),
-            _ => on::<T, 4>(self, term, x),
-        }
+        crate::constraints::for_arity!(term.arity, |N| on::<T, N>(self, term, x))
     }
 
     /// E at the corners `x`.

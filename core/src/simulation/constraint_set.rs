@@ -47,13 +47,22 @@ impl ConstraintSet {
         material: &Material,
     ) -> ConstraintSet {
         let arity = families.arity(family);
-        let particles = families.binding(family).particles(mesh);
-        let size = particles
-            .chunks_exact(arity)
-            .map(|idx| {
-                crate::scene::mesh::longest_edge(idx.iter().map(|&i| mesh.positions[i as usize]))
-            })
-            .collect();
+        let particles = families.particles_on(family, mesh);
+        let size = match arity {
+            // A particle alone has no size of its own: the longest rest edge at it.
+            1 => {
+                let longest = mesh.longest_edge_at();
+                particles.iter().map(|&i| longest[i as usize]).collect()
+            }
+            _ => particles
+                .chunks_exact(arity)
+                .map(|idx| {
+                    crate::scene::mesh::longest_edge(
+                        idx.iter().map(|&i| mesh.positions[i as usize]),
+                    )
+                })
+                .collect(),
+        };
         let mut set = ConstraintSet {
             built: true,
             file: families.file(family).cloned(),

@@ -75,6 +75,12 @@ impl Simulation {
         self.body.sets[family].len()
     }
 
+    /// The particles of every constraint of `family`, flat, its arity per constraint (of a
+    /// family on single particles: the particles it holds).
+    pub fn constraint_particles(&self, family: Family) -> &[u32] {
+        self.body.sets[family].all_particles()
+    }
+
     /// What projecting constraint `c` of `family` now would do, with the current λ and the rule
     /// (XPBD or PBD) of the current settings: C, ∇C, the inverse masses, Δλ and Δx.
     ///
@@ -135,6 +141,9 @@ pub struct Projection {
     pub delta_x: [DVec3; 4],
     /// Whether ∇C is undefined here.
     pub degenerate: bool,
+    /// The element's size at rest: its longest rest edge (of a particle alone, the longest
+    /// rest edge at it), what the reach is measured in and arrows are drawn to.
+    pub size: f64,
 }
 
 impl Projection {
@@ -208,6 +217,7 @@ impl<R: Fn(Family) -> Rule<f64>> VisitProjected for Describe<'_, R> {
             delta_lambda: (!skipped).then_some(correction.delta_lambda[v]),
             delta_x: [DVec3::ZERO; 4],
             degenerate: evaluation.degenerate,
+            size: set.size()[c],
         };
         for k in 0..N {
             projection.particles[k] = unit.particles[k];

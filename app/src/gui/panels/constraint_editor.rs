@@ -348,13 +348,15 @@ pub fn report_lines(report: &Report) -> Vec<(String, bool)> {
         ),
         true,
     ));
-    lines.push((
-        format!(
+    // About its own place, one particle cannot turn: Σ p × ∇C is 0 whatever C is.
+    let rotation = match report.max_relative_error.len() {
+        1 => "rotation invariant: not asked of one particle (it turns about itself)".to_owned(),
+        _ => format!(
             "rotation invariant (sum of p x grad C = 0): {}",
             yes(report.rotation_invariant())
         ),
-        true,
-    ));
+    };
+    lines.push((rotation, true));
     lines
 }
 

@@ -46,7 +46,7 @@ mod tape;
 use expressions::FUNCTIONS;
 pub(super) use given::GIVEN_NAMES;
 pub use op::RESTING_H;
-pub(super) use op::{Inputs, MAX_REGISTERS, MAX_STORED, MAX_WRITTEN};
+pub(super) use op::{Inputs, MAX_REGISTERS, MAX_STORED, MAX_WRITTEN, holds};
 use tape::InputLayout;
 pub(super) use tape::{Registers, Tape};
 

@@ -416,7 +416,7 @@ impl<'a, T: Real> Inputs<'a, T> {
 
 /// Whether `a cmp b` (false with a NaN).
 #[inline(always)]
-pub(super) fn holds<T: Real>(cmp: CompareOp, a: T, b: T) -> T::Mask {
+pub(crate) fn holds<T: Real>(cmp: CompareOp, a: T, b: T) -> T::Mask {
     match cmp {
         CompareOp::Less => b.gt(a),
         CompareOp::LessOrEqual => a.le(b),

@@ -135,6 +135,31 @@ impl TetMesh {
         edges
     }
 
+    /// Per particle, the longest rest edge that ends at it (0 for a particle of no tet): the
+    /// size a constraint on that particle alone is measured in.
+    ///
+    /// ```
+    /// # use glam::DVec3;
+    /// # use tetlab_core::scene::mesh::TetMesh;
+    /// let mesh = TetMesh {
+    ///     positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+    ///     tets: vec![[0, 1, 2, 3]],
+    /// };
+    /// let at = mesh.longest_edge_at();
+    /// assert_eq!(at[0], 1.0, "the origin's edges are the axes");
+    /// assert_eq!(at[1], 2f64.sqrt());
+    /// ```
+    pub fn longest_edge_at(&self) -> Vec<f64> {
+        let mut longest = vec![0.0f64; self.positions.len()];
+        for [i, j] in self.edges() {
+            let length = self.positions[i as usize].distance(self.positions[j as usize]);
+            for k in [i, j] {
+                longest[k as usize] = longest[k as usize].max(length);
+            }
+        }
+        longest
+    }
+
     /// The boundary triangles: faces that belong to exactly one tet, wound so that their normal
     /// (b − a)×(c − a) points out of the body. In tet order, then face order, so the result is
     /// deterministic.

@@ -279,9 +279,15 @@ impl Layout {
                 layout
                     .elements
                     .push(std::array::from_fn(|k| element(k) as u32));
+                // A particle alone is no element whose size a step could grow (see
+                // `correct_in_reach`): its steps are never limited.
                 layout.size.push(F32x8::new(std::array::from_fn(|k| {
                     let corners = elements[element(k)].map(|i| rest_positions[i as usize]);
-                    crate::scene::mesh::longest_edge(corners.iter().map(|p| p.as_dvec3())) as f32
+                    match N {
+                        1 => f32::INFINITY,
+                        _ => crate::scene::mesh::longest_edge(corners.iter().map(|p| p.as_dvec3()))
+                            as f32,
+                    }
                 })));
             }
             layout.colours.push(Colour {

@@ -1,5 +1,5 @@
 //! The layouts of the elements the active families bind to (edges, tets, (tet, vertex) pairs,
-//! surface triangles and hinges), built from a simulation's body in the fast engine's particle
+//! surface triangles and hinges, and each family's own particles), built from a simulation's body in the fast engine's particle
 //! numbering, and the order each family's colours are projected in.
 
 use super::batches::Layout;
@@ -9,7 +9,8 @@ use crate::simulation::state::Body;
 use glam::Vec3A;
 
 /// The layouts of the elements families bind to; every family of a binding shares that
-/// binding's (each is empty when no active family uses it).
+/// binding's (each is empty when no active family uses it), except that a family on single
+/// particles has its own: each file's `where` chooses its particles.
 #[derive(Default)]
 pub(super) struct Layouts {
     edges: Layout,
@@ -17,6 +18,8 @@ pub(super) struct Layouts {
     tet_vertices: Layout,
     triangles: Layout,
     hinges: Layout,
+    /// Of each active family on single particles.
+    particles: Vec<(Family, Layout)>,
 }
 
 impl Layouts {
@@ -89,22 +92,43 @@ impl Layouts {
             let (hinges, _) = flat.as_chunks::<4>();
             layouts.hinges = Layout::new(&renumbered(hinges), inverse_masses, rest_positions);
         }
+        // Each family on single particles: one colour, since no two of its constraints share
+        // a particle.
+        for family in active
+            .families()
+            .filter(|&f| families.binding(f) == Binding::Particles)
+        {
+            let (chosen, _) = body.sets[family].all_particles().as_chunks::<1>();
+            let chosen: Vec<[u32; 1]> = chosen
+                .iter()
+                .map(|p| p.map(|i| renumber[i as usize]))
+                .collect();
+            let layout = Layout::new(&chosen, inverse_masses, rest_positions);
+            layouts.particles.push((family, layout));
+        }
         layouts
     }
 
-    /// The layout a family of `binding` uses.
-    pub(super) fn of(&self, binding: Binding) -> &Layout {
-        match binding {
+    /// The layout `family` (of `families`) uses.
+    ///
+    /// # Panics
+    /// For a family on single particles that was not active when the layouts were built.
+    pub(super) fn of(&self, families: &Families, family: Family) -> &Layout {
+        match families.binding(family) {
             Binding::Edges => &self.edges,
             Binding::Tets => &self.tets,
             Binding::TetVertices => &self.tet_vertices,
             Binding::Triangles => &self.triangles,
             Binding::Hinges => &self.hinges,
+            Binding::Particles => {
+                let own = self.particles.iter().find(|(f, _)| *f == family);
+                &own.expect("an active family's layout").1
+            }
         }
     }
 
     /// Every one, for the families' weights.
-    pub(super) fn all_mut(&mut self) -> [&mut Layout; 5] {
+    pub(super) fn all_mut(&mut self) -> impl Iterator<Item = &mut Layout> {
         [
             &mut self.edges,
             &mut self.tets,
@@ -112,10 +136,12 @@ impl Layouts {
             &mut self.triangles,
             &mut self.hinges,
         ]
+        .into_iter()
+        .chain(self.particles.iter_mut().map(|(_, layout)| layout))
     }
 
     /// Every one.
-    pub(super) fn all(&self) -> [&Layout; 5] {
+    pub(super) fn all(&self) -> impl Iterator<Item = &Layout> {
         [
             &self.edges,
             &self.tets,
@@ -123,6 +149,8 @@ impl Layouts {
             &self.triangles,
             &self.hinges,
         ]
+        .into_iter()
+        .chain(self.particles.iter().map(|(_, layout)| layout))
     }
 
     /// The order of each active family's colours that the settings ask for
@@ -136,7 +164,7 @@ impl Layouts {
             if !resolved.active[family] {
                 return Vec::new();
             }
-            let colours = self.of(families.binding(family)).colour_count();
+            let colours = self.of(families, family).colour_count();
             (resolved.settings)
                 .projection_order(family, colours)
                 .unwrap_or_default()

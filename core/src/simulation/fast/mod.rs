@@ -211,7 +211,7 @@ impl FastSimulation {
             let set = &body.sets[family];
             let rest = set.rest();
             Batches::new(
-                layouts.of(families.binding(family)),
+                layouts.of(families, family),
                 |element| rest[element as usize] as f32,
                 set.stored_len(),
                 |element| {
@@ -222,7 +222,7 @@ impl FastSimulation {
                 },
             )
         });
-        debug_assert!(layouts.all().iter().all(|l| l.colouring_is_valid(n)));
+        debug_assert!(layouts.all().all(|l| l.colouring_is_valid(n)));
         let positions = take(&state.positions);
         // Without the feature (the page), one thread.
         #[cfg(not(feature = "parallel"))]

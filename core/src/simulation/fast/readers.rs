@@ -34,7 +34,7 @@ impl FastSimulation {
     /// The constraints of `family`, coloured and in batches (empty when it is not active).
     pub fn batches(&self, family: Family) -> FamilyBatches<'_> {
         FamilyBatches {
-            layout: self.layouts.of(self.families.binding(family)),
+            layout: self.layouts.of(&self.families, family),
             batches: &self.sets[family],
         }
     }
@@ -43,7 +43,7 @@ impl FastSimulation {
     /// (lines from another thread, lines) over one sweep ([`super::Layout::lines_from_other_threads`]).
     pub fn lines_from_other_threads(&self, family: Family, threads: usize) -> (usize, usize) {
         self.layouts
-            .of(self.families.binding(family))
+            .of(&self.families, family)
             .lines_from_other_threads(&self.colour_orders[family], threads)
     }
 
@@ -177,7 +177,7 @@ impl FastSimulation {
             * size_of::<Vec3A>()
             + self.inverse_masses.capacity() * size_of::<f32>()
             + (self.original.capacity() + self.renumber.capacity()) * size_of::<u32>()
-            + (self.layouts.all().iter())
+            + (self.layouts.all())
                 .map(|layout| layout.heap_bytes())
                 .sum::<usize>()
             + self

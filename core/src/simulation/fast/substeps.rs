@@ -94,7 +94,7 @@ impl Substeps for OnArrays<'_> {
         let count = s.families.visit_unit(
             unit,
             ProjectUnit {
-                layout: s.layouts.of(s.families.binding(lead)),
+                layout: s.layouts.of(&s.families, lead),
                 order: &s.colour_orders[lead],
                 sets: &mut s.sets,
                 positions: (&mut s.positions, &mut s.residuals),

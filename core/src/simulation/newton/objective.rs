@@ -313,11 +313,7 @@ impl Objective<'_> {
                 start.as_ref().map(|(at, h)| (at, *h)),
             )
         }
-        match arity {
-            2 => at::<2>(self, family, c, x),
-            3 => at::<3>(self, family, c, x),
-            _ => at::<4>(self, family, c, x),
-        }
+        crate::constraints::for_arity!(arity, |N| at::<N>(self, family, c, x))
     }
 
     /// The particles' terms of ∇Φ and of ∇²Φ's diagonal.

@@ -202,7 +202,7 @@ fn scale_to_longest(arrows: &mut [Arrow], length: f64) {
 
 /// The arrows of one projection (the one step-by-step mode is about to make): ∇ₚC at each of its
 /// particles, the longest drawn `gain` × [`GRADIENT_ARROW_LENGTH`] × the mean distance between
-/// them, and the Δx it will apply, `correction_gain` times its true length. Appends to `out`.
+/// them (for one particle, its element's size, [`Projection::size`]), and the Δx it will apply, `correction_gain` times its true length. Appends to `out`.
 pub fn projection_arrows(
     families: &Families,
     positions: &[DVec3],
@@ -221,7 +221,11 @@ pub fn projection_arrows(
             pairs += 1;
         }
     }
-    let size = size / pairs.max(1) as f64;
+    // A particle alone is drawn to its element's size (the longest rest edge at it).
+    let size = match pairs {
+        0 => projection.size,
+        _ => size / pairs as f64,
+    };
     let first = out.len();
     if !projection.degenerate {
         for (&particle, &gradient) in particles.iter().zip(&projection.gradients) {

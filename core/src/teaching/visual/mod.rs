@@ -10,8 +10,8 @@ pub use arrows::{
     along_mode, mode_arrows, projection_arrows, selected_arrows,
 };
 pub use surface::{
-    ALL_FACES_UP_TO, display_edges, display_faces, edge_strips, faces_with_tets, inverted_tets,
-    particle_colours,
+    ALL_FACES_UP_TO, display_edges, display_faces, edge_strips, faces_with_tets,
+    held_particle_colours, inverted_tets, particle_colours,
 };
 
 use crate::constraints::volume::signed_volume;

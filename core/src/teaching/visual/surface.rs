@@ -12,6 +12,22 @@ pub fn inverted_tets(positions: &[DVec3], tets: &[[u32; 4]], out: &mut Vec<bool>
     );
 }
 
+/// Colours each particle that an active family on single particles holds (a pin or a hook of
+/// a file, `applies_to = "particles"`) in that family's colour, where `particle_colours` gave
+/// it [`HEALTHY`] (a particle of an inverted tet stays [`INVERTED`]).
+pub fn held_particle_colours(simulation: &Simulation, out: &mut [Rgba]) {
+    let families = simulation.families();
+    let on_particles = |f: Family| families.binding(f) == crate::constraints::Binding::Particles;
+    for family in (families.all()).filter(|&f| simulation.active()[f] && on_particles(f)) {
+        let colour = family_colour(families, family);
+        for &i in simulation.constraint_particles(family) {
+            if out[i as usize] == HEALTHY {
+                out[i as usize] = colour;
+            }
+        }
+    }
+}
+
 /// A particle's colour: [`INVERTED`] when it belongs to an inverted tet, [`HEALTHY`] otherwise.
 pub fn particle_colours(
     particles: usize,
