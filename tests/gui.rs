@@ -611,6 +611,36 @@ fn open_mesh_file_browses_and_loads_a_mesh() {
     );
 }
 
+/// A scene file of several bodies opened by path: the bodies are simulated and drawn, the ball
+/// launched. The view shows the new scene at once, though the old one was never changed (both
+/// at their first revision: the view once kept drawing the old body).
+#[test]
+fn a_scene_file_of_several_bodies_opens_in_the_view() {
+    let mut harness = workbench("cube", 2);
+    harness.get_by_label("mesh file").click();
+    harness.run_steps(1);
+    harness
+        .get_by_label("mesh file")
+        .type_text("../assets/scenes/thrown.toml");
+    harness.run_steps(1);
+    harness.get_by_label("Open").click();
+    harness.run_steps(3);
+    let bench = &harness.state().bench;
+    assert_eq!(bench.scene.name, "thrown");
+    let names: Vec<&str> = bench
+        .simulation
+        .bodies()
+        .iter()
+        .map(|b| b.name.as_str())
+        .collect();
+    assert_eq!(names, ["cube", "ball", "beam"]);
+    assert!(
+        bench.simulation.velocities().iter().any(|v| v.y == 3.0),
+        "the ball is thrown"
+    );
+    harness.snapshot("scene_file_bodies");
+}
+
 /// A panel and the requests it made, drawn on its own.
 struct Alone {
     panel: Box<dyn tetlab::gui::panels::Panel>,

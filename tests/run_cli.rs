@@ -626,3 +626,41 @@ fn exact_step_says_how_far_each_frame_is_from_the_implicit_step() {
     let output = tetlab(&["run", "--frames", "2", "--exact-step", "--ensemble", "2"]);
     assert_usage_error(&output, "--exact-step");
 }
+
+#[test]
+fn a_scene_file_of_several_bodies_is_run_and_measured_body_by_body() {
+    let scene = asset("scenes/thrown.toml");
+    let lines = json_lines(&["run", "--scene", &scene, "--frames", "2", "--json"]);
+    let bodies = lines[2]["bodies"].as_array().expect("each body's metrics");
+    let names: Vec<&str> = bodies.iter().map(|b| b["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["cube", "ball", "beam"]);
+    // The ball was thrown up: it is the one that moves.
+    assert!(
+        bodies[1]["max_speed"].as_f64().unwrap() > 2.0,
+        "{}",
+        bodies[1]
+    );
+    assert!(
+        bodies[0]["max_speed"].as_f64().unwrap() < 0.1,
+        "{}",
+        bodies[0]
+    );
+    // A scene of one body has none.
+    let one = json_lines(&["run", "--frames", "1", "--json"]);
+    assert!(one[1].get("bodies").is_none(), "{}", one[1]);
+
+    let output = tetlab(&["run", "--scene", &scene, "--frames", "2"]);
+    let text = stdout(&output);
+    assert!(text.contains("scene thrown: 233 particles"), "{text}");
+    assert!(text.contains("body ball: 0 inverted tets"), "{text}");
+
+    // A mistake in the scene file: exit 2, named at its place.
+    let dir = std::env::temp_dir().join(format!("tetlab-run-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "[[body]]\nmesh = \"cube\"\nscale = -1\n").unwrap();
+    let output = tetlab(&["run", "--scene", bad.to_str().unwrap(), "--frames", "1"]);
+    let message = assert_usage_error(&output, "bad.toml:3:9: scale is -1");
+    assert!(!message.contains("panicked"), "{message}");
+    std::fs::remove_dir_all(&dir).ok();
+}

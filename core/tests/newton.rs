@@ -31,6 +31,7 @@ fn apex_tet() -> Scene {
         mesh: TetMesh { positions, tets },
         pinned: vec![0, 1, 2],
         notes: Vec::new(),
+        bodies: Vec::new(),
     }
 }
 

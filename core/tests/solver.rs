@@ -551,6 +551,7 @@ fn a_constraint_its_free_particles_can_barely_change_is_skipped() {
         mesh,
         pinned: vec![1, 2, 3],
         notes: Vec::new(),
+        bodies: Vec::new(),
     };
     let mut settings = settings(families(false, true, false), 0.0);
     settings.substeps = 1;

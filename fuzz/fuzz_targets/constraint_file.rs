@@ -2,7 +2,8 @@
 //! line and column that exist; never a panic, never a stack overflow. Each compiled constraint
 //! is evaluated (C, its gradient by automatic differentiation in both modes and the file's own)
 //! at a regular tet and at coincident points, with what the element stores: the results are
-//! finite or flagged undefined, and evaluating never panics.
+//! finite or flagged undefined, and evaluating never panics; a `where` chooses among the tet's
+//! particles without a panic.
 //!
 //! # A generator for deep and long inputs
 //! Inputs that once crashed the parser (10⁴ nested parentheses, 20,000 unary minuses, a
@@ -69,6 +70,10 @@ fuzz_target!(|data: &[u8]| {
                 DVec3::new(0.0, 0.0, 1.0),
             ];
             for file in &files {
+                // Which particles a file on single particles chooses: any of the tet's, in
+                // order, and never a panic.
+                let chosen = file.chooses(&tet);
+                assert!(chosen.windows(2).all(|w| w[0] < w[1]) && chosen.iter().all(|&i| i < 4));
                 for points in [&tet[..], &[DVec3::ZERO; 4][..]] {
                     let points = &points[..file.arity()];
                     let stored = file.store(&tet[..file.arity()], &material);
@@ -82,6 +87,10 @@ fuzz_target!(|data: &[u8]| {
                     // finite, or degenerate with zero gradients.
                     for own in [false, true] {
                         let (value, gradients, degenerate) = match points.len() {
+                            1 => {
+                                let e = file.evaluate_by(&[points[0]], rest, &stored, own);
+                                (e.value, e.gradients.to_vec(), e.degenerate)
+                            }
                             2 => {
                                 let e =
                                     file.evaluate_by(&[points[0], points[1]], rest, &stored, own);

@@ -93,6 +93,39 @@ pub struct FrameRecord {
     /// Whether edits settle (frame 0).
     #[serde(skip_serializing_if = "Option::is_none")]
     edits_settle: Option<bool>,
+    /// Of a scene file of several bodies: each body's metrics.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    bodies: Vec<BodyRecord>,
+}
+
+/// One body's metrics in a frame of a scene of several (`--scene FILE.toml`).
+#[derive(Debug, Serialize)]
+pub struct BodyRecord {
+    name: String,
+    inverted_tets: usize,
+    min_volume_ratio: f64,
+    volume_error: f64,
+    max_edge_strain: f64,
+    max_speed: f64,
+    /// Its centre of mass, m.
+    centre_of_mass: [f64; 3],
+}
+
+impl BodyRecord {
+    /// The records of each body of `simulation`'s scene; none for a scene of one body.
+    pub fn of(simulation: &Simulation) -> Vec<BodyRecord> {
+        (Metrics::measure_bodies(simulation).into_iter())
+            .map(|(name, m)| BodyRecord {
+                name,
+                inverted_tets: m.inverted_tets,
+                min_volume_ratio: m.min_volume_ratio,
+                volume_error: m.volume_error,
+                max_edge_strain: m.max_edge_strain,
+                max_speed: m.max_speed,
+                centre_of_mass: m.centre_of_mass.to_array(),
+            })
+            .collect()
+    }
 }
 
 impl FrameRecord {
@@ -162,6 +195,7 @@ impl FrameRecord {
             threads: first.then(|| simulation.threads()),
             order_seed: first.then_some(settings.settings.order_seed),
             edits_settle: first.then(|| settings.edits_settle()),
+            bodies: BodyRecord::of(simulation),
         }
     }
 }
@@ -249,6 +283,20 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             outcome.horizontal_displacement()
         )
         .map_err(io)?;
+        for body in BodyRecord::of(&simulation) {
+            let [x, y, z] = body.centre_of_mass;
+            writeln!(
+                out,
+                "body {}: {} inverted tets, min V/V0 {:.4}, max edge strain {:.3e}, largest speed \
+                 {:.3} m/s, centre of mass at ({x:.3}, {y:.3}, {z:.3}) m",
+                body.name,
+                body.inverted_tets,
+                body.min_volume_ratio,
+                body.max_edge_strain,
+                body.max_speed
+            )
+            .map_err(io)?;
+        }
         for line in super::simulation_args::describe_skipped(&simulation) {
             writeln!(out, "{line}").map_err(io)?;
         }

@@ -1,6 +1,7 @@
 //! The seam between the workbench and files, so that the rest of the GUI never touches the file
 //! system (a browser has none). A `.toml` file is a constraint file when it says what it
-//! `applies_to`, and a lesson otherwise; anything else a mesh.
+//! `applies_to`, a scene of several bodies when it has `[[body]]` tables, and a lesson
+//! otherwise; anything else a mesh.
 
 use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::scene::Scene;
@@ -8,7 +9,7 @@ use tetlab_core::teaching::lesson::Lesson;
 
 /// What a file held.
 pub enum Opened {
-    /// A mesh, as a scene.
+    /// A mesh, or a scene file of several bodies, as a scene.
     Scene(Scene),
     /// A lesson.
     Lesson(Box<Lesson>),
@@ -89,6 +90,10 @@ fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
             path: name.to_owned(),
             text: text.to_owned(),
         }),
+        // Its bodies' mesh files are read beside it (in a browser only built-ins can be).
+        "toml" if Scene::looks_like_file(text) => Scene::parse_file(name, text)
+            .map(Opened::Scene)
+            .map_err(|e| e.to_string()),
         "toml" => Lesson::parse(name, text)
             .map(|lesson| Opened::Lesson(Box::new(lesson)))
             .map_err(|e| e.to_string()),
@@ -106,7 +111,7 @@ fn open_bytes(name: &std::path::Path, bytes: &[u8]) -> Result<Opened, String> {
             name.display()
         )),
         _ => Err(format!(
-            "{}: not a mesh (.msh), a lesson or a constraint file (.toml)",
+            "{}: not a mesh (.msh), a lesson, a constraint file or a scene file (.toml)",
             name.display()
         )),
     }

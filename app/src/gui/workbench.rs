@@ -200,7 +200,11 @@ impl Workbench {
     /// Replaces the scene, keeping the settings.
     pub fn load(&mut self, scene: Scene) {
         let families = self.simulation.families().clone();
+        // A revision the view has not drawn: a new workbench's would start again where the
+        // old one's may have stood, and the view would keep showing the old scene.
+        let revision = self.revision + 1;
         *self = Workbench::with_families(scene, *self.simulation.settings(), families);
+        self.revision = self.revision.max(revision);
     }
 
     /// After a played frame that took `took`: where the Newton reference stepped it (as the

@@ -13,6 +13,7 @@ use super::selection::{Selection, SelectionError};
 use super::{ConstraintFile, ConstraintFileError, GradeOnce, Stiffness};
 use crate::constraints::Binding;
 use crate::input::text_file;
+use crate::input::text_file::position;
 use std::collections::BTreeMap;
 use std::path::Path;
 use toml::Spanned;
@@ -532,15 +533,6 @@ fn hessian_key(key: &str, arity: usize) -> Option<(usize, usize)> {
     let (i, j) = rest.split_once('p')?;
     let (i, j) = (i.parse::<usize>().ok()?, j.parse::<usize>().ok()?);
     (i < arity && j < arity && key.len() == 4).then_some((i, j))
-}
-
-/// Line and column (from 1, in characters) of byte `offset` of `text`.
-pub(super) fn position(text: &str, offset: usize) -> (usize, usize) {
-    let offset = offset.min(text.len());
-    let before = &text[..text.floor_char_boundary(offset)];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
 }
 
 /// The byte of `text` that byte `offset` of a TOML string's content comes from, the string's

@@ -23,6 +23,21 @@ pub(crate) fn without_byte_order_mark(text: &str) -> &str {
     text.strip_prefix(BYTE_ORDER_MARK).unwrap_or(text)
 }
 
+/// Line and column (from 1, in characters) of byte `offset` of `text`: where an error in a
+/// user's file is placed.
+///
+/// ```
+/// use tetlab_core::input::text_file::position;
+/// assert_eq!(position("a = 1\nbé = x\n", 10), (2, 4), "é is one character of two bytes");
+/// ```
+pub fn position(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text[..text.floor_char_boundary(offset)];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
 /// `bytes` as text.
 ///
 /// ```

@@ -8,6 +8,7 @@ use crate::constraints::{Constraint, Families, Family, PerFamily, SubstepStart, 
 use crate::simulation::divergence::{Cause, Divergence};
 use crate::simulation::{ConstraintSet, Simulation};
 use glam::DVec3;
+use std::ops::Range;
 
 /// Rest volumes at or below this fraction of the mean rest volume are left out of
 /// [`Metrics::min_volume_ratio`]: V/V₀ of a tet that had no volume means nothing.
@@ -85,8 +86,30 @@ impl Metrics {
 
     /// Measures the current state of `simulation`.
     pub fn measure(simulation: &Simulation) -> Metrics {
+        let whole = 0..simulation.positions().len() as u32;
+        Metrics::measure_part(simulation, whole, 0..simulation.tets().len() as u32)
+    }
+
+    /// Measures each body of a scene of several ([`Simulation::bodies`]) on its own: its name
+    /// and its metrics. Empty for a scene of one body.
+    pub fn measure_bodies(simulation: &Simulation) -> Vec<(String, Metrics)> {
+        (simulation.bodies().iter())
+            .map(|body| {
+                let part = body.particles.clone();
+                let metrics = Metrics::measure_part(simulation, part, body.tets.clone());
+                (body.name.clone(), metrics)
+            })
+            .collect()
+    }
+
+    /// The metrics of the particles `particles` and the tets `tets` of `simulation`: of one
+    /// body, whose elements have no particle outside it (an element is counted where its
+    /// first particle is).
+    fn measure_part(simulation: &Simulation, particles: Range<u32>, tets: Range<u32>) -> Metrics {
         let positions = simulation.positions();
-        let rest_volumes = simulation.constraints(Family::VOLUME).rest();
+        let range = particles.start as usize..particles.end as usize;
+        let tet_range = tets.start as usize..tets.end as usize;
+        let rest_volumes = &simulation.constraints(Family::VOLUME).rest()[tet_range.clone()];
         let total_rest: f64 = rest_volumes.iter().sum();
         // The scale of "a sliver": the mean size of a rest volume (a degenerate tet may be a hair
         // negative, and a mesh of them could make a signed mean negative or zero).
@@ -95,7 +118,7 @@ impl Metrics {
         let mut inverted_tets = 0;
         let mut min_volume_ratio: Option<f64> = None;
         let mut total = 0.0;
-        for (tet, &rest) in simulation.tets().iter().zip(rest_volumes) {
+        for (tet, &rest) in simulation.tets()[tet_range].iter().zip(rest_volumes) {
             let v = signed_volume(&tet.map(|i| positions[i as usize]));
             total += v;
             if v < 0.0 {
@@ -109,7 +132,7 @@ impl Metrics {
         let mut max_edge_strain: f64 = 0.0;
         let edges = simulation.constraints(Family::EDGES);
         for (c, &rest) in edges.rest().iter().enumerate() {
-            if rest > 0.0 {
+            if rest > 0.0 && particles.contains(&edges.particles(c)[0]) {
                 let [a, b] = [edges.particles(c)[0], edges.particles(c)[1]];
                 let length = positions[a as usize].distance(positions[b as usize]);
                 max_edge_strain = larger(max_edge_strain, (length - rest).abs() / rest);
@@ -124,17 +147,14 @@ impl Metrics {
                 0.0
             },
             max_edge_strain,
-            max_displacement: positions
-                .iter()
-                .zip(simulation.rest_positions())
+            max_displacement: (positions[range.clone()].iter())
+                .zip(&simulation.rest_positions()[range.clone()])
                 .map(|(p, r)| p.distance(*r))
                 .fold(0.0, larger),
-            max_speed: simulation
-                .velocities()
-                .iter()
+            max_speed: (simulation.velocities()[range.clone()].iter())
                 .map(|v| v.length())
                 .fold(0.0, larger),
-            centre_of_mass: simulation.centre_of_mass(positions),
+            centre_of_mass: simulation.centre_of_mass_of(positions, range),
             residual: simulation.families().per_family(|family| {
                 simulation.families().visit(
                     family,
@@ -142,6 +162,7 @@ impl Metrics {
                         set: simulation.constraints(family),
                         positions,
                         rest_positions: simulation.rest_positions(),
+                        particles: particles.clone(),
                     },
                 )
             }),
@@ -172,6 +193,8 @@ struct Rms<'a> {
     set: &'a ConstraintSet,
     positions: &'a [DVec3],
     rest_positions: &'a [DVec3],
+    /// Only the constraints whose first particle is among these.
+    particles: Range<u32>,
 }
 
 impl Visit for Rms<'_> {
@@ -182,7 +205,12 @@ impl Visit for Rms<'_> {
         if set.is_empty() {
             return 0.0;
         }
-        let sum: f64 = (0..set.len())
+        let mine = (0..set.len()).filter(|&c| self.particles.contains(&set.particles(c)[0]));
+        let count = mine.clone().count();
+        if count == 0 {
+            return 0.0;
+        }
+        let sum: f64 = mine
             .map(|c| {
                 let idx: [u32; N] = std::array::from_fn(|k| set.particles(c)[k]);
                 let p = idx.map(|i| self.positions[i as usize]);
@@ -200,7 +228,7 @@ impl Visit for Rms<'_> {
                     .powi(2)
             })
             .sum();
-        (sum / set.len() as f64).sqrt()
+        (sum / count as f64).sqrt()
     }
 }
 

@@ -1,9 +1,12 @@
 //! Scenes: a rest mesh plus which particles are pinned. Built-in scenes are generated in code;
-//! any TetGen or Gmsh file can be loaded as a scene. [`Perturbation`]s deform a scene's current
+//! any TetGen or Gmsh file can be loaded as a scene, and a scene file (TOML) places several
+//! bodies, each launched with its own velocity ([`SceneBody`]). [`Perturbation`]s deform a scene's current
 //! positions to set up an experiment (invert one tet, mirror the body, flatten it, scramble it). [`mesh`]
 //! holds the tet mesh and its file formats.
 
 pub mod mesh;
+mod scene_file;
+pub use scene_file::{MAX_PLACEMENT, SceneBody};
 
 use crate::constraints::volume::signed_volume;
 use crate::input::limits;
@@ -83,6 +86,9 @@ pub struct Scene {
     pub pinned: Vec<u32>,
     /// What loading changed or noticed, one line each.
     pub notes: Vec<String>,
+    /// The bodies of a scene file, which parts of the mesh are each's; empty for a scene of one
+    /// body (a built-in, a mesh file), which starts at rest.
+    pub bodies: Vec<SceneBody>,
 }
 
 /// Why a scene could not be made.
@@ -101,6 +107,15 @@ pub enum SceneError {
     },
     /// The file could not be loaded.
     Mesh(MeshError),
+    /// A mistake in a scene file: where (line and column from 1) and what.
+    File {
+        /// The scene file.
+        path: std::path::PathBuf,
+        /// Line and column, when one is to blame.
+        at: Option<(usize, usize)>,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 impl fmt::Display for SceneError {
@@ -108,7 +123,8 @@ impl fmt::Display for SceneError {
         match self {
             SceneError::Unknown(spec) => write!(
                 f,
-                "'{spec}' is neither a built-in scene (tet, cube, beam, ball) nor an existing file"
+                "'{spec}' is neither a built-in scene (tet, cube, beam, ball) nor an existing file \
+                 (a mesh, .node/.ele/.msh, or a scene file, .toml)"
             ),
             SceneError::Resolution(why) => f.write_str(why),
             SceneError::TooLarge {
@@ -125,6 +141,12 @@ impl fmt::Display for SceneError {
                 builtin.largest_resolution()
             ),
             SceneError::Mesh(e) => e.fmt(f),
+            SceneError::File { path, at, message } => match at {
+                Some((line, column)) => {
+                    write!(f, "{}:{line}:{column}: {message}", path.display())
+                }
+                None => write!(f, "{}: {message}", path.display()),
+            },
         }
     }
 }
@@ -132,7 +154,8 @@ impl fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 impl Scene {
-    /// A built-in scene by name, or a mesh file (`.node`, `.ele`, `.msh`) by path.
+    /// A built-in scene by name, a mesh file (`.node`, `.ele`, `.msh`) or a scene file of
+    /// several bodies (`.toml`, [`Scene::load_file`]) by path.
     pub fn from_spec(spec: &str, resolution: u32) -> Result<Scene, SceneError> {
         if let Some(builtin) = Builtin::from_name(spec) {
             return Scene::builtin(builtin, resolution);
@@ -140,6 +163,9 @@ impl Scene {
         let path = Path::new(spec);
         if !crate::input::text_file::available(path) {
             return Err(SceneError::Unknown(spec.to_owned()));
+        }
+        if Scene::is_scene_file(spec) {
+            return Scene::load_file(path);
         }
         Scene::load(path).map_err(SceneError::Mesh)
     }
@@ -186,6 +212,7 @@ impl Scene {
             mesh,
             pinned,
             notes: Vec::new(),
+            bodies: Vec::new(),
         })
     }
 
@@ -222,6 +249,7 @@ impl Scene {
             mesh,
             pinned: Vec::new(),
             notes,
+            bodies: Vec::new(),
         }
     }
 }

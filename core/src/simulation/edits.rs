@@ -49,11 +49,15 @@ impl Simulation {
         self.settling = Some(0);
     }
 
-    /// Back to the rest shape, at rest, at frame 0.
+    /// Back to the rest shape, at frame 0: at rest, or as a scene file's bodies were launched
+    /// (each with its velocity).
     pub fn reset(&mut self) {
         let (_, body, state) = self.edit();
         state.positions.copy_from_slice(&body.rest_positions);
         stop(state);
+        if !body.start_velocities.is_empty() {
+            state.velocities.copy_from_slice(&body.start_velocities);
+        }
         state.taken = super::Taken::default();
         self.skipped = Default::default();
         self.settling = None;

@@ -49,12 +49,13 @@ pub use settling::VIOLATED;
 pub use state::{Body, Grab, Revision, State, Taken};
 
 use crate::constraints::{Families, Family, PerFamily};
-use crate::scene::Scene;
 use crate::scene::mesh::TetMesh;
+use crate::scene::{Scene, SceneBody};
 use crate::simulation::divergence::Divergence;
 use crate::simulation::projection::SkipCounts;
 use engine_slot::EngineSlot;
 use glam::DVec3;
+use std::ops::Range;
 
 /// An edit has settled when the speed the corrections of a frame would give a particle, ΣΔp / h
 /// over its substeps, is at most this many mean rest edge lengths per second (plus what gravity
@@ -124,6 +125,8 @@ impl Simulation {
             plane_strain: false,
             mean_edge,
             sets,
+            start_velocities: start_velocities(scene),
+            bodies: scene.bodies.clone(),
         };
         let mut state = State::at_rest(&body);
         for &i in &scene.pinned {
@@ -324,6 +327,12 @@ impl Simulation {
         &self.state.inverse_masses
     }
 
+    /// The bodies of a scene file, which particles and tets are each's; empty for a scene of one
+    /// body.
+    pub fn bodies(&self) -> &[SceneBody] {
+        &self.body.bodies
+    }
+
     /// The tets, as indices into the positions.
     pub fn tets(&self) -> &[[u32; 4]] {
         &self.body.tets
@@ -401,9 +410,15 @@ impl Simulation {
     /// assert!((centre - glam::DVec3::new(0.0, 0.5, 0.0)).length() < 1e-12);
     /// ```
     pub fn centre_of_mass(&self, positions: &[DVec3]) -> DVec3 {
+        self.centre_of_mass_of(positions, 0..positions.len())
+    }
+
+    /// [`Simulation::centre_of_mass`] of the particles `particles` alone (one body's).
+    pub fn centre_of_mass_of(&self, positions: &[DVec3], particles: Range<usize>) -> DVec3 {
         let mut weighted = DVec3::ZERO;
         let mut mass = 0.0;
-        for (p, w) in positions.iter().zip(&self.body.lumped_inverse_masses) {
+        let masses = &self.body.lumped_inverse_masses[particles.clone()];
+        for (p, w) in positions[particles].iter().zip(masses) {
             weighted += *p / *w;
             mass += 1.0 / *w;
         }
@@ -453,4 +468,23 @@ impl Simulation {
     pub fn constraints(&self, family: Family) -> &ConstraintSet {
         &self.body.sets[family]
     }
+}
+
+/// Each particle's velocity at the start: its body's in a scene file ([`Scene::bodies`]), 0 for
+/// a pinned one; empty for a scene that starts at rest.
+fn start_velocities(scene: &Scene) -> Vec<DVec3> {
+    if scene.bodies.iter().all(|b| b.velocity == DVec3::ZERO) {
+        return Vec::new();
+    }
+    let mut velocities = vec![DVec3::ZERO; scene.mesh.positions.len()];
+    for body in &scene.bodies {
+        for i in body.particles.clone() {
+            velocities[i as usize] = body.velocity;
+        }
+    }
+    // A pinned particle stays where it is.
+    for &i in &scene.pinned {
+        velocities[i as usize] = DVec3::ZERO;
+    }
+    velocities
 }

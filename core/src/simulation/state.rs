@@ -47,6 +47,10 @@ pub struct Body {
     /// The constraints of each family, as its binding makes them (those of a family the
     /// simulation has not used are not built).
     pub sets: PerFamily<ConstraintSet>,
+    /// Each particle's velocity at the start (the scene file's bodies'); empty: at rest.
+    pub start_velocities: Vec<DVec3>,
+    /// The bodies of a scene file; empty for a scene of one body.
+    pub bodies: Vec<crate::scene::SceneBody>,
 }
 
 /// Where the particles are and how they move, in f64 and in the scene's numbering.
@@ -149,7 +153,10 @@ impl State {
         State {
             positions: body.rest_positions.clone(),
             previous: body.rest_positions.clone(),
-            velocities: vec![DVec3::ZERO; n],
+            velocities: match body.start_velocities.len() {
+                0 => vec![DVec3::ZERO; n],
+                _ => body.start_velocities.clone(),
+            },
             inverse_masses: body.lumped_inverse_masses.clone(),
             pinned: vec![false; n],
             corrections: vec![DVec3::ZERO; n],

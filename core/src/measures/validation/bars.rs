@@ -87,6 +87,7 @@ fn hanging_bar(trial: &mut Trial) -> Result<Vec<Check>, Stop> {
             mesh,
             pinned: top.iter().map(|&i| i as u32).collect(),
             notes: Vec::new(),
+            bodies: Vec::new(),
         };
         let settings = HANGING.settings(material, GRAVITY, size);
         let mut simulation = trial.simulation(&format!("resolution-{n}"), &scene, settings);

@@ -185,6 +185,7 @@ fn membrane(
         mesh,
         pinned: left,
         notes: Vec::new(),
+        bodies: Vec::new(),
     };
     let material = Material {
         young: STIFFNESS * (1.0 - nu * nu),

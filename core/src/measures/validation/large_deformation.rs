@@ -108,6 +108,7 @@ fn scene(name: &str, mesh: crate::scene::mesh::TetMesh) -> Scene {
         mesh,
         pinned: Vec::new(),
         notes: Vec::new(),
+        bodies: Vec::new(),
     }
 }
 

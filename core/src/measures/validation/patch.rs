@@ -73,6 +73,7 @@ fn run(trial: &mut Trial) -> Result<Vec<Check>, Stop> {
         mesh,
         pinned: boundary.clone(),
         notes: Vec::new(),
+        bodies: Vec::new(),
     };
     let settings = PROTOCOL.settings(Material::default(), 0.0, size);
     let mut simulation = trial.simulation("block", &scene, settings);

@@ -64,6 +64,7 @@ fn run(trial: &mut Trial) -> Result<Vec<Check>, Stop> {
         mesh,
         pinned: left.iter().chain(&right).map(|&i| i as u32).collect(),
         notes: Vec::new(),
+        bodies: Vec::new(),
     };
     let settings = PROTOCOL.settings(material, 0.0, size);
     let mut simulation = trial.simulation(&format!("resolution-{n}"), &scene, settings);

@@ -321,7 +321,7 @@ pub(super) fn reflow(text: &str) -> String {
 
 /// The line (from 1) of byte offset `at`.
 pub(super) fn line_of(text: &str, at: usize) -> usize {
-    text[..at.min(text.len())].matches('\n').count() + 1
+    crate::input::text_file::position(text, at).0
 }
 
 pub(super) fn finite(text: &str) -> Result<f64, String> {

@@ -1,0 +1,307 @@
+//! A scene of several bodies written as a file (TOML): each body a built-in scene or a mesh file,
+//! placed (scaled, turned, moved) and launched with a velocity of its own ([`Scene::load_file`]).
+//! The bodies become one mesh whose parts share no particle, so that every engine, metric and
+//! front end runs them as it runs one body; [`SceneBody`] says which particles and tets are
+//! whose.
+//!
+//! # The file
+//! ```toml
+//! name = "two cubes"          # optional: the file's name without .toml otherwise
+//! [[body]]
+//! name = "lower"              # optional: body1, body2, … otherwise
+//! mesh = "cube"               # a built-in (tet, cube, beam, ball) or a mesh file, relative to this file
+//! resolution = 2              # optional, for cube, beam and ball (4 otherwise)
+//! scale = 1.0                 # optional: about the mesh's centre (its box's), > 0
+//! rotate = [0, 0, 0]          # optional: degrees about x, then y, then z, about the centre
+//! translate = [0, 0, 0]       # optional: metres, from where the mesh puts it
+//! velocity = [0, 0, 0]        # optional: m/s, every particle of the body at the start
+//! [[body]]
+//! mesh = "cube"
+//! translate = [0, 1.5, 0]
+//! ```
+//! A scene that reaches below the ground (y < 0) is lifted as a whole to rest on it, and the
+//! notes say so. Every mistake is named at file:line:column.
+
+use super::mesh::TetMesh;
+use super::{Builtin, Scene, SceneError};
+use crate::input::limits;
+use crate::input::text_file;
+use glam::{DMat3, DVec3};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// One body of a scene of several: its name, which particles and tets of the scene's mesh are
+/// its, and the velocity it starts with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneBody {
+    /// Its name (the file's `name`, or `body1`, `body2`, …).
+    pub name: String,
+    /// Its particles, consecutive in the scene's mesh.
+    pub particles: Range<u32>,
+    /// Its tets, consecutive in the scene's mesh.
+    pub tets: Range<u32>,
+    /// The velocity of each of its particles at the start, in m/s.
+    pub velocity: DVec3,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    #[serde(default)]
+    name: Option<Spanned<String>>,
+    #[serde(default)]
+    body: Vec<RawBody>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBody {
+    #[serde(default)]
+    name: Option<Spanned<String>>,
+    mesh: Spanned<String>,
+    #[serde(default)]
+    resolution: Option<Spanned<u32>>,
+    #[serde(default)]
+    scale: Option<Spanned<f64>>,
+    #[serde(default)]
+    rotate: Option<Spanned<[f64; 3]>>,
+    #[serde(default)]
+    translate: Option<Spanned<[f64; 3]>>,
+    #[serde(default)]
+    velocity: Option<Spanned<[f64; 3]>>,
+}
+
+/// The largest |coordinate| a placement or a velocity may give, in metres or m/s: far beyond any
+/// scene, and far inside what f32 (the fast engine) holds with room for its products.
+pub const MAX_PLACEMENT: f64 = 1e6;
+
+impl Scene {
+    /// Whether `spec` names a scene file (`.toml`) rather than a built-in scene or a mesh.
+    pub fn is_scene_file(spec: &str) -> bool {
+        Path::new(spec)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+    }
+
+    /// Whether TOML `text` is meant as a scene file (it has `[[body]]` tables) rather than a
+    /// lesson or a constraint file; also when it has a mistake, so that the mistake is reported
+    /// as a scene file's.
+    ///
+    /// ```
+    /// use tetlab_core::scene::Scene;
+    /// assert!(Scene::looks_like_file("[[body]]\nmesh = \"cube\"\n"));
+    /// assert!(Scene::looks_like_file("[[body]]\nmesh = \n"));
+    /// assert!(!Scene::looks_like_file("title = \"a lesson\"\nscene = \"cube\"\n"));
+    /// ```
+    pub fn looks_like_file(text: &str) -> bool {
+        match toml::from_str::<toml::Table>(text) {
+            Ok(table) => table.contains_key("body"),
+            Err(_) => text.lines().any(|line| line.trim() == "[[body]]"),
+        }
+    }
+
+    /// Reads a scene of several bodies from `path` (see the module).
+    ///
+    /// ```
+    /// use tetlab_core::scene::Scene;
+    /// let text = "[[body]]\nmesh = \"cube\"\nresolution = 1\n\
+    ///             [[body]]\nmesh = \"cube\"\nresolution = 1\ntranslate = [0, 2, 0]\nvelocity = [0, -1, 0]\n";
+    /// let scene = Scene::parse_file(std::path::Path::new("two.toml"), text).unwrap();
+    /// assert_eq!(scene.bodies.len(), 2);
+    /// assert_eq!(scene.mesh.positions.len(), 16, "two cubes of one cell");
+    /// assert_eq!(scene.bodies[1].particles, 8..16);
+    /// assert_eq!(scene.mesh.positions[8].y, 2.0);
+    /// ```
+    pub fn load_file(path: &Path) -> Result<Scene, SceneError> {
+        let text = text_file::read(path).map_err(|e| SceneError::File {
+            path: path.to_owned(),
+            at: e.line.map(|l| (l, 1)),
+            message: e.message,
+        })?;
+        Scene::parse_file(path, &text)
+    }
+
+    /// [`Scene::load_file`] of the text `text` (`path` names it in errors and is where its mesh
+    /// files are looked for).
+    pub fn parse_file(path: &Path, text: &str) -> Result<Scene, SceneError> {
+        let text = text_file::without_byte_order_mark(text);
+        let error = |offset: Option<usize>, message: String| SceneError::File {
+            path: path.to_owned(),
+            at: offset.map(|o| text_file::position(text, o)),
+            message,
+        };
+        let raw: RawScene = toml::from_str(text).map_err(|e| {
+            let message = e.message().trim().replace('\n', " ");
+            error(e.span().map(|s| s.start), message)
+        })?;
+        if raw.body.is_empty() {
+            return Err(error(
+                None,
+                "no body: give each as a [[body]] table with its mesh (mesh = \"cube\")".into(),
+            ));
+        }
+        let folder = path.parent().unwrap_or(Path::new(""));
+        let mut scene = Scene {
+            name: match &raw.name {
+                Some(name) => name.get_ref().trim().to_owned(),
+                None => path
+                    .file_stem()
+                    .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned()),
+            },
+            mesh: TetMesh {
+                positions: Vec::new(),
+                tets: Vec::new(),
+            },
+            pinned: Vec::new(),
+            notes: Vec::new(),
+            bodies: Vec::new(),
+        };
+        for (k, body) in raw.body.iter().enumerate() {
+            let name = match &body.name {
+                Some(name) if !name.get_ref().trim().is_empty() => name.get_ref().trim().to_owned(),
+                Some(name) => return Err(error(Some(name.span().start), "an empty name".into())),
+                None => format!("body{}", k + 1),
+            };
+            if scene.bodies.iter().any(|b: &SceneBody| b.name == name) {
+                let at = body.name.as_ref().map(|n| n.span().start);
+                return Err(error(at, format!("two bodies are named \"{name}\"")));
+            }
+            let part = body_scene(body, folder).map_err(|e| match e {
+                // A mistake of the mesh file is its own file's, with its own place.
+                SceneError::Mesh(e) => SceneError::Mesh(e),
+                other => error(Some(body.mesh.span().start), other.to_string()),
+            })?;
+            let placement = placement(body).map_err(|(at, message)| error(Some(at), message))?;
+            let velocity = match &body.velocity {
+                Some(v) => finite_vector(v, "velocity", "m/s")
+                    .map_err(|(at, message)| error(Some(at), message))?,
+                None => DVec3::ZERO,
+            };
+            let total = scene.mesh.tets.len() + part.mesh.tets.len();
+            if total > limits::MAX_TETS {
+                return Err(error(
+                    Some(body.mesh.span().start),
+                    format!(
+                        "with this body the scene has {total} tets, more than the {} tetlab \
+                         simulates",
+                        limits::MAX_TETS
+                    ),
+                ));
+            }
+            scene.add(name, part, placement, velocity);
+        }
+        scene.lift_onto_the_ground();
+        Ok(scene)
+    }
+
+    /// Appends `part` as a body named `name`, placed by `placement`, starting at `velocity`.
+    fn add(&mut self, name: String, part: Scene, placement: Placement, velocity: DVec3) {
+        let first = self.mesh.positions.len() as u32;
+        let first_tet = self.mesh.tets.len() as u32;
+        let (lo, hi) = super::mesh::bounds(&part.mesh.positions);
+        let centre = 0.5 * (lo + hi);
+        self.mesh.positions.extend(
+            part.mesh
+                .positions
+                .iter()
+                .map(|&p| centre + placement.translate + placement.turn * (p - centre)),
+        );
+        self.mesh
+            .tets
+            .extend(part.mesh.tets.iter().map(|t| t.map(|i| i + first)));
+        self.pinned.extend(part.pinned.iter().map(|&i| i + first));
+        self.notes
+            .extend(part.notes.iter().map(|note| format!("{name}: {note}")));
+        self.bodies.push(SceneBody {
+            name,
+            particles: first..self.mesh.positions.len() as u32,
+            tets: first_tet..self.mesh.tets.len() as u32,
+            velocity,
+        });
+    }
+
+    /// Lifts the whole scene to rest on the ground when a part of it is below (y < 0).
+    fn lift_onto_the_ground(&mut self) {
+        let lowest = (self.mesh.positions.iter()).fold(f64::INFINITY, |low, p| low.min(p.y));
+        if lowest < 0.0 {
+            for p in &mut self.mesh.positions {
+                p.y -= lowest;
+            }
+            self.notes.push(format!(
+                "the scene reached {lowest:.4} below the ground: lifted as a whole to rest on it"
+            ));
+        }
+    }
+}
+
+/// How a body is placed: x ↦ centre + translate + turn (x − centre), turn = R · scale.
+struct Placement {
+    turn: DMat3,
+    translate: DVec3,
+}
+
+/// The body's mesh as a scene of its own: a built-in at its resolution, or a mesh file found
+/// beside the scene file.
+fn body_scene(body: &RawBody, folder: &Path) -> Result<Scene, SceneError> {
+    let spec = body.mesh.get_ref().trim();
+    let resolution = body.resolution.as_ref().map_or(4, |r| *r.get_ref());
+    if let Some(builtin) = Builtin::from_name(spec) {
+        return Scene::builtin(builtin, resolution);
+    }
+    let path: PathBuf = folder.join(spec);
+    if !text_file::available(&path) {
+        return Err(SceneError::Unknown(path.display().to_string()));
+    }
+    Scene::load(&path).map_err(SceneError::Mesh)
+}
+
+fn placement(body: &RawBody) -> Result<Placement, (usize, String)> {
+    let scale = match &body.scale {
+        Some(s) => {
+            let value = *s.get_ref();
+            if !(value.is_finite() && value > 0.0 && value <= MAX_PLACEMENT) {
+                return Err((
+                    s.span().start,
+                    format!(
+                        "scale is {value}: it must be above 0 (a mirror is a perturbation, not a \
+                         placement) and at most {MAX_PLACEMENT:e}"
+                    ),
+                ));
+            }
+            value
+        }
+        None => 1.0,
+    };
+    let degrees = match &body.rotate {
+        Some(r) => finite_vector(r, "rotate", "degrees")?,
+        None => DVec3::ZERO,
+    };
+    let radians = degrees * (std::f64::consts::PI / 180.0);
+    let rotation = DMat3::from_rotation_z(radians.z)
+        * DMat3::from_rotation_y(radians.y)
+        * DMat3::from_rotation_x(radians.x);
+    let translate = match &body.translate {
+        Some(t) => finite_vector(t, "translate", "m")?,
+        None => DVec3::ZERO,
+    };
+    Ok(Placement {
+        turn: rotation * scale,
+        translate,
+    })
+}
+
+/// A vector of the file, each component finite and within [`MAX_PLACEMENT`].
+fn finite_vector(v: &Spanned<[f64; 3]>, what: &str, unit: &str) -> Result<DVec3, (usize, String)> {
+    let value = DVec3::from_array(*v.get_ref());
+    if value.is_finite() && value.abs().max_element() <= MAX_PLACEMENT {
+        return Ok(value);
+    }
+    Err((
+        v.span().start,
+        format!(
+            "{what} is {:?}: each component must be a finite number of {unit} within ±{MAX_PLACEMENT:e}",
+            v.get_ref()
+        ),
+    ))
+}
