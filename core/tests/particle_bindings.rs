@@ -14,12 +14,9 @@ use tetlab_core::constraints::{Families, Family};
 use tetlab_core::scene::{Builtin, Scene};
 use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
-fn example(name: &str) -> ConstraintFile {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../assets/constraints")
-        .join(name);
-    ConstraintFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
-}
+#[path = "support/example_files.rs"]
+mod example_files;
+use example_files::example;
 
 #[test]
 fn where_chooses_particles_by_their_rest_positions_on_any_mesh() {

@@ -3,20 +3,15 @@
 //! and the bending and surface-area examples of `assets/constraints` simulated on both engines.
 
 use glam::DVec3;
-use std::path::Path;
-use tetlab_core::constraint_file::ConstraintFile;
 use tetlab_core::constraints::{Binding, Families, PerFamily};
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::scene::{Builtin, Scene};
 use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
-fn example(name: &str) -> ConstraintFile {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../assets/constraints")
-        .join(name);
-    ConstraintFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
-}
+#[path = "support/example_files.rs"]
+mod example_files;
+use example_files::example;
 
 #[test]
 fn surface_triangles_are_wound_outwards() {
