@@ -97,6 +97,17 @@ fn a_mistake_in_where_is_named_at_its_place() {
         "value = \"length(p0 - q0)\"\n[gradient]\np1 = \"p0\"\n",
     );
     assert!(e.contains("this binding has particle p0 only"), "{e}");
+    // Each projection is one particle's: no pair.
+    let e = mistake(
+        "particles",
+        "q0.y > 1",
+        "pair = [\"a\", \"b\"]\n[[constraint]]\nname = \"a\"\nvalue = \"p0.x\"\n\
+         [[constraint]]\nname = \"b\"\nvalue = \"p0.y\"\n",
+    );
+    assert!(
+        e.starts_with("w.toml:4:8:") && e.contains("each alone"),
+        "{e}"
+    );
 }
 
 /// The beam (its end at x = 0 held by the scene) with soft edges, `file`'s family active or

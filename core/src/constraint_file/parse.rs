@@ -255,6 +255,15 @@ pub(super) fn parse_all(
         files.push(file);
     }
     if let Some(pair) = &raw.pair {
+        // A pin's projection is one particle's: nothing to share with another's.
+        if binding == Binding::Particles {
+            return Err(error(
+                Some(pair.span().start),
+                "`pair` projects two constraints together, and a file on single particles \
+                 (applies_to = \"particles\") projects each alone"
+                    .to_owned(),
+            ));
+        }
         let names = pair.get_ref();
         if names.len() != 2 || names[0].get_ref() == names[1].get_ref() {
             return Err(error(

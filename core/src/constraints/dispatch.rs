@@ -28,7 +28,8 @@ impl Families {
     ///
     /// # Panics
     /// If the unit's two families cannot be a pair (the table links only the neo-Hookean halves,
-    /// and a file's two constraints, which have one arity).
+    /// and a file's two constraints, which have one arity of two or more: a file on single
+    /// particles is refused a `pair`, so that no pair's code is compiled for one particle).
     #[inline]
     pub fn visit_unit<T: VisitProjected>(&self, unit: Unit, visitor: T) -> T::Output {
         let Some(partner) = unit.partner else {
@@ -48,9 +49,6 @@ impl Families {
             return builtin::visit_pair(lead, partner, visitor);
         }
         match (self.file_code(lead), self.file_code(partner)) {
-            (FileCode::One(a), FileCode::One(b)) => {
-                visitor.visit([lead, partner], &Pair(&a.0, &b.0))
-            }
             (FileCode::Two(a), FileCode::Two(b)) => {
                 visitor.visit([lead, partner], &Pair(&a.0, &b.0))
             }
