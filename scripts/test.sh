@@ -49,6 +49,10 @@ echo "== rerun rrd verify (a recording of $scene)"
 cargo run --locked --quiet -- record --scene "$scene" --perturb flatten --gravity 10 \
   --constraints edges,height,volume --frames 60 --quiet --out "$recording"
 "$venv/bin/rerun" rrd verify "$recording"
+echo "== rerun rrd verify (a recording of two bodies in contact)"
+cargo run --locked --quiet -- record --scene assets/scenes/stacked-cubes.toml \
+  --constraints edges,volume,contact --frames 30 --quiet --out "$recording.contact.rrd"
+"$venv/bin/rerun" rrd verify "$recording.contact.rrd"
 
 if [ -d ../shared/meshes ]; then
   echo "== ../shared/meshes is here: the tests that read the reference meshes run"

@@ -299,7 +299,8 @@ fn check_gradients_reports_every_family_within_bound() {
             "height",
             "volume",
             "neohookean-deviatoric",
-            "neohookean-hydrostatic"
+            "neohookean-hydrostatic",
+            "contact"
         ]
     );
     for row in &rows {

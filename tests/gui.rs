@@ -535,7 +535,10 @@ fn classroom_mode_shows_the_view_and_the_lesson_only() {
 #[test]
 fn the_compare_panel_runs_two_constraint_sets_side_by_side() {
     let mut harness = workbench("cube", 2);
-    // The compare panel's "edges" checkbox, below the solver panel's.
+    // The compare panel's "edges" checkbox, below the solver panel's; the panel is scrolled
+    // down to it first (the side panel is taller than the window).
+    harness.get_by_label("Compare side by side").scroll_to_me();
+    harness.run();
     harness
         .get_all_by_label("edges")
         .last()
@@ -639,6 +642,50 @@ fn a_scene_file_of_several_bodies_opens_in_the_view() {
         "the ball is thrown"
     );
     harness.snapshot("scene_file_bodies");
+}
+
+/// Two cubes stacked, opened as a scene file: with the contact family switched on in the solver
+/// panel (which then shows the thickness and friction), the small cube rests on the large one
+/// frame after frame, touching it, where without contact it would sink into it.
+#[test]
+fn a_stack_rests_on_contact_in_the_workbench() {
+    let mut harness = workbench("cube", 2);
+    harness.get_by_label("mesh file").click();
+    harness.run_steps(1);
+    harness
+        .get_by_label("mesh file")
+        .type_text("../assets/scenes/stacked-cubes.toml");
+    harness.run_steps(1);
+    harness.get_by_label("Open").click();
+    harness.run_steps(3);
+    // The solver panel's checkbox, above the compare panel's.
+    harness
+        .get_all_by_label("contact")
+        .next()
+        .expect("the solver panel's contact")
+        .click();
+    harness.run_steps(2);
+    assert!(
+        harness.query_by_label_contains("mu_s").is_some(),
+        "the friction is shown"
+    );
+    for _ in 0..20 {
+        harness.get_by_label("Step frame").click();
+        harness.run_steps(1);
+    }
+    let bench = &harness.state().bench;
+    assert_eq!(bench.simulation.frame(), 20);
+    assert!(bench.metrics.contacts > 0, "the cubes touch");
+    let upper = &bench.simulation.bodies()[1];
+    let lowest = bench.simulation.positions()[upper.particles.start as usize..]
+        .iter()
+        .map(|p| p.y)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        lowest > 1.0,
+        "the small cube rests on the large one: {lowest}"
+    );
+    harness.snapshot("contact_stack");
 }
 
 /// A panel and the requests it made, drawn on its own.

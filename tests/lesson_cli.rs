@@ -19,7 +19,7 @@ fn the_built_in_lessons_are_listed_and_observe_what_they_say() {
     let list = tetlab(&["lesson", "--list"]);
     assert!(list.status.success());
     let text = stdout(&list);
-    assert_eq!(text.lines().count(), 13, "{text}");
+    assert_eq!(text.lines().count(), 14, "{text}");
     assert!(text.contains("02-edges-cannot-uninvert.toml"));
 
     let output = tetlab(&["lesson", "2"]);

@@ -45,8 +45,9 @@ fn every_energy() -> Vec<(String, Families, PerFamily<bool>)> {
         let mut families = Families::builtin();
         let files = ConstraintFile::load_all(&path).unwrap_or_else(|e| panic!("{e}"));
         // A damper (it reads where the particles were) has no energy of the positions, and a
-        // family on single particles (a pin) none on a tet alone.
-        let on_particles = |f: &ConstraintFile| f.binding == Binding::Particles;
+        // family on single particles (a pin) or on contacts none on a tet alone.
+        let on_particles =
+            |f: &ConstraintFile| matches!(f.binding, Binding::Particles | Binding::Contacts);
         if files.iter().any(|f| f.reads_motion() || on_particles(f)) {
             continue;
         }

@@ -183,7 +183,7 @@ fn settings_are_what_was_set_and_what_follows_is_resolved() {
     let families = simulation.families();
     assert_eq!(
         families.describe(simulation.active()),
-        "edges+height+volume+neohookean"
+        "edges+height+volume+neohookean+contact"
     );
     assert_eq!(simulation.active().families().count(), families.len());
     assert_eq!(

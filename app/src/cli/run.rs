@@ -8,7 +8,7 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write;
 use tetlab_core::constraints::Family;
-use tetlab_core::input::limits;
+use tetlab_core::input::limits::{self, Number};
 use tetlab_core::measures::energy_account::{Energy, EnergyWatch};
 use tetlab_core::measures::ensemble::{Ensemble, Member, Tally};
 use tetlab_core::measures::exact_step::ExactStepGap;
@@ -96,6 +96,13 @@ pub struct FrameRecord {
     /// Of a scene file of several bodies: each body's metrics.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     bodies: Vec<BodyRecord>,
+    /// With a family that binds to contacts: the contacts touching
+    /// (`tetlab_core::measures::Metrics::contacts`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    contacts: Option<usize>,
+    /// With a family that binds to contacts: the largest penetration, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_penetration: Option<f64>,
 }
 
 /// One body's metrics in a frame of a scene of several (`--scene FILE.toml`).
@@ -109,11 +116,18 @@ pub struct BodyRecord {
     max_speed: f64,
     /// Its centre of mass, m.
     centre_of_mass: [f64; 3],
+    /// With a family that binds to contacts: its particles' contacts touching, and the largest
+    /// penetration among them, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    contacts: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_penetration: Option<f64>,
 }
 
 impl BodyRecord {
     /// The records of each body of `simulation`'s scene; none for a scene of one body.
     pub fn of(simulation: &Simulation) -> Vec<BodyRecord> {
+        let contact = has_contact(simulation);
         (Metrics::measure_bodies(simulation).into_iter())
             .map(|(name, m)| BodyRecord {
                 name,
@@ -123,9 +137,19 @@ impl BodyRecord {
                 max_edge_strain: m.max_edge_strain,
                 max_speed: m.max_speed,
                 centre_of_mass: m.centre_of_mass.to_array(),
+                contacts: contact.then_some(m.contacts),
+                max_penetration: contact.then_some(m.max_penetration),
             })
             .collect()
     }
+}
+
+/// Whether an active family of `simulation` binds to contacts.
+fn has_contact(simulation: &Simulation) -> bool {
+    let families = simulation.families();
+    tetlab_core::simulation::contact::contact_families(families, simulation.active())
+        .next()
+        .is_some()
 }
 
 impl FrameRecord {
@@ -196,6 +220,8 @@ impl FrameRecord {
             order_seed: first.then_some(settings.settings.order_seed),
             edits_settle: first.then(|| settings.edits_settle()),
             bodies: BodyRecord::of(simulation),
+            contacts: has_contact(simulation).then_some(metrics.contacts),
+            max_penetration: has_contact(simulation).then_some(metrics.max_penetration),
         }
     }
 }
@@ -240,10 +266,15 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     // exact frame converged.
     let mut largest_gap: Option<(f64, f64, u64)> = None;
     let mut gaps_converged = true;
+    // The largest penetration of the run, and its frame.
+    let mut deepest = (0.0f64, 0u64);
     for _ in 0..args.simulation.frames {
         let before = args.exact_step.then(|| simulation.clone());
         let metrics = SimulationArgs::step(&mut simulation)?;
         outcome.observe(&simulation, &metrics);
+        if metrics.max_penetration > deepest.0 {
+            deepest = (metrics.max_penetration, simulation.frame());
+        }
         let gap = before.map(|before| ExactStepGap::measure(&before, &simulation));
         if let Some(gap) = gap {
             gaps_converged &= gap.converged;
@@ -283,6 +314,19 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             outcome.horizontal_displacement()
         )
         .map_err(io)?;
+        if has_contact(&simulation) {
+            writeln!(
+                out,
+                "contact: {} touching at the end, largest penetration {:.3e} m (of the \
+                 thickness {} m; over the run {:.3e} m, frame {})",
+                outcome.last.contacts,
+                outcome.last.max_penetration,
+                simulation.settings().contact.thickness.show(),
+                deepest.0,
+                deepest.1
+            )
+            .map_err(io)?;
+        }
         for body in BodyRecord::of(&simulation) {
             let [x, y, z] = body.centre_of_mass;
             writeln!(
@@ -296,6 +340,13 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
                 body.max_speed
             )
             .map_err(io)?;
+            if let (Some(touching), Some(deepest)) = (body.contacts, body.max_penetration) {
+                writeln!(
+                    out,
+                    "  {touching} contacts touching, largest penetration {deepest:.3e} m"
+                )
+                .map_err(io)?;
+            }
         }
         for line in super::simulation_args::describe_skipped(&simulation) {
             writeln!(out, "{line}").map_err(io)?;

@@ -144,6 +144,32 @@ pub struct SolverArgs {
     /// (1..=1e9); a longer step is skipped and counted: where ∇C vanishes and C does not.
     #[arg(long, value_name = "K", default_value_t = Settings::default().reach, value_parser = |s: &str| limits::REACH.parse(s), allow_hyphen_values = true)]
     pub reach: f64,
+    /// The thickness contact keeps between surfaces, in metres (1e-9..=1e3), for the contact
+    /// family [default: 0.01].
+    #[arg(long, value_name = "D", default_value_t = Settings::default().contact.thickness, value_parser = |s: &str| limits::THICKNESS.parse(s))]
+    pub thickness: f64,
+    /// Friction of contact: static and kinetic coefficients μs,μk (each 0..=10), or one number
+    /// for both [default: 0.5,0.4].
+    #[arg(long, value_name = "MU_S[,MU_K]", value_parser = parse_friction)]
+    pub friction: Option<[f64; 2]>,
+}
+
+/// `μs,μk`, or `μ` for both, each in range.
+fn parse_friction(text: &str) -> Result<[f64; 2], String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    match parts[..] {
+        [both] => {
+            let mu = limits::FRICTION.parse(both)?;
+            Ok([mu, mu])
+        }
+        [mu_static, mu_kinetic] => Ok([
+            limits::FRICTION.parse(mu_static)?,
+            limits::FRICTION.parse(mu_kinetic)?,
+        ]),
+        _ => Err(format!(
+            "'{text}' is not μs,μk or one coefficient for both (e.g. 0.5,0.4)"
+        )),
+    }
 }
 
 /// `FAMILY=VALUE` as given, its value in range; the family is looked up later
@@ -184,6 +210,11 @@ impl SolverArgs {
             reach: self.reach,
             ..Settings::default()
         };
+        settings.contact.thickness = self.thickness;
+        if let Some([mu_static, mu_kinetic]) = self.friction {
+            settings.contact.static_friction = mu_static;
+            settings.contact.kinetic_friction = mu_kinetic;
+        }
         settings.set_gravity(self.gravity);
         let (mut settings, families) = self.families.apply(settings)?;
         for NamedValue { name, value } in &self.stiffness {
@@ -232,6 +263,19 @@ impl SolverArgs {
         text += &describe_order(s);
         if s.reach != Settings::default().reach {
             text += &format!(", reach {} rest edges", s.reach.show());
+        }
+        let active = simulation.active();
+        if tetlab_core::simulation::contact::contact_families(families, active)
+            .next()
+            .is_some()
+        {
+            let c = s.contact;
+            text += &format!(
+                ", contact thickness {} m, friction {}/{}",
+                c.thickness.show(),
+                c.static_friction.show(),
+                c.kinetic_friction.show()
+            );
         }
         for family in simulation.active().families() {
             if let Some(file) = families.file(family) {

@@ -47,6 +47,8 @@ pub struct Recorder<'a> {
     logged_colours: Option<Vec<Rgba>>,
     points: Vec<Vec3>,
     arrow_scratch: Vec<Arrow>,
+    /// The contacts touching, reused every frame: each particle's position and normal.
+    contact_scratch: Vec<(glam::DVec3, glam::DVec3)>,
     modes: bool,
 }
 
@@ -119,6 +121,7 @@ impl<'a> Recorder<'a> {
             logged_colours: None,
             points: Vec::new(),
             arrow_scratch: Vec::new(),
+            contact_scratch: Vec::new(),
             modes: false,
         }
     }
@@ -210,6 +213,7 @@ impl<'a> Recorder<'a> {
             )),
         );
         self.log_arrows(simulation);
+        self.log_contacts(simulation, metrics);
         if self.modes {
             self.log_modes_now(simulation);
         }
@@ -231,6 +235,45 @@ impl<'a> Recorder<'a> {
             ("taken_by_settling", energy.taken.settling),
         ] {
             log(&format!("energy/{name}"), &rerun::Scalars::single(value));
+        }
+    }
+
+    /// Logs the contacts touching, where a family on contacts is active: each particle's point
+    /// and its contact normal, a thickness long (`world/contacts`, in the contact family's
+    /// colour), and the contacts and the largest penetration as metrics.
+    fn log_contacts(&mut self, simulation: &Simulation, metrics: &Metrics) {
+        let families = simulation.families();
+        let Some(family) =
+            tetlab_core::simulation::contact::contact_families(families, simulation.active())
+                .next()
+        else {
+            return;
+        };
+        visual::contact_points(simulation, &mut self.contact_scratch);
+        let length = 10.0 * simulation.settings().contact.thickness;
+        let [r, g, b, a] = visual::family_colour(families, family);
+        self.rec
+            .log(
+                format!("{}world/contacts", self.root),
+                &rerun::Arrows3D::from_vectors(
+                    self.contact_scratch
+                        .iter()
+                        .map(|(_, n)| (*n * length).as_vec3()),
+                )
+                .with_origins(self.contact_scratch.iter().map(|(p, _)| p.as_vec3()))
+                .with_colors([rerun::Color::from_unmultiplied_rgba(r, g, b, a)]),
+            )
+            .ok();
+        for (name, value) in [
+            ("contacts", metrics.contacts as f64),
+            ("max_penetration", metrics.max_penetration),
+        ] {
+            self.rec
+                .log(
+                    format!("{}metrics/{name}", self.root),
+                    &rerun::Scalars::single(value),
+                )
+                .ok();
         }
     }
 

@@ -353,6 +353,11 @@ impl ConstraintFile {
         self.prelude.reads_rest_shape() || self.rest.as_ref().is_some_and(Tape::reads_rest_shape)
     }
 
+    /// Whether the file gives its rest value itself (`rest = …`), rather than C at rest.
+    pub fn has_own_rest(&self) -> bool {
+        self.rest.is_some()
+    }
+
     /// Whether C reads where the particles were at the start of the substep (`start0`…) or the
     /// substep's length `h`: then a solver gathers them for it.
     pub fn reads_motion(&self) -> bool {

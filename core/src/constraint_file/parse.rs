@@ -113,6 +113,7 @@ pub(super) fn parse_all(
         "triangles" => Binding::Triangles,
         "hinges" => Binding::Hinges,
         "particles" => Binding::Particles,
+        "contacts" => Binding::Contacts,
         other => {
             return Err(error(
                 Some(raw.applies_to.span().start),
@@ -120,7 +121,8 @@ pub(super) fn parse_all(
                     "applies_to is \"{other}\": expected \"edges\" (p0 p1), \"tets\" \
                      (p0..p3), \"tet-vertices\" (p0..p3, four per tet), \"triangles\" (p0 p1 \
                      p2, the surface's, wound outwards), \"hinges\" (p0 p1 an edge of the \
-                     surface, p2 p3 the wings) or \"particles\" (p0, those `where` chooses)"
+                     surface, p2 p3 the wings), \"particles\" (p0, those `where` chooses) or \"contacts\" (p0 \
+                     a particle, p1 p2 p3 a surface triangle it meets, wound outwards)"
                 ),
             ));
         }
@@ -255,7 +257,16 @@ pub(super) fn parse_all(
         files.push(file);
     }
     if let Some(pair) = &raw.pair {
-        // A pin's projection is one particle's: nothing to share with another's.
+        // A pin's projection is one particle's, a contact's its own pair's: nothing to share
+        // with another's.
+        if binding == Binding::Contacts {
+            return Err(error(
+                Some(pair.span().start),
+                "`pair` projects two constraints together, and a file on contacts \
+                 (applies_to = \"contacts\") projects each alone"
+                    .to_owned(),
+            ));
+        }
         if binding == Binding::Particles {
             return Err(error(
                 Some(pair.span().start),
@@ -294,6 +305,33 @@ pub(super) fn parse_all(
         let (name_a, name_b) = (files[a].name.clone(), files[b].name.clone());
         files[a].pair = Some(name_b);
         files[b].pair = Some(name_a);
+    }
+    if binding == Binding::Contacts {
+        // A contact is found where two surfaces meet, not laid on the rest shape: it has no rest
+        // shape to read, and its rest value is the contact's thickness.
+        let at = Some(raw.applies_to.span().start);
+        for file in &files {
+            if file.reads_rest_shape() || file.stored_len() > 0 || file.has_own_rest() {
+                return Err(error(
+                    at,
+                    format!(
+                        "{}: a constraint on contacts has no rest shape (q0…, Dm, V0) and no \
+                         rest of its own: `rest` in C is the contact's thickness",
+                        file.name
+                    ),
+                ));
+            }
+            if file.reads_motion() {
+                return Err(error(
+                    at,
+                    format!(
+                        "{}: a constraint on contacts reads where its particles are, not where \
+                         they were (start0…, h): friction is the contact's own",
+                        file.name
+                    ),
+                ));
+            }
+        }
     }
     Ok(files)
 }

@@ -54,6 +54,11 @@ pub enum Binding {
     /// positions (a pin set, a handle, the particles above a plane); without one, every
     /// particle ([`crate::constraint_file::ConstraintFile::chooses`]).
     Particles,
+    /// Found every frame rather than bound once: (p0, p1, p2, p3) with p0 a particle of a
+    /// surface and (p1, p2, p3) a surface triangle it is about to meet, wound outwards, of
+    /// another body or of its own away from p0 (`crate::simulation::contact`). It has no
+    /// constraints on a mesh at rest.
+    Contacts,
 }
 
 impl Binding {
@@ -63,7 +68,7 @@ impl Binding {
             Binding::Particles => 1,
             Binding::Edges => 2,
             Binding::Triangles => 3,
-            Binding::Tets | Binding::TetVertices | Binding::Hinges => 4,
+            Binding::Tets | Binding::TetVertices | Binding::Hinges | Binding::Contacts => 4,
         }
     }
 
@@ -76,6 +81,7 @@ impl Binding {
             Binding::Triangles => mesh.surface_faces().into_iter().flatten().collect(),
             Binding::Hinges => mesh.surface_hinges().into_iter().flatten().collect(),
             Binding::Particles => (0..mesh.positions.len() as u32).collect(),
+            Binding::Contacts => Vec::new(),
             Binding::TetVertices => mesh
                 .tets
                 .iter()
@@ -101,8 +107,10 @@ impl Binding {
             Binding::Edges => (0..0, true),
             Binding::Tets => (tet..tet + 1, false),
             Binding::TetVertices => (4 * tet..4 * tet + 4, false),
-            // Of the surface or of single particles, not of a tet.
-            Binding::Triangles | Binding::Hinges | Binding::Particles => (0..0, false),
+            // Of the surface, of single particles or of contacts, not of a tet.
+            Binding::Triangles | Binding::Hinges | Binding::Particles | Binding::Contacts => {
+                (0..0, false)
+            }
         };
         let pairs = pairs(edges);
         let looked_up = TET_EDGES

@@ -7,6 +7,7 @@
 
 use super::any::{AnyConstraint, Typed};
 use super::binding::Binding;
+use super::contact::Contact;
 use super::distance::Distance;
 use super::height::Height;
 use super::neohookean::{Deviatoric, Hydrostatic};
@@ -28,8 +29,8 @@ macro_rules! builtin_families {
             $( $(#[$doc])* pub const $constant: Family = Family($index); )*
         }
 
-        /// The built-in families' rows, in projection order (edges, heights, volumes, then the
-        /// neo-Hookean pair).
+        /// The built-in families' rows, in projection order (edges, heights, volumes, the
+        /// neo-Hookean pair, then contact).
         pub static TABLE: [Row; [$($index),*].len()] = [$($row),*];
 
         // The places are 0, 1, 2, … in the order of the entries.
@@ -162,6 +163,25 @@ builtin_families! {
         projected_with: Some(Family::NEOHOOKEAN_DEVIATORIC),
         reads_rest_shape: true,
         rest_uses_material: true,
+        stored_len: 0,
+    };
+    /// Contact between surfaces ([`super::contact`]): found every frame, projected after the
+    /// other families of each sweep.
+    5 CONTACT: Contact, 4 => Row {
+        name: Cow::Borrowed("contact"),
+        aliases: &["contacts", "collision"],
+        title: Cow::Borrowed("Contact: height above another surface"),
+        label: Cow::Borrowed("contact"),
+        colour: [220, 40, 120, 255],
+        formula: Formula::Builtin(super::contact::FORMULA),
+        rest_symbol: "d",
+        arity: 4,
+        binding: Binding::Contacts,
+        group: Cow::Borrowed("contact"),
+        compliance_from_material: None,
+        projected_with: None,
+        reads_rest_shape: false,
+        rest_uses_material: false,
         stored_len: 0,
     };
 }

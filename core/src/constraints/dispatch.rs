@@ -76,6 +76,9 @@ impl Families {
     pub fn units<'a>(&'a self, active: &'a PerFamily<bool>) -> impl Iterator<Item = Unit> + 'a {
         self.all()
             .filter(|&f| active[f] && !self.projected_by_partner(f, active))
+            // Contacts are found every frame and projected after the sweep's families
+            // (`crate::simulation::contact`).
+            .filter(|&f| self.binding(f) != super::Binding::Contacts)
             .map(|lead| Unit {
                 lead,
                 partner: self.partner_in(lead, active),

@@ -27,6 +27,7 @@
 mod any;
 mod binding;
 mod builtin;
+pub mod contact;
 pub mod differentiable;
 mod dispatch;
 pub mod distance;

@@ -83,7 +83,10 @@ impl ElementEnergy {
         let mut terms = Vec::new();
         let mut compliances = Vec::new();
         let of_positions = |f: Family| !families.file(f).is_some_and(|file| file.reads_motion());
-        let of_the_body = |f: Family| families.binding(f) != Binding::Particles;
+        // A pin holds a particle to the world, a contact two surfaces apart: neither is an
+        // energy of one tet.
+        let of_the_body =
+            |f: Family| !matches!(families.binding(f), Binding::Particles | Binding::Contacts);
         for family in (families.all()).filter(|&f| active[f] && of_positions(f) && of_the_body(f)) {
             let compliance = match families.row(family).compliance_from_material {
                 Some(from) => Compliance::Given(from(material)),
@@ -113,7 +116,7 @@ impl ElementEnergy {
         }
         if terms.is_empty() {
             return Err(
-                "no family is active that has an energy of the positions (a damper or a pin \
+                "no family is active that has an energy of the positions (a damper, a pin or a contact \
                  has none on a tet): name one (--constraints or --constraint-file)"
                     .into(),
             );

@@ -178,6 +178,23 @@ pub const REACH: Bounds<f64> = Bounds {
     max: 1e9,
 };
 
+/// The thickness contact keeps between surfaces, m
+/// ([`crate::simulation::contact::ContactSettings::thickness`]): positive, since a contact
+/// of thickness 0 would lose the particle resting on it to rounding.
+pub const THICKNESS: Bounds<f64> = Bounds {
+    name: "thickness",
+    min: 1e-9,
+    max: 1e3,
+};
+
+/// A coefficient of friction, static or kinetic
+/// ([`crate::simulation::contact::ContactSettings`]).
+pub const FRICTION: Bounds<f64> = Bounds {
+    name: "friction",
+    min: 0.0,
+    max: 10.0,
+};
+
 /// Frames a headless run simulates.
 pub const FRAMES: Bounds<u64> = Bounds {
     name: "frames",

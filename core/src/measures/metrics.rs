@@ -5,6 +5,7 @@
 
 use crate::constraints::volume::signed_volume;
 use crate::constraints::{Constraint, Families, Family, PerFamily, SubstepStart, Visit};
+use crate::simulation::contact::project::over_triangle;
 use crate::simulation::divergence::{Cause, Divergence};
 use crate::simulation::{ConstraintSet, Simulation};
 use glam::DVec3;
@@ -37,7 +38,20 @@ pub struct Metrics {
     /// Root mean square of C over each family's constraints (metres for edges and heights,
     /// cubic metres for volumes), whether or not the family is active.
     pub residual: PerFamily<f64>,
+    /// Contacts touching: the frame's contact pairs ([`crate::simulation::contact`]) whose
+    /// particle is over its triangle and at most [`TOUCHING`] thicknesses above it. 0 when no
+    /// family binds to contacts.
+    pub contacts: usize,
+    /// The largest penetration, m: over the frame's contact pairs whose particle is over its
+    /// triangle, the most by which it is closer than the thickness d, max(0, d − h) with h its
+    /// height above the triangle (the built-in contact's −C).
+    pub max_penetration: f64,
 }
+
+/// A contact pair touches when its particle is at most this many thicknesses above its
+/// triangle ([`Metrics::contacts`]): a contact at rest holds it at one thickness, to within
+/// the solver's tolerance.
+pub const TOUCHING: f64 = 1.1;
 
 impl Metrics {
     /// The four headline measurements, by the names used in JSON, recordings and plots.
@@ -50,6 +64,22 @@ impl Metrics {
         ]
     }
 
+    /// Every measurement a lesson may expect something of, by name: the headline's, then the
+    /// largest speed and displacement, the contacts touching and the largest penetration.
+    pub fn named(&self) -> [(&'static str, f64); 8] {
+        let [a, b, c, d] = self.headline();
+        [
+            a,
+            b,
+            c,
+            d,
+            ("max_speed", self.max_speed),
+            ("max_displacement", self.max_displacement),
+            ("contacts", self.contacts as f64),
+            ("max_penetration", self.max_penetration),
+        ]
+    }
+
     /// Ok when every measurement is finite; otherwise the first that is not, as the divergence
     /// of a state at `frame`.
     /// `families` names the families of the residuals.
@@ -58,6 +88,7 @@ impl Metrics {
             ("max_displacement", self.max_displacement),
             ("max_speed", self.max_speed),
             ("centre_of_mass", self.centre_of_mass.length()),
+            ("max_penetration", self.max_penetration),
         ];
         let all = self.headline().into_iter().chain(more);
         if let Some((name, value)) = all.into_iter().find(|(_, v)| !v.is_finite()) {
@@ -138,6 +169,7 @@ impl Metrics {
                 max_edge_strain = larger(max_edge_strain, (length - rest).abs() / rest);
             }
         }
+        let touching = contacts_of(simulation, &particles);
         Metrics {
             inverted_tets,
             min_volume_ratio: min_volume_ratio.unwrap_or(1.0),
@@ -147,6 +179,8 @@ impl Metrics {
                 0.0
             },
             max_edge_strain,
+            contacts: touching.0,
+            max_penetration: touching.1,
             max_displacement: (positions[range.clone()].iter())
                 .zip(&simulation.rest_positions()[range.clone()])
                 .map(|(p, r)| p.distance(*r))
@@ -168,6 +202,34 @@ impl Metrics {
             }),
         }
     }
+}
+
+/// The touching contacts among the frame's pairs whose particle is among `particles`, and the
+/// largest penetration among them ([`Metrics::contacts`], [`Metrics::max_penetration`]).
+fn contacts_of(simulation: &Simulation, particles: &Range<u32>) -> (usize, f64) {
+    let positions = simulation.positions();
+    let thickness = simulation.settings().contact.thickness;
+    let mut touching = 0;
+    let mut deepest: f64 = 0.0;
+    for pair in simulation.contact_pairs() {
+        if !particles.contains(&pair[0]) {
+            continue;
+        }
+        let p = pair.map(|i| positions[i as usize]);
+        if over_triangle(p[0], [p[1], p[2], p[3]]).is_none() {
+            continue;
+        }
+        let e = crate::constraints::contact::evaluate(&p, thickness);
+        if e.degenerate {
+            continue;
+        }
+        let height = e.value + thickness;
+        if height <= TOUCHING * thickness {
+            touching += 1;
+        }
+        deepest = larger(deepest, -e.value);
+    }
+    (touching, deepest)
 }
 
 /// The smaller of two numbers, NaN if either is (f64::min would drop a NaN).

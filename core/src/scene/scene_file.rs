@@ -11,10 +11,11 @@
 //! name = "lower"              # optional: body1, body2, … otherwise
 //! mesh = "cube"               # a built-in (tet, cube, beam, ball) or a mesh file, relative to this file
 //! resolution = 2              # optional, for cube, beam and ball (4 otherwise)
-//! scale = 1.0                 # optional: about the mesh's centre (its box's), > 0
+//! scale = 1.0                 # optional: about the mesh's centre (its box's), > 0; or [x, y, z]
 //! rotate = [0, 0, 0]          # optional: degrees about x, then y, then z, about the centre
 //! translate = [0, 0, 0]       # optional: metres, from where the mesh puts it
 //! velocity = [0, 0, 0]        # optional: m/s, every particle of the body at the start
+//! fixed = false               # optional: true pins every particle (a floor, a ramp, a wall)
 //! [[body]]
 //! mesh = "cube"
 //! translate = [0, 1.5, 0]
@@ -63,13 +64,23 @@ struct RawBody {
     #[serde(default)]
     resolution: Option<Spanned<u32>>,
     #[serde(default)]
-    scale: Option<Spanned<f64>>,
+    scale: Option<Spanned<Scale>>,
     #[serde(default)]
     rotate: Option<Spanned<[f64; 3]>>,
     #[serde(default)]
     translate: Option<Spanned<[f64; 3]>>,
     #[serde(default)]
     velocity: Option<Spanned<[f64; 3]>>,
+    #[serde(default)]
+    fixed: bool,
+}
+
+/// A body's scale: one factor, or one per axis.
+#[derive(serde::Deserialize)]
+#[serde(untagged)]
+enum Scale {
+    One(f64),
+    Axes([f64; 3]),
 }
 
 /// The largest |coordinate| a placement or a velocity may give, in metres or m/s: far beyond any
@@ -189,7 +200,14 @@ impl Scene {
                     ),
                 ));
             }
+            let fixed = body.fixed;
             scene.add(name, part, placement, velocity);
+            if fixed {
+                let body = scene.bodies.last().expect("the body just added");
+                scene.pinned.extend(body.particles.clone());
+                scene.pinned.sort_unstable();
+                scene.pinned.dedup();
+            }
         }
         scene.lift_onto_the_ground();
         Ok(scene)
@@ -259,19 +277,23 @@ fn body_scene(body: &RawBody, folder: &Path) -> Result<Scene, SceneError> {
 fn placement(body: &RawBody) -> Result<Placement, (usize, String)> {
     let scale = match &body.scale {
         Some(s) => {
-            let value = *s.get_ref();
-            if !(value.is_finite() && value > 0.0 && value <= MAX_PLACEMENT) {
+            let (value, written) = match s.get_ref() {
+                Scale::One(k) => (DVec3::splat(*k), format!("{k}")),
+                Scale::Axes([x, y, z]) => (DVec3::new(*x, *y, *z), format!("[{x}, {y}, {z}]")),
+            };
+            let fine = |k: f64| k.is_finite() && k > 0.0 && k <= MAX_PLACEMENT;
+            if !(fine(value.x) && fine(value.y) && fine(value.z)) {
                 return Err((
                     s.span().start,
                     format!(
-                        "scale is {value}: it must be above 0 (a mirror is a perturbation, not a \
-                         placement) and at most {MAX_PLACEMENT:e}"
+                        "scale is {written}: each factor must be above 0 (a mirror is a \
+                         perturbation, not a placement) and at most {MAX_PLACEMENT:e}"
                     ),
                 ));
             }
             value
         }
-        None => 1.0,
+        None => DVec3::ONE,
     };
     let degrees = match &body.rotate {
         Some(r) => finite_vector(r, "rotate", "degrees")?,
@@ -286,7 +308,7 @@ fn placement(body: &RawBody) -> Result<Placement, (usize, String)> {
         None => DVec3::ZERO,
     };
     Ok(Placement {
-        turn: rotation * scale,
+        turn: rotation * DMat3::from_diagonal(scale),
         translate,
     })
 }

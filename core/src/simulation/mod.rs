@@ -17,6 +17,7 @@
 //! [`crate::constraints::volume::evaluate`] and [`projection::correct`].
 
 mod constraint_set;
+pub mod contact;
 pub mod divergence;
 mod edits;
 mod engine;
@@ -93,6 +94,8 @@ pub struct Simulation {
     threads: usize,
     /// Projections skipped for a counted reason since the start (or the last reset), per family.
     skipped: PerFamily<SkipCounts>,
+    /// The broad phase of contact, its arrays kept between frames.
+    contact_finder: contact::ContactFinder,
 }
 
 impl Simulation {
@@ -127,6 +130,7 @@ impl Simulation {
             sets,
             start_velocities: start_velocities(scene),
             bodies: scene.bodies.clone(),
+            contact_surface: std::sync::OnceLock::new(),
         };
         let mut state = State::at_rest(&body);
         for &i in &scene.pinned {
@@ -149,6 +153,7 @@ impl Simulation {
             engine: EngineSlot::default(),
             threads: 1,
             skipped: PerFamily::default(),
+            contact_finder: contact::ContactFinder::default(),
         };
         simulation.apply_orders();
         simulation
@@ -168,6 +173,12 @@ impl Simulation {
     /// The active families of the table ([`Resolved::active`]).
     pub fn active(&self) -> &PerFamily<bool> {
         &self.resolved.active
+    }
+
+    /// The contact pairs found at the start of the last frame, [particle, a, b, c]
+    /// ([`contact`]); empty when no active family binds to contacts.
+    pub fn contact_pairs(&self) -> &[[u32; 4]] {
+        &self.state.contacts
     }
 
     /// The table of families it simulates.

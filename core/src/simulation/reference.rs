@@ -21,15 +21,7 @@ pub struct ReferenceEngine;
 
 impl Engine for ReferenceEngine {
     fn step(&mut self, frame: Frame<'_>) -> PerFamily<SkipCounts> {
-        let grab = frame.state.grab.map(|g| (g.particle, g.target));
-        let plane_strain = frame.body.plane_strain;
-        let plan = Plan::new(
-            frame.families,
-            frame.resolved,
-            plane_strain,
-            grab,
-            frame.settling,
-        );
+        let plan = Plan::of(&frame);
         let mut on = OnState::new(frame.families, frame.body, frame.state);
         substep::frame(&mut on, &plan);
         on.skipped
@@ -123,13 +115,34 @@ impl Substeps for OnState<'_> {
             .copy_from_slice(&self.state.positions);
     }
 
-    fn reset_multipliers(&mut self, _: &Plan) {
+    fn reset_multipliers(&mut self, plan: &Plan) {
         for family in self.families.all() {
             self.state.lambdas[family].fill(0.0);
         }
         if let Some(grab) = &mut self.state.grab {
             grab.lambda = 0.0;
         }
+        if let Some(contact) = &plan.contact {
+            let wanted = contact.found.len() * contact.families.len();
+            self.state.contact_lambdas.resize(wanted, 0.0);
+            self.state.contact_lambdas.fill(0.0);
+        }
+    }
+
+    fn contacts(&mut self, plan: &Plan) {
+        let Some(contact) = &plan.contact else {
+            return;
+        };
+        let s = &mut *self.state;
+        crate::simulation::contact::project_pairs(
+            self.families,
+            plan,
+            contact,
+            &contact.found,
+            (&mut s.positions, &s.previous, &s.inverse_masses),
+            &mut s.contact_lambdas,
+            &mut self.skipped,
+        );
     }
 
     fn project(&mut self, unit: Unit, plan: &Plan) {

@@ -113,6 +113,10 @@ pub struct Settings {
     /// why 100 is the default).
     #[serde(default = "default_reach")]
     pub reach: f64,
+    /// How contact behaves (its thickness and friction), for the families that bind to
+    /// contacts ([`super::contact`]).
+    #[serde(default)]
+    pub contact: super::contact::ContactSettings,
 }
 
 fn default_reach() -> f64 {
@@ -137,6 +141,7 @@ impl Settings {
         limits::DAMPING.check(self.damping)?;
         limits::REACH.check(self.reach)?;
         self.material.check()?;
+        self.contact.check()?;
         limits::COMPLIANCE
             .check(self.grab_compliance)
             .map_err(|e| format!("grab {e}"))?;
@@ -215,6 +220,7 @@ impl Default for Settings {
             engine: EngineChoice::Auto,
             order_seed: None,
             reach: DEFAULT_REACH,
+            contact: super::contact::ContactSettings::default(),
         }
     }
 }

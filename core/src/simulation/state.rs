@@ -51,6 +51,8 @@ pub struct Body {
     pub start_velocities: Vec<DVec3>,
     /// The bodies of a scene file; empty for a scene of one body.
     pub bodies: Vec<crate::scene::SceneBody>,
+    /// The surface contact is found on, made when first asked for ([`Body::contact_surface`]).
+    pub(crate) contact_surface: std::sync::OnceLock<super::contact::ContactSurface>,
 }
 
 /// Where the particles are and how they move, in f64 and in the scene's numbering.
@@ -84,6 +86,12 @@ pub struct State {
     pub taken_by_particle: Vec<DVec3>,
     /// What the ground, damping and the settling cap took from the body so far, J.
     pub taken: Taken,
+    /// The contact pairs found at the start of the last frame, [particle, a, b, c]
+    /// ([`super::contact`]); empty when no family binds to contacts.
+    pub contacts: std::sync::Arc<Vec<[u32; 4]>>,
+    /// The XPBD multiplier of each contact pair of each contact family (family by family, in
+    /// the order of the contact plan), within the current substep.
+    pub contact_lambdas: Vec<f64>,
 }
 
 /// The energy taken from a body by what is not a family (J): the ground (its impulses against
@@ -166,6 +174,8 @@ impl State {
             pushes: vec![DVec3::ZERO; n],
             taken_by_particle: vec![DVec3::ZERO; n],
             taken: Taken::default(),
+            contacts: std::sync::Arc::default(),
+            contact_lambdas: Vec::new(),
         }
     }
 
@@ -201,6 +211,13 @@ impl State {
 }
 
 impl Body {
+    /// The surface contact is found on: its triangles, particles and neighbours.
+    pub fn contact_surface(&self) -> &super::contact::ContactSurface {
+        self.contact_surface.get_or_init(|| {
+            super::contact::ContactSurface::of(&self.tets, self.rest_positions.len())
+        })
+    }
+
     /// The diagonal of the rest shape's bounding box, in metres: the size of the body (0 for
     /// none).
     pub fn rest_diagonal(&self) -> f64 {

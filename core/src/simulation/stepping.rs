@@ -19,6 +19,7 @@ impl Simulation {
         self.state.frame_corrections.fill(DVec3::ZERO);
         self.hold_off_settling();
         let settling = self.edits_settle_now();
+        self.find_contacts();
         // The slot is taken out while its engine steps the rest of the simulation.
         let mut slot = std::mem::take(&mut self.engine);
         let engine = slot.ready(self.engine(), self.start());
@@ -48,6 +49,33 @@ impl Simulation {
         }
         self.frame += 1;
         self.time += self.settings.dt;
+    }
+
+    /// The contact pairs of the coming frame, from where the particles are and how fast they
+    /// move ([`super::contact::ContactFinder`]), into the state; none when no active family
+    /// binds to contacts. Not an edit: the pairs are read afresh every frame.
+    fn find_contacts(&mut self) {
+        use super::contact::{Reach, contact_families};
+        if contact_families(&self.families, &self.resolved.active)
+            .next()
+            .is_none()
+        {
+            if !self.state.contacts.is_empty() {
+                self.state.contacts = std::sync::Arc::default();
+            }
+            return;
+        }
+        let reach = Reach {
+            thickness: self.settings.contact.thickness,
+            dt: self.settings.dt,
+            gravity: self.settings.gravity,
+        };
+        let surface = self.body.contact_surface();
+        let state = &mut self.state;
+        let found = (self.contact_finder).find(surface, &state.positions, &state.velocities, reach);
+        let contacts = std::sync::Arc::make_mut(&mut state.contacts);
+        contacts.clear();
+        contacts.extend_from_slice(found);
     }
 
     /// Gives each particle its inverse mass (the lumped one, 0 where pinned or rigidly held):
@@ -118,7 +146,10 @@ impl Simulation {
         let grab = self.state.grab.map(|g| (g.particle, g.target));
         let plane_strain = self.body.plane_strain;
         let settling = self.edits_settle_now();
-        Plan::new(&self.families, &self.resolved, plane_strain, grab, settling)
+        let mut plan = Plan::new(&self.families, &self.resolved, plane_strain, grab, settling);
+        plan.contact =
+            super::contact::ContactPlan::new(&self.families, &self.resolved, &self.state.contacts);
+        plan
     }
 
     /// Runs `stage` on the reference engine's view of the state: an edit of the state, as far as
@@ -149,6 +180,7 @@ impl Simulation {
     /// The first stage of a substep: predict positions, and (XPBD) λ = 0 for every constraint.
     pub fn begin_substep(&mut self) {
         self.hold_off_settling();
+        self.find_contacts();
         self.on_state(|on, plan| substep::begin_substep(on, plan, true));
     }
 

@@ -19,6 +19,7 @@
 //! the same skeleton: implement [`Substeps`], or wrap the reference engine's
 //! ([`super::OnState`]) and change what it does at one stage.
 
+use super::contact::ContactPlan;
 use super::engine::Frame;
 pub use super::integrate::Substep as Motion;
 use super::projection::{Rule, correction};
@@ -56,6 +57,8 @@ pub struct Plan {
     pub settling: bool,
     /// Whether to keep Δp of the frame's last substep.
     pub keep_corrections: bool,
+    /// What the sweeps project of contact, when a family that binds to contacts is active.
+    pub contact: Option<ContactPlan>,
 }
 
 impl Plan {
@@ -92,6 +95,7 @@ impl Plan {
                 .map(|(particle, target)| (particle, target, compliance)),
             settling,
             keep_corrections: true,
+            contact: None,
         }
     }
 
@@ -100,13 +104,15 @@ impl Plan {
     pub fn of(frame: &Frame<'_>) -> Plan {
         let grab = frame.state.grab.map(|g| (g.particle, g.target));
         let (families, resolved) = (frame.families, frame.resolved);
-        Plan::new(
+        let mut plan = Plan::new(
             families,
             resolved,
             frame.body.plane_strain,
             grab,
             frame.settling,
-        )
+        );
+        plan.contact = ContactPlan::new(families, resolved, &frame.state.contacts);
+        plan
     }
 
     /// Whether substep `substep` (from 0) keeps its Δp: every one while an edit settles (their
@@ -161,6 +167,11 @@ macro_rules! forward_stages {
             self.$on.project(unit, plan);
         }
     };
+    (@stage $on:ident contacts) => {
+        fn contacts(&mut self, plan: &$crate::simulation::substep::Plan) {
+            self.$on.contacts(plan);
+        }
+    };
     (@stage $on:ident grabbed) => {
         fn grabbed(&mut self, particle: usize) -> $crate::simulation::substep::GrabbedParticle<'_> {
             self.$on.grabbed(particle)
@@ -211,6 +222,9 @@ pub trait Substeps {
             sweep(self, plan);
         }
     }
+    /// Projects every pair of [`Plan::contact`] by each family that binds to contacts, with
+    /// friction (`contact::project`); called only when there is a contact plan.
+    fn contacts(&mut self, plan: &Plan);
     /// The position of `particle`, its inverse mass, and the compliant grab's multiplier, to
     /// be projected towards a target (`project_soft_grab`).
     fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_>;
@@ -267,8 +281,12 @@ pub fn sweep(engine: &mut impl Substeps, plan: &Plan) {
     end_sweep(engine, plan);
 }
 
-/// The end of a sweep, after the families: the compliant grab, then the ground and the plane.
+/// The end of a sweep, after the families: contact, the compliant grab, then the ground and
+/// the plane.
 pub fn end_sweep(engine: &mut impl Substeps, plan: &Plan) {
+    if plan.contact.is_some() {
+        engine.contacts(plan);
+    }
     if let Some((particle, target, compliance)) = plan.soft_grab {
         let target = engine.target(target);
         project_soft_grab(engine.grabbed(particle), target, compliance, plan.h);

@@ -13,11 +13,14 @@ pub struct ComparePanel {
 }
 
 impl Default for ComparePanel {
-    /// The geometric families: the material ones are another model, added by choice.
+    /// The geometric families of a body: the material ones are another model, and contact
+    /// another matter (between bodies), each added by choice.
     fn default() -> Self {
         ComparePanel {
             families: PerFamily::builtin_from_fn(|f| {
-                f.builtin_row().unwrap().compliance_from_material.is_none()
+                let row = f.builtin_row().unwrap();
+                row.compliance_from_material.is_none()
+                    && row.binding != tetlab_core::constraints::Binding::Contacts
             }),
         }
     }

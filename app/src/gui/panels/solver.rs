@@ -99,6 +99,13 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
             }
         });
     }
+    let active = settings.active;
+    if tetlab_core::simulation::contact::contact_families(families, &active)
+        .next()
+        .is_some()
+    {
+        contact_row(ui, &mut settings.contact);
+    }
     ui.add(
         egui::Slider::new(&mut settings.substeps, 1..=400)
             .logarithmic(true)
@@ -115,6 +122,43 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
          speed them up until the edit is undone",
         );
     (settings != *current).then_some(settings)
+}
+
+/// Contact's thickness and friction, under the families when a family on contacts is active.
+fn contact_row(ui: &mut egui::Ui, contact: &mut tetlab_core::simulation::contact::ContactSettings) {
+    use tetlab_core::input::limits::{FRICTION, THICKNESS};
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::DragValue::new(&mut contact.thickness)
+                .range(THICKNESS.min..=THICKNESS.max)
+                .speed(1e-3)
+                .prefix("d ")
+                .suffix(" m"),
+        )
+        .on_hover_text(
+            "Contact's thickness: the least height it keeps a particle above a triangle",
+        );
+        for (value, name, what) in [
+            (
+                &mut contact.static_friction,
+                "mu_s ",
+                "Static friction: sticks while the slide is under mu_s times the push",
+            ),
+            (
+                &mut contact.kinetic_friction,
+                "mu_k ",
+                "Kinetic friction: a slide is slowed by mu_k times the push",
+            ),
+        ] {
+            ui.add(
+                egui::DragValue::new(value)
+                    .range(FRICTION.min..=FRICTION.max)
+                    .speed(0.01)
+                    .prefix(name),
+            )
+            .on_hover_text(what);
+        }
+    });
 }
 
 /// The families a material describes (the neo-Hookean pair): on or off together, with the

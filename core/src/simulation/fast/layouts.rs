@@ -20,6 +20,9 @@ pub(super) struct Layouts {
     hinges: Layout,
     /// Of each active family on single particles.
     particles: Vec<(Family, Layout)>,
+    /// Of contacts: empty, since contacts are found every frame and projected apart from the
+    /// sweep's layouts (`crate::simulation::contact`).
+    contacts: Layout,
 }
 
 impl Layouts {
@@ -50,6 +53,9 @@ impl Layouts {
                 .map(|edge| edge.map(|i| renumber[i as usize]))
                 .collect();
             layouts.edges = Layout::new(&edges, inverse_masses, rest_positions);
+        }
+        if uses(Binding::Contacts) {
+            layouts.contacts = Layout::new::<4>(&[], inverse_masses, rest_positions);
         }
         if uses(Binding::Tets) {
             let tets = renumbered(&body.tets);
@@ -120,6 +126,7 @@ impl Layouts {
             Binding::TetVertices => &self.tet_vertices,
             Binding::Triangles => &self.triangles,
             Binding::Hinges => &self.hinges,
+            Binding::Contacts => &self.contacts,
             Binding::Particles => {
                 let own = self.particles.iter().find(|(f, _)| *f == family);
                 &own.expect("an active family's layout").1

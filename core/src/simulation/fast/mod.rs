@@ -157,6 +157,8 @@ pub struct FastSimulation {
     /// Per particle, what the ground, damping and the settling cap took within the frame (J),
     /// summed in order once a frame ([`crate::simulation::Taken`]), so for any thread count.
     taken: Vec<Vec3A>,
+    /// The frame's contact pairs in the new numbering, and their multipliers.
+    contacts: (Vec<[u32; 4]>, Vec<f32>),
 }
 
 /// Δp per particle (new numbering), kept on request.
@@ -264,6 +266,7 @@ impl FastSimulation {
             plane_strain: body.plane_strain,
             pushes: vec![Vec3A::ZERO; n],
             taken: vec![Vec3A::ZERO; n],
+            contacts: (Vec::new(), Vec::new()),
         }
     }
 
@@ -480,15 +483,7 @@ impl FastSimulation {
 impl Engine for FastSimulation {
     fn step(&mut self, frame: Frame<'_>) -> PerFamily<SkipCounts> {
         self.prepare(&frame);
-        let grab = frame.state.grab.map(|g| (g.particle, g.target));
-        let plane_strain = frame.body.plane_strain;
-        let plan = Plan::new(
-            frame.families,
-            frame.resolved,
-            plane_strain,
-            grab,
-            frame.settling,
-        );
+        let plan = Plan::of(&frame);
         let taken = self.run(&plan);
         let state = frame.state;
         state.taken.ground += taken.ground;

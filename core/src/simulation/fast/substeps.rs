@@ -36,6 +36,13 @@ impl Substeps for OnArrays<'_> {
         if keep {
             s.corrections.frame.fill(Vec3A::ZERO);
         }
+        // The frame's contact pairs, renumbered once.
+        let (found, _) = &mut s.contacts;
+        found.clear();
+        if let Some(contact) = &plan.contact {
+            let renumber = &s.renumber;
+            found.extend((contact.found.iter()).map(|pair| pair.map(|i| renumber[i as usize])));
+        }
     }
 
     fn predict(&mut self, plan: &Plan) {
@@ -78,12 +85,34 @@ impl Substeps for OnArrays<'_> {
         s.corrections.predicted.copy_from_slice(&s.positions);
     }
 
-    fn reset_multipliers(&mut self, _: &Plan) {
+    fn reset_multipliers(&mut self, plan: &Plan) {
         let s = &mut *self.simulation;
         for family in s.resolved.active.families() {
             s.sets[family].reset_lambda();
         }
         self.grab_lambda = 0.0;
+        if let Some(contact) = &plan.contact {
+            let (found, lambdas) = &mut s.contacts;
+            lambdas.resize(found.len() * contact.families.len(), 0.0);
+            lambdas.fill(0.0);
+        }
+    }
+
+    fn contacts(&mut self, plan: &Plan) {
+        let Some(contact) = &plan.contact else {
+            return;
+        };
+        let s = &mut *self.simulation;
+        let (found, lambdas) = &mut s.contacts;
+        crate::simulation::contact::project_pairs(
+            &s.families,
+            plan,
+            contact,
+            found,
+            (&mut s.positions, &s.previous, &s.inverse_masses),
+            lambdas,
+            &mut s.skipped,
+        );
     }
 
     fn project(&mut self, unit: Unit, plan: &Plan) {

@@ -132,7 +132,7 @@ impl Expectation {
             measured.metrics
         };
         let value = metrics
-            .headline()
+            .named()
             .into_iter()
             .find(|(name, _)| *name == self.metric)
             .map(|(_, v)| v)
@@ -182,7 +182,7 @@ impl Expectation {
             Some(metric) => (true, metric),
             None => (false, metric),
         };
-        let names = Metrics::default().headline().map(|(name, _)| name);
+        let names = Metrics::default().named().map(|(name, _)| name);
         if !names.contains(&metric) {
             let modes = MODE_METRICS.map(|(name, _)| name);
             return Err(format!(

@@ -134,3 +134,23 @@ pub fn edge_strips(edges: &[[u32; 2]]) -> Vec<Vec<u32>> {
     }
     strips
 }
+
+/// The contacts touching ([`crate::measures::metrics::Metrics::contacts`]): for each, the
+/// particle's position and the unit normal of the triangle it rests on (∇ₚ₀C of the built-in
+/// contact, pointing away from the triangle's body), as front ends draw and record them.
+pub fn contact_points(simulation: &Simulation, out: &mut Vec<(DVec3, DVec3)>) {
+    out.clear();
+    let positions = simulation.positions();
+    let thickness = simulation.settings().contact.thickness;
+    for pair in simulation.contact_pairs() {
+        let p = pair.map(|i| positions[i as usize]);
+        if crate::simulation::contact::project::over_triangle(p[0], [p[1], p[2], p[3]]).is_none() {
+            continue;
+        }
+        let e = crate::constraints::contact::evaluate(&p, thickness);
+        let touching = e.value + thickness <= crate::measures::metrics::TOUCHING * thickness;
+        if !e.degenerate && touching {
+            out.push((p[0], e.gradients[0]));
+        }
+    }
+}

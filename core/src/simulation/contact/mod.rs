@@ -1,0 +1,149 @@
+//! Contact between bodies, and between parts of one body: the pairs of a surface particle and a
+//! surface triangle that may meet within a frame, found once a frame ([`ContactFinder`] over a
+//! [`ContactSurface`]), and projected at the end of every sweep by each active family that binds
+//! to contacts ([`crate::constraints::Binding::Contacts`]: the built-in `contact`, whose formula
+//! is the height constraint's, or a constraint file's), as an inequality C ≥ 0 with friction.
+//!
+//! What is the same as for the other families: the formula is the family's
+//! [`crate::constraints::Constraint`], the rule is the family's (its compliance, XPBD or PBD),
+//! and both CPU engines run the one pass (`project`), each in its own precision.
+//! What differs: the pairs change every frame; a pair is projected only while C < 0 and its
+//! particle is over the triangle; its rest value is the thickness ([`ContactSettings`]);
+//! friction follows each projection.
+
+mod broad_phase;
+pub(crate) mod project;
+mod surface;
+
+pub use broad_phase::{ContactFinder, Reach};
+pub use surface::ContactSurface;
+
+use crate::constraints::{Binding, Families, Family, MAX_FAMILIES};
+use crate::simulation::Resolved;
+use arrayvec::ArrayVec;
+use std::sync::Arc;
+
+/// How contact behaves: the thickness d it keeps between surfaces, and the friction
+/// coefficients.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ContactSettings {
+    /// The thickness d, m: a particle is held at least d above any surface triangle it meets.
+    pub thickness: f64,
+    /// Static friction μ_s: a contact sticks while the slide it would make is under μ_s times
+    /// the push along the normal.
+    pub static_friction: f64,
+    /// Kinetic friction μ_k: a sliding contact is slowed by μ_k times the push.
+    pub kinetic_friction: f64,
+}
+
+impl Default for ContactSettings {
+    /// d = 0.01 m, μ_s = 0.5, μ_k = 0.4.
+    fn default() -> Self {
+        ContactSettings {
+            thickness: 0.01,
+            static_friction: 0.5,
+            kinetic_friction: 0.4,
+        }
+    }
+}
+
+impl ContactSettings {
+    /// Ok when the thickness is positive and finite and the coefficients are in [0, 10];
+    /// otherwise what is wrong, named.
+    pub fn check(&self) -> Result<(), String> {
+        crate::input::limits::THICKNESS.check(self.thickness)?;
+        crate::input::limits::FRICTION
+            .check(self.static_friction)
+            .map_err(|e| format!("static {e}"))?;
+        crate::input::limits::FRICTION
+            .check(self.kinetic_friction)
+            .map_err(|e| format!("kinetic {e}"))?;
+        Ok(())
+    }
+}
+
+/// What a frame's sweeps project of contact: the pairs found at its start, the active families
+/// that bind to contacts, the thickness and the friction.
+#[derive(Clone, Debug)]
+pub struct ContactPlan {
+    /// The pairs, [particle, a, b, c] in the scene's numbering.
+    pub found: Arc<Vec<[u32; 4]>>,
+    /// The active families that bind to contacts, in the table's order.
+    pub families: ArrayVec<Family, MAX_FAMILIES>,
+    /// The order of the pairs that the settings' order seed asks for (`None`: as found).
+    pub order: Option<Vec<u32>>,
+    /// The contact settings.
+    pub settings: ContactSettings,
+}
+
+impl ContactPlan {
+    /// The plan of a frame under `resolved` with the pairs `found`: `None` when no active family
+    /// binds to contacts.
+    pub fn new(
+        families: &Families,
+        resolved: &Resolved,
+        found: &Arc<Vec<[u32; 4]>>,
+    ) -> Option<ContactPlan> {
+        let contact: ArrayVec<Family, MAX_FAMILIES> =
+            contact_families(families, &resolved.active).collect();
+        if contact.is_empty() {
+            return None;
+        }
+        let settings = resolved.settings;
+        let order = settings.projection_order(contact[0], found.len());
+        Some(ContactPlan {
+            found: Arc::clone(found),
+            families: contact,
+            order,
+            settings: settings.contact,
+        })
+    }
+}
+
+/// The families among `active` that bind to contacts.
+pub fn contact_families<'a>(
+    families: &'a Families,
+    active: &'a crate::constraints::PerFamily<bool>,
+) -> impl Iterator<Item = Family> + 'a {
+    families
+        .all()
+        .filter(move |&f| active[f] && families.binding(f) == Binding::Contacts)
+}
+
+/// One pass of every family of `contact` over the pairs `found` (in the engine's numbering), on
+/// an engine's arrays in its precision: the positions, where the particles were at the
+/// substep's start, the inverse masses; `lambdas` holds each family's multipliers in turn
+/// (`found.len()` each). Adds each family's skipped projections to `skipped`.
+pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
+    families: &Families,
+    plan: &crate::simulation::substep::Plan,
+    contact: &ContactPlan,
+    found: &[[u32; 4]],
+    (positions, previous, inverse_masses): (&mut [V], &[V], &[V::Real]),
+    lambdas: &mut [V::Real],
+    skipped: &mut crate::constraints::PerFamily<crate::simulation::projection::SkipCounts>,
+) where
+    V::Real: crate::numbers::vector::Real<Mask = bool> + PartialOrd,
+{
+    use crate::numbers::vector::Real;
+    let n = found.len();
+    let settings = contact.settings;
+    for (k, &family) in contact.families.iter().enumerate() {
+        let pass = project::ContactPass {
+            found,
+            order: contact.order.as_deref(),
+            positions: &mut *positions,
+            previous,
+            inverse_masses,
+            lambdas: &mut lambdas[k * n..(k + 1) * n],
+            thickness: V::Real::from_f64(settings.thickness),
+            rule: plan.rules[family].to(),
+            friction: [
+                V::Real::from_f64(settings.static_friction),
+                V::Real::from_f64(settings.kinetic_friction),
+            ],
+        };
+        let counted = families.visit(family, pass);
+        skipped[family] = skipped[family] + counted;
+    }
+}
