@@ -646,7 +646,8 @@ fn a_scene_file_of_several_bodies_opens_in_the_view() {
 
 /// Two cubes stacked, opened as a scene file: with the contact family switched on in the solver
 /// panel (which then shows the thickness and friction), the small cube rests on the large one
-/// frame after frame, touching it, where without contact it would sink into it.
+/// frame after frame, touching it, where without contact it would sink into it; the contacts'
+/// normals are drawn where they touch.
 #[test]
 fn a_stack_rests_on_contact_in_the_workbench() {
     let mut harness = workbench("cube", 2);

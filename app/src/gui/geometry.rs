@@ -372,6 +372,9 @@ pub fn update(
         );
     } else {
         tet_arrows(bench, options, arrows);
+        if options.arrows {
+            visual::contact_arrows(simulation, options.arrow_scale as f64, arrows);
+        }
     }
     if let Some(mode) = bench.mode_shown.filter(|m| m.tet < tets.len()) {
         let corners = tets[mode.tet];

@@ -47,8 +47,8 @@ pub struct Recorder<'a> {
     logged_colours: Option<Vec<Rgba>>,
     points: Vec<Vec3>,
     arrow_scratch: Vec<Arrow>,
-    /// The contacts touching, reused every frame: each particle's position and normal.
-    contact_scratch: Vec<(glam::DVec3, glam::DVec3)>,
+    /// The arrows of the contacts touching, reused every frame.
+    contact_scratch: Vec<Arrow>,
     modes: bool,
 }
 
@@ -239,8 +239,9 @@ impl<'a> Recorder<'a> {
     }
 
     /// Logs the contacts touching, where a family on contacts is active: each particle's point
-    /// and its contact normal, a thickness long (`world/contacts`, in the contact family's
-    /// colour), and the contacts and the largest penetration as metrics.
+    /// and its contact normal (`world/contacts`, in the contact family's colour,
+    /// [`visual::contact_arrows`], as the workbench draws them), and the contacts and the
+    /// largest penetration as metrics.
     fn log_contacts(&mut self, simulation: &Simulation, metrics: &Metrics) {
         let families = simulation.families();
         let Some(family) =
@@ -249,18 +250,16 @@ impl<'a> Recorder<'a> {
         else {
             return;
         };
-        visual::contact_points(simulation, &mut self.contact_scratch);
-        let length = 10.0 * simulation.settings().contact.thickness;
+        self.contact_scratch.clear();
+        visual::contact_arrows(simulation, 1.0, &mut self.contact_scratch);
         let [r, g, b, a] = visual::family_colour(families, family);
         self.rec
             .log(
                 format!("{}world/contacts", self.root),
                 &rerun::Arrows3D::from_vectors(
-                    self.contact_scratch
-                        .iter()
-                        .map(|(_, n)| (*n * length).as_vec3()),
+                    self.contact_scratch.iter().map(|a| a.vector.as_vec3()),
                 )
-                .with_origins(self.contact_scratch.iter().map(|(p, _)| p.as_vec3()))
+                .with_origins(self.contact_scratch.iter().map(|a| a.origin.as_vec3()))
                 .with_colors([rerun::Color::from_unmultiplied_rgba(r, g, b, a)]),
             )
             .ok();

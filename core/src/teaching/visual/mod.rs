@@ -10,7 +10,7 @@ pub use arrows::{
     along_mode, mode_arrows, projection_arrows, selected_arrows,
 };
 pub use surface::{
-    ALL_FACES_UP_TO, contact_points, display_edges, display_faces, edge_strips, faces_with_tets,
+    ALL_FACES_UP_TO, contact_arrows, display_edges, display_faces, edge_strips, faces_with_tets,
     held_particle_colours, inverted_tets, particle_colours,
 };
 

@@ -135,13 +135,20 @@ pub fn edge_strips(edges: &[[u32; 2]]) -> Vec<Vec<u32>> {
     strips
 }
 
-/// The contacts touching ([`crate::measures::metrics::Metrics::contacts`]): for each, the
-/// particle's position and the unit normal of the triangle it rests on (∇ₚ₀C of the built-in
-/// contact, pointing away from the triangle's body), as front ends draw and record them.
-pub fn contact_points(simulation: &Simulation, out: &mut Vec<(DVec3, DVec3)>) {
-    out.clear();
+/// The arrows of the contacts touching ([`crate::measures::metrics::Metrics::contacts`]), where
+/// a family on contacts is active: at each touching particle, ∇ₚ₀C of the built-in contact (the
+/// unit normal of the triangle it rests on, pointing out of the triangle's body), in the first
+/// such family's colour, [`super::GRADIENT_ARROW_LENGTH`] mean rest edges long at `gain` 1.
+/// Appended to `out`.
+pub fn contact_arrows(simulation: &Simulation, gain: f64, out: &mut Vec<super::Arrow>) {
+    let families = simulation.families();
+    let active = simulation.active();
+    let Some(family) = crate::simulation::contact::contact_families(families, active).next() else {
+        return;
+    };
     let positions = simulation.positions();
     let thickness = simulation.settings().contact.thickness;
+    let length = gain * super::GRADIENT_ARROW_LENGTH * simulation.body().mean_edge;
     for pair in simulation.contact_pairs() {
         let p = pair.map(|i| positions[i as usize]);
         if crate::simulation::contact::project::over_triangle(p[0], [p[1], p[2], p[3]]).is_none() {
@@ -150,7 +157,13 @@ pub fn contact_points(simulation: &Simulation, out: &mut Vec<(DVec3, DVec3)>) {
         let e = crate::constraints::contact::evaluate(&p, thickness);
         let touching = e.value + thickness <= crate::measures::metrics::TOUCHING * thickness;
         if !e.degenerate && touching {
-            out.push((p[0], e.gradients[0]));
+            out.push(super::Arrow {
+                quantity: super::Quantity::Gradient(family),
+                particle: pair[0],
+                origin: p[0],
+                value: e.gradients[0],
+                vector: e.gradients[0] * length,
+            });
         }
     }
 }
