@@ -664,3 +664,46 @@ fn a_scene_file_of_several_bodies_is_run_and_measured_body_by_body() {
     assert!(!message.contains("panicked"), "{message}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Contact on the command line: the stacked cubes rest and `run` says how they touch; the
+/// Newton reference, which solves a substep without contact, is refused for a family on
+/// contacts, as is `--exact-step`, which steps against it.
+#[test]
+fn contact_is_reported_and_refused_where_it_cannot_run() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../assets/scenes/stacked-cubes.toml"
+    );
+    let common = [
+        "run",
+        "--scene",
+        scene,
+        "--constraints",
+        "edges,volume,contact",
+    ];
+    let output = tetlab(&[&common[..], &["--frames", "10"]].concat());
+    let text = stdout(&output);
+    assert!(output.status.success(), "{text}");
+    assert!(
+        text.contains("contact thickness 0.01 m, friction 0.5/0.4"),
+        "{text}"
+    );
+    assert!(text.contains("contact: 13 touching at the end"), "{text}");
+    let json = tetlab(&[&common[..], &["--frames", "1", "--json"]].concat());
+    let last: serde_json::Value = stdout(&json)
+        .lines()
+        .last()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .unwrap();
+    assert!(last["contacts"].as_u64().unwrap() > 0, "{last}");
+    assert!(last["max_penetration"].as_f64().unwrap() < 1e-3, "{last}");
+    let newton = tetlab(&[&common[..], &["--engine", "newton", "--frames", "1"]].concat());
+    assert_usage_error(
+        &newton,
+        "--engine newton: the Newton reference solves a substep without contact",
+    );
+    let exact = tetlab(&[&common[..], &["--exact-step", "--frames", "1"]].concat());
+    assert_usage_error(&exact, "--exact-step: the Newton reference");
+    let friction = tetlab(&[&common[..], &["--friction", "0.5,x", "--frames", "1"]].concat());
+    assert_usage_error(&friction, "--friction");
+}

@@ -411,8 +411,10 @@ fn compare_frame_one(
 /// A claim on a knife edge: each engine runs [`Claim::orderings`] order seeds, and the numbers
 /// that recover may differ by one of N at most.
 fn compare_orderings(claim: &Claim, scene: &Scene) -> Option<String> {
+    let builtin = tetlab_core::constraints::Families::builtin();
     let ensemble = Ensemble {
         scene,
+        families: &builtin,
         settings: claim.settings(EngineChoice::Reference),
         perturbation: claim.perturbation,
         frames: claim.frames,

@@ -232,6 +232,13 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         return run_ensemble(args, n, out);
     }
     let (scene, mut simulation) = args.simulation.build()?;
+    if args.exact_step && has_contact(&simulation) {
+        return Err(UsageError(
+            "--exact-step: the Newton reference it steps against solves a substep without \
+             contact, so with a family on contacts there is no exact frame to compare with"
+                .to_owned(),
+        ));
+    }
     let io = UsageError::stdout;
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
     let mut outcome = Outcome::start(&simulation, &initial);
@@ -397,6 +404,7 @@ fn run_ensemble(args: &Args, n: u64, out: &mut impl Write) -> Result<(), UsageEr
     };
     let ensemble = Ensemble {
         scene: &scene,
+        families: simulation.families(),
         settings: *simulation.settings(),
         perturbation: args.simulation.perturb,
         frames: args.simulation.frames,

@@ -222,6 +222,15 @@ impl SolverArgs {
                 .map_err(|e| UsageError(format!("--stiffness {name}={value}: {e}")))?;
             settings.stiffness.set(family, *value);
         }
+        let contact =
+            tetlab_core::simulation::contact::contact_families(&families, &settings.active).next();
+        if let (Some(family), Some(EngineChoice::Newton)) = (contact, self.engine) {
+            return Err(UsageError(format!(
+                "--engine newton: the Newton reference solves a substep without contact, and {} \
+                 is a family on contacts: run it on the reference or the fast engine",
+                families.name(family)
+            )));
+        }
         Ok((settings, families))
     }
 

@@ -8,6 +8,7 @@
 //! engine runs on one thread, which gives the same bits as any other count. The results come
 //! back in (engine, seed) order whatever the number of workers.
 
+use crate::constraints::Families;
 use crate::measures::metrics::Metrics;
 use crate::measures::outcome::Outcome;
 use crate::scene::{Perturbation, Scene};
@@ -21,6 +22,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 pub struct Ensemble<'a> {
     /// The scene.
     pub scene: &'a Scene,
+    /// The table of families the members run: the built-in ones and those of the constraint
+    /// files the settings may make active.
+    pub families: &'a Families,
     /// The settings of every member but its engine and order seed.
     pub settings: Settings,
     /// Applied before the first frame.
@@ -53,7 +57,7 @@ impl Ensemble<'_> {
             order_seed,
             ..self.settings
         };
-        let mut simulation = Simulation::new(self.scene, settings);
+        let mut simulation = Simulation::with_families(self.scene, settings, self.families.clone());
         simulation.set_threads(threads);
         if let Some(perturbation) = self.perturbation {
             simulation.perturb(perturbation);

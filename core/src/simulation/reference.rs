@@ -136,7 +136,7 @@ impl Substeps for OnState<'_> {
         let s = &mut *self.state;
         crate::simulation::contact::project_pairs(
             self.families,
-            plan,
+            &plan.rules,
             contact,
             &contact.found,
             (&mut s.positions, &s.previous, &s.inverse_masses),

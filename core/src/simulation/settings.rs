@@ -116,7 +116,7 @@ pub struct Settings {
     /// How contact behaves (its thickness and friction), for the families that bind to
     /// contacts ([`super::contact`]).
     #[serde(default)]
-    pub contact: super::contact::ContactSettings,
+    pub contact: super::contact::contact_settings::ContactSettings,
 }
 
 fn default_reach() -> f64 {
@@ -220,7 +220,7 @@ impl Default for Settings {
             engine: EngineChoice::Auto,
             order_seed: None,
             reach: DEFAULT_REACH,
-            contact: super::contact::ContactSettings::default(),
+            contact: super::contact::contact_settings::ContactSettings::default(),
         }
     }
 }

@@ -52,7 +52,7 @@ pub struct Body {
     /// The bodies of a scene file; empty for a scene of one body.
     pub bodies: Vec<crate::scene::SceneBody>,
     /// The surface contact is found on, made when first asked for ([`Body::contact_surface`]).
-    pub(crate) contact_surface: std::sync::OnceLock<super::contact::ContactSurface>,
+    pub(crate) contact_surface: std::sync::OnceLock<super::contact::surface::ContactSurface>,
 }
 
 /// Where the particles are and how they move, in f64 and in the scene's numbering.
@@ -212,9 +212,9 @@ impl State {
 
 impl Body {
     /// The surface contact is found on: its triangles, particles and neighbours.
-    pub fn contact_surface(&self) -> &super::contact::ContactSurface {
+    pub fn contact_surface(&self) -> &super::contact::surface::ContactSurface {
         self.contact_surface.get_or_init(|| {
-            super::contact::ContactSurface::of(&self.tets, self.rest_positions.len())
+            super::contact::surface::ContactSurface::of(&self.tets, self.rest_positions.len())
         })
     }
 

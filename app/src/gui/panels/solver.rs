@@ -41,13 +41,27 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
         ui.radio_value(&mut settings.method, Method::Xpbd, "XPBD");
         ui.radio_value(&mut settings.method, Method::Pbd, "PBD");
     });
+    let contact = tetlab_core::simulation::contact::contact_families(families, &current.active)
+        .next()
+        .is_some();
     ui.horizontal(|ui| {
         ui.label("engine");
         for engine in EngineChoice::ALL {
-            ui.radio_value(&mut settings.engine, engine, engine.name())
-                .on_hover_text(engine.summary());
+            // The Newton reference solves a substep without contact.
+            let without = contact && engine == EngineChoice::Newton;
+            ui.add_enabled_ui(!without, |ui| {
+                ui.radio_value(&mut settings.engine, engine, engine.name())
+                    .on_hover_text(engine.summary())
+                    .on_disabled_hover_text(
+                        "The Newton reference solves a substep without contact: switch contact \
+                         off to use it",
+                    );
+            });
         }
     });
+    if contact && settings.engine == EngineChoice::Newton {
+        settings.engine = EngineChoice::Auto;
+    }
     for (group, members) in families.groups() {
         let family = members.families().next().expect("a group has a family");
         // The material gives the compliance of the neo-Hookean pair and of a file's constraints

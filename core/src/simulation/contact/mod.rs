@@ -12,55 +12,18 @@
 //! friction follows each projection.
 
 mod broad_phase;
+pub(crate) mod contact_settings;
 pub(crate) mod project;
-mod surface;
+pub(crate) mod surface;
 
 pub use broad_phase::{ContactFinder, Reach};
+pub use contact_settings::ContactSettings;
 pub use surface::ContactSurface;
 
 use crate::constraints::{Binding, Families, Family, MAX_FAMILIES};
 use crate::simulation::Resolved;
 use arrayvec::ArrayVec;
 use std::sync::Arc;
-
-/// How contact behaves: the thickness d it keeps between surfaces, and the friction
-/// coefficients.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ContactSettings {
-    /// The thickness d, m: a particle is held at least d above any surface triangle it meets.
-    pub thickness: f64,
-    /// Static friction μ_s: a contact sticks while the slide it would make is under μ_s times
-    /// the push along the normal.
-    pub static_friction: f64,
-    /// Kinetic friction μ_k: a sliding contact is slowed by μ_k times the push.
-    pub kinetic_friction: f64,
-}
-
-impl Default for ContactSettings {
-    /// d = 0.01 m, μ_s = 0.5, μ_k = 0.4.
-    fn default() -> Self {
-        ContactSettings {
-            thickness: 0.01,
-            static_friction: 0.5,
-            kinetic_friction: 0.4,
-        }
-    }
-}
-
-impl ContactSettings {
-    /// Ok when the thickness is positive and finite and the coefficients are in [0, 10];
-    /// otherwise what is wrong, named.
-    pub fn check(&self) -> Result<(), String> {
-        crate::input::limits::THICKNESS.check(self.thickness)?;
-        crate::input::limits::FRICTION
-            .check(self.static_friction)
-            .map_err(|e| format!("static {e}"))?;
-        crate::input::limits::FRICTION
-            .check(self.kinetic_friction)
-            .map_err(|e| format!("kinetic {e}"))?;
-        Ok(())
-    }
-}
 
 /// What a frame's sweeps project of contact: the pairs found at its start, the active families
 /// that bind to contacts, the thickness and the friction.
@@ -113,10 +76,11 @@ pub fn contact_families<'a>(
 /// One pass of every family of `contact` over the pairs `found` (in the engine's numbering), on
 /// an engine's arrays in its precision: the positions, where the particles were at the
 /// substep's start, the inverse masses; `lambdas` holds each family's multipliers in turn
-/// (`found.len()` each). Adds each family's skipped projections to `skipped`.
+/// (`found.len()` each); `rules` are the families' rules. Adds each family's skipped
+/// projections to `skipped`.
 pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
     families: &Families,
-    plan: &crate::simulation::substep::Plan,
+    rules: &crate::constraints::PerFamily<crate::simulation::projection::Rule<f64>>,
     contact: &ContactPlan,
     found: &[[u32; 4]],
     (positions, previous, inverse_masses): (&mut [V], &[V], &[V::Real]),
@@ -137,7 +101,7 @@ pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
             inverse_masses,
             lambdas: &mut lambdas[k * n..(k + 1) * n],
             thickness: V::Real::from_f64(settings.thickness),
-            rule: plan.rules[family].to(),
+            rule: rules[family].to(),
             friction: [
                 V::Real::from_f64(settings.static_friction),
                 V::Real::from_f64(settings.kinetic_friction),

@@ -106,7 +106,7 @@ impl Substeps for OnArrays<'_> {
         let (found, lambdas) = &mut s.contacts;
         crate::simulation::contact::project_pairs(
             &s.families,
-            plan,
+            &plan.rules,
             contact,
             found,
             (&mut s.positions, &s.previous, &s.inverse_masses),
