@@ -49,14 +49,17 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
         for engine in EngineChoice::ALL {
             // The Newton reference solves a substep without contact.
             let without = contact && engine == EngineChoice::Newton;
-            ui.add_enabled_ui(!without, |ui| {
-                ui.radio_value(&mut settings.engine, engine, engine.name())
-                    .on_hover_text(engine.summary())
-                    .on_disabled_hover_text(
-                        "The Newton reference solves a substep without contact: switch contact \
-                         off to use it",
-                    );
-            });
+            let radio = egui::RadioButton::new(settings.engine == engine, engine.name());
+            let response = ui
+                .add_enabled(!without, radio)
+                .on_hover_text(engine.summary())
+                .on_disabled_hover_text(
+                    "The Newton reference solves a substep without contact: switch contact off \
+                     to use it",
+                );
+            if response.clicked() {
+                settings.engine = engine;
+            }
         }
     });
     if contact && settings.engine == EngineChoice::Newton {
