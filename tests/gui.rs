@@ -620,14 +620,7 @@ fn open_mesh_file_browses_and_loads_a_mesh() {
 #[test]
 fn a_scene_file_of_several_bodies_opens_in_the_view() {
     let mut harness = workbench("cube", 2);
-    harness.get_by_label("mesh file").click();
-    harness.run_steps(1);
-    harness
-        .get_by_label("mesh file")
-        .type_text("../assets/scenes/thrown.toml");
-    harness.run_steps(1);
-    harness.get_by_label("Open").click();
-    harness.run_steps(3);
+    open_by_path(&mut harness, "../assets/scenes/thrown.toml");
     let bench = &harness.state().bench;
     assert_eq!(bench.scene.name, "thrown");
     let names: Vec<&str> = bench
@@ -651,14 +644,7 @@ fn a_scene_file_of_several_bodies_opens_in_the_view() {
 #[test]
 fn a_stack_rests_on_contact_in_the_workbench() {
     let mut harness = workbench("cube", 2);
-    harness.get_by_label("mesh file").click();
-    harness.run_steps(1);
-    harness
-        .get_by_label("mesh file")
-        .type_text("../assets/scenes/stacked-cubes.toml");
-    harness.run_steps(1);
-    harness.get_by_label("Open").click();
-    harness.run_steps(3);
+    open_by_path(&mut harness, "../assets/scenes/stacked-cubes.toml");
     // The solver panel's checkbox, above the compare panel's.
     harness
         .get_all_by_label("contact")
@@ -687,6 +673,16 @@ fn a_stack_rests_on_contact_in_the_workbench() {
         "the small cube rests on the large one: {lowest}"
     );
     harness.snapshot("contact_stack");
+}
+
+/// Types `path` into the mesh-file field and presses Open.
+fn open_by_path(harness: &mut Harness<'static, TetlabApp>, path: &str) {
+    harness.get_by_label("mesh file").click();
+    harness.run_steps(1);
+    harness.get_by_label("mesh file").type_text(path);
+    harness.run_steps(1);
+    harness.get_by_label("Open").click();
+    harness.run_steps(3);
 }
 
 /// A panel and the requests it made, drawn on its own.
