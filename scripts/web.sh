@@ -55,6 +55,13 @@ for name in $(sed -n 's|^scene = ".*shared/meshes/\([^"]*\)".*|\1|p' assets/less
     fi
   done
 done
+# The scene files the built-in lessons name (lesson 14's stacked cubes, `../scenes/NAME.toml`),
+# from assets/scenes, beside them: the page fetches them from meshes/ too.
+for name in $(sed -n 's|^scene = "\.\./scenes/\([^"]*\)".*|\1|p' assets/lessons/*.toml | sort -u); do
+  mkdir -p "$out/meshes"
+  cp "assets/scenes/$name" "$out/meshes/$name"
+  echo "== placed assets/scenes/$name in $out/meshes/"
+done
 
 # Binaryen's optimiser (-Oz) with TETLAB_WASM_OPT=1, from the npm registry's `binaryen` package
 # (its JavaScript build runs on the machine's Node.js; Debian 12's binaryen 108 is too old for
