@@ -706,4 +706,13 @@ fn contact_is_reported_and_refused_where_it_cannot_run() {
     assert_usage_error(&exact, "--exact-step: the Newton reference");
     let friction = tetlab(&[&common[..], &["--friction", "0.5,x", "--frames", "1"]].concat());
     assert_usage_error(&friction, "--friction");
+    // A negative value is the value's mistake, not taken for an option.
+    for (option, value, said) in [
+        ("--thickness", "-1", "thickness -1 is out of range"),
+        ("--friction", "-1", "friction -1 is out of range"),
+        ("--friction", "0.2,-1", "friction -1 is out of range"),
+    ] {
+        let wrong = tetlab(&[&common[..], &[option, value, "--frames", "1"]].concat());
+        assert_usage_error(&wrong, said);
+    }
 }

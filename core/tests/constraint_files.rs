@@ -360,3 +360,42 @@ fn hessian_blocks_cost_an_element_no_storage() {
     let gradients = check(&file, 2000, 1);
     assert!(gradients.agrees(), "{gradients:?}");
 }
+
+#[test]
+fn a_file_on_contacts_is_refused_what_a_contact_has_not() {
+    // A contact is found where surfaces meet: it has no rest shape, no rest value of its own,
+    // no stored numbers and no motion of its own (friction is the contact's).
+    let header = "name = \"c\"\napplies_to = \"contacts\"\n";
+    for (body, what) in [
+        ("value = \"length(p0 - q0) - rest\"", "no rest shape"),
+        ("value = \"dot(p0 - p1, q2 - q1) - rest\"", "no rest shape"),
+        ("value = \"det(Dm) - rest\"", "no rest shape"),
+        ("value = \"V0 - rest\"", "no rest shape"),
+        (
+            "value = \"length(p0 - p1) - rest\"\n[gradient]\np0 = \"q0 - p1\"",
+            "no rest shape",
+        ),
+        (
+            "value = \"length(p0 - p1)\"\nrest = \"0.1\"",
+            "no rest shape",
+        ),
+        (
+            "value = \"length(p0 - start0) - rest\"",
+            "not where they were",
+        ),
+        (
+            "value = \"length(p0 - p1) * h - rest\"",
+            "not where they were",
+        ),
+    ] {
+        let message = error(&format!("{header}{body}\n"));
+        assert!(message.starts_with("mine.toml:2:14: "), "{body}: {message}");
+        assert!(message.contains(what), "{body}: {message}");
+    }
+    // What it may read: where its four particles are and the thickness.
+    let file = ConstraintFile::parse(
+        Path::new("mine.toml"),
+        &format!("{header}value = \"dot(p0 - p1, normalize(cross(p2 - p1, p3 - p1))) - rest\"\n"),
+    );
+    assert!(file.is_ok(), "{:?}", file.err().map(|e| e.to_string()));
+}

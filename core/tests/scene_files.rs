@@ -79,6 +79,14 @@ fn every_mistake_is_named_at_its_place() {
     assert!(e.starts_with("s.toml:3:1:") && e.contains("colour"), "{e}");
     let e = mistake("[[body]]\nmesh = \"cube\"\nscale = 0\n");
     assert!(e.starts_with("s.toml:3:9: scale is 0"), "{e}");
+    // A scale of the wrong shape is told what a scale is, at its place.
+    for (scale, shown) in [("[1, 2]", "[1, 2]"), ("\"big\"", "\"big\"")] {
+        let e = mistake(&format!("[[body]]\nmesh = \"cube\"\nscale = {scale}\n"));
+        assert!(
+            e.starts_with(&format!("s.toml:3:9: scale is {shown}")) && e.contains("one per axis"),
+            "{e}"
+        );
+    }
     let e = mistake("[[body]]\nmesh = \"cube\"\nvelocity = [0, nan, 0]\n");
     assert!(
         e.starts_with("s.toml:3:12: velocity") && e.contains("finite"),

@@ -177,6 +177,47 @@ fn a_step_allocates_nothing() {
     }
 }
 
+/// With contact, the pairs are found again every frame: the grid holds one entry per surface
+/// particle, and the pairs keep room for twice the most yet, so a cube dropped onto another,
+/// grabbed by a bottom corner and dragged across it allocates nothing once it has landed.
+#[test]
+fn a_step_with_contact_allocates_nothing_once_its_arrays_have_grown() {
+    let text = "[[body]]\nmesh = \"cube\"\nresolution = 3\n\
+                [[body]]\nmesh = \"cube\"\nresolution = 2\nscale = 0.5\n\
+                rotate = [0, 30, 0]\ntranslate = [0, 0.9, 0]\n";
+    let scene = Scene::parse_file(std::path::Path::new("stack.toml"), text).unwrap();
+    for engine in [EngineChoice::Reference, EngineChoice::Fast] {
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        let active = simulation
+            .families()
+            .parse_list("edges,volume,contact")
+            .unwrap();
+        simulation.set_settings(Settings {
+            active,
+            engine,
+            ..Settings::default()
+        });
+        for _ in 0..30 {
+            simulation.step();
+        }
+        // Its first particle is a bottom corner: dragged along the lower cube's top.
+        let corner = scene.bodies[1].particles.start as usize;
+        let at = simulation.positions()[corner];
+        simulation.grab(corner, at);
+        simulation.step();
+        let before = allocations();
+        for k in 0..10 {
+            simulation.move_grab(at + DVec3::new(0.005 * k as f64, 0.0, 0.0));
+            simulation.step();
+        }
+        assert_eq!(allocations(), before, "{engine:?}");
+        assert!(
+            Metrics::measure(&simulation).contacts > 0,
+            "{engine:?}: the cubes touch"
+        );
+    }
+}
+
 #[test]
 fn masses_are_lumped_from_density_times_rest_volume() {
     let scene = Scene::builtin(Builtin::Ball, 2).unwrap();

@@ -146,11 +146,11 @@ pub struct SolverArgs {
     pub reach: f64,
     /// The thickness contact keeps between surfaces, in metres (1e-9..=1e3), for the contact
     /// family [default: 0.01].
-    #[arg(long, value_name = "D", default_value_t = Settings::default().contact.thickness, value_parser = |s: &str| limits::THICKNESS.parse(s))]
+    #[arg(long, value_name = "D", default_value_t = Settings::default().contact.thickness, value_parser = |s: &str| limits::THICKNESS.parse(s), allow_hyphen_values = true)]
     pub thickness: f64,
     /// Friction of contact: static and kinetic coefficients μs,μk (each 0..=10), or one number
     /// for both [default: 0.5,0.4].
-    #[arg(long, value_name = "MU_S[,MU_K]", value_parser = parse_friction)]
+    #[arg(long, value_name = "MU_S[,MU_K]", value_parser = parse_friction, allow_hyphen_values = true)]
     pub friction: Option<[f64; 2]>,
 }
 

@@ -210,8 +210,9 @@ pub(super) fn parse_all(
                     .to_owned(),
             ));
         };
-        let file = shared.compile(file_name, None, value, &single)?;
-        return Ok(vec![file]);
+        let files = vec![shared.compile(file_name, None, value, &single)?];
+        what_a_contact_has(&files, binding, &raw.applies_to, &error)?;
+        return Ok(files);
     }
     let stray = [&raw.value, &raw.rest, &raw.stiffness]
         .into_iter()
@@ -306,34 +307,50 @@ pub(super) fn parse_all(
         files[a].pair = Some(name_b);
         files[b].pair = Some(name_a);
     }
-    if binding == Binding::Contacts {
-        // A contact is found where two surfaces meet, not laid on the rest shape: it has no rest
-        // shape to read, and its rest value is the contact's thickness.
-        let at = Some(raw.applies_to.span().start);
-        for file in &files {
-            if file.reads_rest_shape() || file.stored_len() > 0 || file.has_own_rest() {
-                return Err(error(
-                    at,
-                    format!(
-                        "{}: a constraint on contacts has no rest shape (q0…, Dm, V0) and no \
-                         rest of its own: `rest` in C is the contact's thickness",
-                        file.name
-                    ),
-                ));
-            }
-            if file.reads_motion() {
-                return Err(error(
-                    at,
-                    format!(
-                        "{}: a constraint on contacts reads where its particles are, not where \
-                         they were (start0…, h): friction is the contact's own",
-                        file.name
-                    ),
-                ));
-            }
+    what_a_contact_has(&files, binding, &raw.applies_to, &error)?;
+    Ok(files)
+}
+
+/// A constraint on contacts is found where two surfaces meet, not laid on the rest shape: it
+/// reads no rest shape (in C, its gradient or what it stores), gives no rest value of its own
+/// (its `rest` is the contact's thickness) and no motion (friction is the contact's own). Any
+/// of them is refused at `applies_to`.
+fn what_a_contact_has(
+    files: &[ConstraintFile],
+    binding: Binding,
+    applies_to: &Spanned<String>,
+    error: &dyn Fn(Option<usize>, String) -> ConstraintFileError,
+) -> Result<(), ConstraintFileError> {
+    if binding != Binding::Contacts {
+        return Ok(());
+    }
+    let at = Some(applies_to.span().start);
+    for file in files {
+        let c_reads_rest = [&file.value, &file.gradient, &file.yours]
+            .iter()
+            .any(|tape| tape.reads_rest_shape());
+        if c_reads_rest || file.reads_rest_shape() || file.stored_len() > 0 || file.has_own_rest() {
+            return Err(error(
+                at,
+                format!(
+                    "{}: a constraint on contacts has no rest shape (q0…, Dm, V0) and no rest \
+                     of its own: `rest` in C is the contact's thickness",
+                    file.name
+                ),
+            ));
+        }
+        if file.reads_motion() {
+            return Err(error(
+                at,
+                format!(
+                    "{}: a constraint on contacts reads where its particles are, not where they \
+                     were (start0…, h): friction is the contact's own",
+                    file.name
+                ),
+            ));
         }
     }
-    Ok(files)
+    Ok(())
 }
 
 /// What the constraints of a file share: where it is, its text, its binding and `define`.

@@ -77,10 +77,57 @@ struct RawBody {
 
 /// A body's scale: one factor, or one per axis.
 #[derive(serde::Deserialize)]
-#[serde(untagged)]
+#[serde(try_from = "toml::Value")]
 enum Scale {
     One(f64),
     Axes([f64; 3]),
+}
+
+impl TryFrom<toml::Value> for Scale {
+    type Error = String;
+
+    /// `2`, `0.5` or `[1, 2, 1]`; anything else is told what a scale is.
+    fn try_from(value: toml::Value) -> Result<Self, String> {
+        let number = |v: &toml::Value| match v {
+            toml::Value::Float(k) => Some(*k),
+            toml::Value::Integer(k) => Some(*k as f64),
+            _ => None,
+        };
+        let wrong = || {
+            format!(
+                "scale is {}: it is one factor (`scale = 2`) or one per axis \
+                 (`scale = [1, 2, 1]`, three numbers)",
+                written(&value)
+            )
+        };
+        if let Some(k) = number(&value) {
+            return Ok(Scale::One(k));
+        }
+        match &value {
+            toml::Value::Array(items) if items.len() == 3 => {
+                let axes: Option<Vec<f64>> = items.iter().map(number).collect();
+                let axes = axes.ok_or_else(wrong)?;
+                Ok(Scale::Axes([axes[0], axes[1], axes[2]]))
+            }
+            _ => Err(wrong()),
+        }
+    }
+}
+
+/// A TOML value as it would be written in the file, for a message.
+fn written(value: &toml::Value) -> String {
+    match value {
+        toml::Value::String(text) => format!("{text:?}"),
+        toml::Value::Integer(k) => k.to_string(),
+        toml::Value::Float(k) => k.to_string(),
+        toml::Value::Boolean(b) => b.to_string(),
+        toml::Value::Datetime(d) => d.to_string(),
+        toml::Value::Array(items) => {
+            let items: Vec<String> = items.iter().map(written).collect();
+            format!("[{}]", items.join(", "))
+        }
+        toml::Value::Table(_) => "a table".to_string(),
+    }
 }
 
 /// The largest |coordinate| a placement or a velocity may give, in metres or m/s: far beyond any

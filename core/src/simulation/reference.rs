@@ -124,6 +124,7 @@ impl Substeps for OnState<'_> {
         }
         if let Some(contact) = &plan.contact {
             let wanted = contact.found.len() * contact.families.len();
+            super::contact::keep_room(&mut self.state.contact_lambdas, wanted);
             self.state.contact_lambdas.resize(wanted, 0.0);
             self.state.contact_lambdas.fill(0.0);
         }

@@ -75,6 +75,7 @@ impl Simulation {
         let found = (self.contact_finder).find(surface, &state.positions, &state.velocities, reach);
         let contacts = std::sync::Arc::make_mut(&mut state.contacts);
         contacts.clear();
+        super::contact::keep_room(contacts, found.len());
         contacts.extend_from_slice(found);
     }
 

@@ -1,9 +1,9 @@
 //! The broad phase: which (particle, triangle) pairs may meet within a frame, found once a frame
 //! with a spatial hash ([`ContactFinder::find`]).
 //!
-//! Every surface triangle's bounding box, grown by a margin m, is entered in the cells of a
-//! uniform grid it overlaps (the cells hashed to 64 bits, kept sorted in one flat array); each
-//! surface particle looks in its own cell. A pair is kept when the particle may touch the
+//! Every surface particle is entered in its cell of a uniform grid (the cell hashed to 64 bits,
+//! one entry per particle, kept sorted in one flat array); every surface triangle's bounding
+//! box, grown by a margin m, looks in the cells it overlaps. A pair is kept when the particle may touch the
 //! triangle ([`super::ContactSurface::may_touch`]), lies within m of the triangle's plane on its
 //! outer side or at most one thickness d under it (−d ≤ h ≤ m), and its foot on the plane lies
 //! within m of the triangle. The margin covers the largest motion of the frame:
@@ -15,7 +15,8 @@
 //!
 //! A uniform grid rather than a bounding-volume hierarchy: the bodies are of one scale (a
 //! triangle's size varies little across a tet mesh), the grid is rebuilt in one sort a frame
-//! and allocates nothing once its arrays have grown; a hierarchy would have to be refitted or
+//! and holds exactly one entry per surface particle, so it never grows after the first frame
+//! (the pairs found keep room for twice the most yet: [`super::keep_room`]); a hierarchy would have to be refitted or
 //! rebuilt every frame too (docs/performance.md has the measured cost).
 
 use super::ContactSurface;
@@ -25,7 +26,7 @@ use glam::DVec3;
 /// once they have grown, and the pairs found.
 #[derive(Clone, Debug, Default)]
 pub struct ContactFinder {
-    /// (cell hash, triangle), sorted.
+    /// (cell hash, surface particle), sorted: one entry per surface particle.
     cells: Vec<(u64, u32)>,
     /// The pairs found: [particle, triangle's three corners], sorted.
     found: Vec<[u32; 4]>,
@@ -90,40 +91,46 @@ impl ContactFinder {
             return &self.found;
         }
         let index = |p: DVec3| (p / cell).floor();
-        for (k, t) in surface.triangles.iter().enumerate() {
-            let (low, high) = bounds(t);
+        let key = |[x, y, z]: [f64; 3]| hash([x as i64, y as i64, z as i64]);
+        // Each surface particle in its one cell: as many entries as surface particles, every
+        // frame, so the array never grows after the first.
+        self.cells.reserve_exact(surface.particles.len());
+        for &particle in &surface.particles {
+            let at = index(positions[particle as usize]);
+            self.cells.push((key(at.to_array()), particle));
+        }
+        self.cells.sort_unstable();
+        // Each triangle looks in the cells its grown box covers.
+        for triangle in &surface.triangles {
+            let (low, high) = bounds(triangle);
             let (low, high) = (index(low), index(high));
             let span = high - low;
+            let corners = triangle.map(|i| positions[i as usize]);
             for x in 0..=span.x as i64 {
                 for y in 0..=span.y as i64 {
                     for z in 0..=span.z as i64 {
-                        let at = [low.x as i64 + x, low.y as i64 + y, low.z as i64 + z];
-                        self.cells.push((hash(at), k as u32));
+                        let at = low + DVec3::new(x as f64, y as f64, z as f64);
+                        let cell = key(at.to_array());
+                        let start = self.cells.partition_point(|&(h, _)| h < cell);
+                        for &(h, particle) in &self.cells[start..] {
+                            if h != cell {
+                                break;
+                            }
+                            if !surface.may_touch(particle, *triangle) {
+                                continue;
+                            }
+                            let x = positions[particle as usize];
+                            if near(x, corners, margin, reach.thickness) {
+                                let [a, b, c] = *triangle;
+                                self.found.push([particle, a, b, c]);
+                            }
+                        }
                     }
                 }
             }
         }
-        self.cells.sort_unstable();
-        for &particle in &surface.particles {
-            let x = positions[particle as usize];
-            let at = index(x);
-            let key = hash([at.x as i64, at.y as i64, at.z as i64]);
-            let start = self.cells.partition_point(|&(h, _)| h < key);
-            for &(h, k) in &self.cells[start..] {
-                if h != key {
-                    break;
-                }
-                let triangle = surface.triangles[k as usize];
-                if !surface.may_touch(particle, triangle) {
-                    continue;
-                }
-                let corners = triangle.map(|i| positions[i as usize]);
-                if near(x, corners, margin, reach.thickness) {
-                    let [a, b, c] = triangle;
-                    self.found.push([particle, a, b, c]);
-                }
-            }
-        }
+        let len = self.found.len();
+        super::keep_room(&mut self.found, len);
         self.found.sort_unstable();
         self.found.dedup();
         &self.found

@@ -111,3 +111,23 @@ pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
         skipped[family] = skipped[family] + counted;
     }
 }
+
+/// Makes room in `array` for twice `len` items (twice the most a frame has needed), so that
+/// the frames after allocate nothing while their count of pairs stays under that. Pairs come
+/// and go every frame: an array grown only to each new largest count would allocate at each.
+///
+/// ```
+/// # use tetlab_core::simulation::contact::keep_room;
+/// let mut pairs: Vec<[u32; 4]> = Vec::new();
+/// keep_room(&mut pairs, 10);
+/// let room = pairs.capacity();
+/// assert!(room >= 20);
+/// keep_room(&mut pairs, 10);
+/// assert_eq!(pairs.capacity(), room, "room already made is kept, not made again");
+/// ```
+pub fn keep_room<T>(array: &mut Vec<T>, len: usize) {
+    let room = 2 * len;
+    if array.capacity() < room {
+        array.reserve_exact(room - array.len());
+    }
+}

@@ -41,6 +41,7 @@ impl Substeps for OnArrays<'_> {
         found.clear();
         if let Some(contact) = &plan.contact {
             let renumber = &s.renumber;
+            crate::simulation::contact::keep_room(found, contact.found.len());
             found.extend((contact.found.iter()).map(|pair| pair.map(|i| renumber[i as usize])));
         }
     }
@@ -93,7 +94,9 @@ impl Substeps for OnArrays<'_> {
         self.grab_lambda = 0.0;
         if let Some(contact) = &plan.contact {
             let (found, lambdas) = &mut s.contacts;
-            lambdas.resize(found.len() * contact.families.len(), 0.0);
+            let wanted = found.len() * contact.families.len();
+            crate::simulation::contact::keep_room(lambdas, wanted);
+            lambdas.resize(wanted, 0.0);
             lambdas.fill(0.0);
         }
     }
