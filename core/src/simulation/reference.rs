@@ -140,7 +140,7 @@ impl Substeps for OnState<'_> {
             &plan.rules,
             contact,
             &contact.found,
-            (&mut s.positions, &s.previous, &s.inverse_masses),
+            (&mut s.positions, &mut s.previous, &s.inverse_masses),
             &mut s.contact_lambdas,
             &mut self.skipped,
         );

@@ -83,7 +83,7 @@ pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
     rules: &crate::constraints::PerFamily<crate::simulation::projection::Rule<f64>>,
     contact: &ContactPlan,
     found: &[[u32; 4]],
-    (positions, previous, inverse_masses): (&mut [V], &[V], &[V::Real]),
+    (positions, previous, inverse_masses): (&mut [V], &mut [V], &[V::Real]),
     lambdas: &mut [V::Real],
     skipped: &mut crate::constraints::PerFamily<crate::simulation::projection::SkipCounts>,
 ) where
@@ -97,7 +97,7 @@ pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
             found,
             order: contact.order.as_deref(),
             positions: &mut *positions,
-            previous,
+            previous: &mut *previous,
             inverse_masses,
             lambdas: &mut lambdas[k * n..(k + 1) * n],
             thickness: V::Real::from_f64(settings.thickness),

@@ -4,6 +4,15 @@
 //! (C < 0), then held or slowed along the surface by friction. In any precision, one
 //! pair after another in a fixed order, so the bits do not depend on the thread count.
 //!
+//! A pair already inside the thickness at the substep's start (C_start < 0) is first only
+//! stopped, at C ≥ C_start (what gives velocity, since velocity is (x − x_start) / h), and then
+//! moved out to C = 0 together with where its particles were at the substep's start, which gives
+//! none: the "pre-stabilization" of Macklin et al. 2014 (§ 4.4), applied to the layer. Stopping
+//! alone was a ratchet: another pair's friction or the body's own constraints pushed such a
+//! particle a little deeper in one substep, the next held it at that new depth, and over a
+//! frame two armadillos sank 10 cm into each other. Throwing it out with velocity instead gave a
+//! neo-Hookean cube landing on another's edge 762 J in one frame.
+//!
 //! Friction, as Macklin et al. 2014 (§ 6.1) and Müller et al. 2020 (§ 3.5) write it for
 //! positions: let Δx be the particle's motion over the substep relative to the point of the
 //! triangle under it (its corners' motion weighted by the foot's barycentric coordinates b),
@@ -25,8 +34,9 @@ pub(crate) struct ContactPass<'a, V: Vector3> {
     /// The order to project them in (`None`: as found).
     pub order: Option<&'a [u32]>,
     pub positions: &'a mut [V],
-    /// Where the particles were at the substep's start.
-    pub previous: &'a [V],
+    /// Where the particles were at the substep's start: moved with them where a pair leaves the
+    /// layer it was already in (see the module docs), so that it gains no speed.
+    pub previous: &'a mut [V],
     pub inverse_masses: &'a [V::Real],
     /// The multipliers of this family's pairs.
     pub lambdas: &'a mut [V::Real],
@@ -49,7 +59,6 @@ where
         if N != 4 {
             return skipped;
         }
-        let unbounded = V::Real::from_f64(f64::INFINITY);
         for k in 0..self.found.len() {
             let c = self.order.map_or(k, |order| order[k] as usize);
             let ids = self.found[c];
@@ -68,42 +77,26 @@ where
                 continue;
             }
             // A particle already closer than the thickness at the substep's start (one that came
-            // over the triangle's edge into the layer, not through its face) is held where it
-            // was, not thrown out: the contact only ever stops an approach, so it never gives a
-            // body energy. C_start = min(0, C at the substep's start) is its floor.
+            // over the triangle's edge into the layer, not through its face, or was pushed in by
+            // another projection) is stopped at its floor C_start = min(0, C at the substep's
+            // start), so contact gives it no speed, and then leaves the layer with where it
+            // started (the module docs).
             let floor = constraint.evaluate(&start, self.thickness, &start).value;
+            let floor = if floor.finite() { floor } else { V::Real::ZERO };
             let floor = if floor < V::Real::ZERO {
                 floor
             } else {
                 V::Real::ZERO
             };
+            let w: [V::Real; N] = std::array::from_fn(|i| self.inverse_masses[ids[i] as usize]);
             let mut e = constraint.evaluate(&p, self.thickness, &p);
             e.value -= floor;
-            if !above(V::Real::ZERO, e.value) {
-                continue;
+            if above(V::Real::ZERO, e.value) {
+                self.stop_the_approach(c, e, ids, w, b, &mut skipped);
             }
-            let w: [V::Real; N] = std::array::from_fn(|i| self.inverse_masses[ids[i] as usize]);
-            let normal = e.gradients[0];
-            let Some(fix) = correction(e, w, self.lambdas[c], self.rule, unbounded) else {
-                let none = e.degenerate || !(e.value.finite());
-                skipped.degenerate += u64::from(none);
-                continue;
-            };
-            self.lambdas[c] += fix.delta_lambda[0];
-            for (&i, dx) in ids.iter().zip(fix.delta_x) {
-                self.positions[i as usize] += dx;
+            if floor < V::Real::ZERO {
+                self.leave_the_layer(constraint, ids, w);
             }
-            let moved_apart =
-                fix.delta_x[0] - weighted(b, [fix.delta_x[1], fix.delta_x[2], fix.delta_x[3]]);
-            let length = normal.length();
-            if !above(length, V::Real::ZERO) {
-                continue;
-            }
-            let n = normal / length;
-            let pushed = moved_apart.dot(n);
-            let ids = [ids[0], ids[1], ids[2], ids[3]];
-            let w = [w[0], w[1], w[2], w[3]];
-            self.friction(ids, w, b, n, pushed);
         }
         skipped
     }
@@ -113,6 +106,71 @@ impl<V: Vector3> ContactPass<'_, V>
 where
     V::Real: Real<Mask = bool> + PartialOrd,
 {
+    /// Projects pair `c` (`ids`, inverse masses `w`, the foot at barycentric `b`) to its floor
+    /// from `e` (C less the floor, below 0), then applies friction to what that moved it apart.
+    /// A skipped projection is counted in `skipped`.
+    fn stop_the_approach<const N: usize>(
+        &mut self,
+        c: usize,
+        e: crate::constraints::Evaluation<V, N>,
+        ids: [u32; 4],
+        w: [V::Real; N],
+        b: [V::Real; 3],
+        skipped: &mut SkipCounts,
+    ) {
+        let unbounded = V::Real::from_f64(f64::INFINITY);
+        let normal = e.gradients[0];
+        let Some(fix) = correction(e, w, self.lambdas[c], self.rule, unbounded) else {
+            let none = e.degenerate || !(e.value.finite());
+            skipped.degenerate += u64::from(none);
+            return;
+        };
+        self.lambdas[c] += fix.delta_lambda[0];
+        for (k, dx) in fix.delta_x.iter().enumerate() {
+            self.positions[ids[k] as usize] += *dx;
+        }
+        let moved_apart =
+            fix.delta_x[0] - weighted(b, [fix.delta_x[1], fix.delta_x[2], fix.delta_x[3]]);
+        let length = normal.length();
+        if !above(length, V::Real::ZERO) {
+            return;
+        }
+        let n = normal / length;
+        let pushed = moved_apart.dot(n);
+        let w = [w[0], w[1], w[2], w[3]];
+        self.friction(ids, w, b, n, pushed);
+    }
+
+    /// Moves the pair `ids`, already within the thickness at the substep's start and held there
+    /// by its floor, out to C = 0, and where its particles were at the substep's start with
+    /// them: a rigid projection (Δxᵢ = −wᵢ C ∇Cᵢ / Σ wⱼ |∇Cⱼ|²) that gives no velocity, since
+    /// velocity is (x − x_start) / h. Skipped where C is not finite or ∇C vanishes.
+    fn leave_the_layer<const N: usize, C: Constraint<N>>(
+        &mut self,
+        constraint: &C,
+        ids: [u32; 4],
+        w: [V::Real; N],
+    ) {
+        let p: [V; N] = std::array::from_fn(|i| self.positions[ids[i] as usize]);
+        let e = constraint.evaluate(&p, self.thickness, &p);
+        if e.degenerate || !e.value.finite() || !above(V::Real::ZERO, e.value) {
+            return;
+        }
+        let mut weight = V::Real::ZERO;
+        for (g, &wi) in e.gradients.iter().zip(&w) {
+            weight += wi * g.dot(*g);
+        }
+        if !above(weight, V::Real::ZERO) || !weight.finite() {
+            return;
+        }
+        let scale = -e.value / weight;
+        for (k, (g, &wi)) in e.gradients.iter().zip(&w).enumerate() {
+            let (i, dx) = (ids[k], *g * (scale * wi));
+            self.positions[i as usize] += dx;
+            self.previous[i as usize] += dx;
+        }
+    }
+
     /// Static or kinetic friction on the pair `ids` with inverse masses `w`, the foot at
     /// barycentric `b`, normal `n`, after a projection that pushed the particle `pushed` away.
     fn friction(&mut self, ids: [u32; 4], w: [V::Real; 4], b: [V::Real; 3], n: V, pushed: V::Real) {

@@ -112,7 +112,7 @@ impl Substeps for OnArrays<'_> {
             &plan.rules,
             contact,
             found,
-            (&mut s.positions, &s.previous, &s.inverse_masses),
+            (&mut s.positions, &mut s.previous, &s.inverse_masses),
             lambdas,
             &mut s.skipped,
         );
