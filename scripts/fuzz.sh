@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # Runs every fuzz target of fuzz/ (cargo-fuzz on libFuzzer, on the stable toolchain), each seeded
 # from real files: the meshes of ../shared/meshes (when present) and assets/meshes, the lessons
-# of assets/lessons, the constraint files of assets/constraints, and recordings tetlab writes.
+# of assets/lessons, the constraint files of assets/constraints, the scene files of
+# assets/scenes, and recordings tetlab writes.
 # Prints, per target, the executions, the time and the crashes; a crash's input is kept in
 # fuzz/artifacts/TARGET/ and the run fails.
 #
 # Usage: scripts/fuzz.sh [--seconds S | --runs N] [TARGET...]
 #   --seconds S   run each target for S seconds (default 60)
 #   --runs N      run each target for N executions
-#   TARGET        tetgen, gmsh_v22, gmsh_v41, lesson, rrd, constraint_file (default: all)
+#   TARGET        tetgen, gmsh_v22, gmsh_v41, lesson, rrd, constraint_file, scene_file
+#                 (default: all)
 # The corpus grows in $TETLAB_FUZZ_CORPUS (default /var/tmp/tetlab-fuzz-corpus), outside the
 # repository, so later runs start where earlier ones stopped; the instrumented build lives in
 # $TETLAB_FUZZ_TARGET (default /var/tmp/tetlab-fuzz-target), so later runs reuse it.
@@ -21,11 +23,11 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) limit=(-max_total_time="$2"); shift 2 ;;
     --runs) limit=(-runs="$2"); shift 2 ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(tetgen gmsh_v22 gmsh_v41 lesson rrd constraint_file)
+[ ${#targets[@]} -gt 0 ] || targets=(tetgen gmsh_v22 gmsh_v41 lesson rrd constraint_file scene_file)
 
 # cargo-fuzz of a version that builds with this toolchain, when missing.
 fuzz_version=0.13.1
@@ -67,6 +69,8 @@ seed() {
       fi ;;
     lesson)
       cp assets/lessons/*.toml "$dir/" ;;
+    scene_file)
+      cp assets/scenes/*.toml "$dir/" ;;
     constraint_file)
       cp assets/constraints/*.toml "$dir/"
       # The generator's inputs (fuzz/fuzz_targets/constraint_file.rs): NUL-separated segments,

@@ -183,6 +183,35 @@ impl Scene {
     /// [`Scene::load_file`] of the text `text` (`path` names it in errors and is where its mesh
     /// files are looked for).
     pub fn parse_file(path: &Path, text: &str) -> Result<Scene, SceneError> {
+        let folder = path.parent().unwrap_or(Path::new(""));
+        Scene::parse_file_with(path, text, &|spec, resolution| {
+            body_mesh(spec, resolution, folder)
+        })
+    }
+
+    /// [`Scene::parse_file`] with each body's mesh made by `make_mesh` from its `mesh` and
+    /// `resolution` (4 when not given) rather than from the built-ins and the files beside
+    /// `path`: what a fuzzer or a browser, which has no folder to look in, gives.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use tetlab_core::scene::{Builtin, Scene, SceneError};
+    /// // Built-ins only: a mesh file is refused, at the body's `mesh`.
+    /// let builtins = |spec: &str, resolution: u32| match Builtin::from_name(spec) {
+    ///     Some(builtin) => Scene::builtin(builtin, resolution),
+    ///     None => Err(SceneError::Unknown(spec.to_owned())),
+    /// };
+    /// let text = "[[body]]\nmesh = \"tet\"\n[[body]]\nmesh = \"../bunny.node\"\n";
+    /// let e = Scene::parse_file_with(Path::new("s.toml"), text, &builtins).unwrap_err();
+    /// assert!(e.to_string().starts_with("s.toml:4:8: "), "{e}");
+    /// let one = Scene::parse_file_with(Path::new("s.toml"), "[[body]]\nmesh = \"tet\"\n", &builtins);
+    /// assert_eq!(one.unwrap().mesh.tets.len(), 1);
+    /// ```
+    pub fn parse_file_with(
+        path: &Path,
+        text: &str,
+        make_mesh: &dyn Fn(&str, u32) -> Result<Scene, SceneError>,
+    ) -> Result<Scene, SceneError> {
         let text = text_file::without_byte_order_mark(text);
         let error = |offset: Option<usize>, message: String| SceneError::File {
             path: path.to_owned(),
@@ -199,7 +228,6 @@ impl Scene {
                 "no body: give each as a [[body]] table with its mesh (mesh = \"cube\")".into(),
             ));
         }
-        let folder = path.parent().unwrap_or(Path::new(""));
         let mut scene = Scene {
             name: match &raw.name {
                 Some(name) => name.get_ref().trim().to_owned(),
@@ -225,7 +253,8 @@ impl Scene {
                 let at = body.name.as_ref().map(|n| n.span().start);
                 return Err(error(at, format!("two bodies are named \"{name}\"")));
             }
-            let part = body_scene(body, folder).map_err(|e| match e {
+            let resolution = body.resolution.as_ref().map_or(4, |r| *r.get_ref());
+            let part = make_mesh(body.mesh.get_ref().trim(), resolution).map_err(|e| match e {
                 // A mistake of the mesh file is its own file's, with its own place.
                 SceneError::Mesh(e) => SceneError::Mesh(e),
                 other => error(Some(body.mesh.span().start), other.to_string()),
@@ -306,11 +335,9 @@ struct Placement {
     translate: DVec3,
 }
 
-/// The body's mesh as a scene of its own: a built-in at its resolution, or a mesh file found
-/// beside the scene file.
-fn body_scene(body: &RawBody, folder: &Path) -> Result<Scene, SceneError> {
-    let spec = body.mesh.get_ref().trim();
-    let resolution = body.resolution.as_ref().map_or(4, |r| *r.get_ref());
+/// A body's mesh `spec` as a scene of its own: a built-in at `resolution`, or a mesh file found
+/// in `folder` (the scene file's).
+fn body_mesh(spec: &str, resolution: u32, folder: &Path) -> Result<Scene, SceneError> {
     if let Some(builtin) = Builtin::from_name(spec) {
         return Scene::builtin(builtin, resolution);
     }
