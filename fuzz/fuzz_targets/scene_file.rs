@@ -8,24 +8,14 @@
 
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
-use tetlab_core::input::limits::{MAX_TETS, RESOLUTION};
 use tetlab_core::input::text_file::decode;
-use tetlab_core::scene::{Builtin, Scene, SceneError};
+use tetlab_core::scene::{Scene, SceneError};
 use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
 
-/// Built-in meshes of up to 500 tets are built; larger valid ones are refused here (to keep
-/// each run fast), out-of-range ones go to `Scene::builtin`, which refuses them; mesh files are
-/// refused (a fuzzer's path could name any file on the machine).
-fn small(name: &str, resolution: u32) -> Result<Scene, SceneError> {
-    let Some(builtin) = Builtin::from_name(name) else {
-        return Err(SceneError::Unknown(name.to_owned()));
-    };
-    let valid = RESOLUTION.contains(resolution) && builtin.tets(resolution) <= MAX_TETS as u64;
-    if valid && builtin.tets(resolution) > 500 {
-        return Err(SceneError::Resolution("not built while fuzzing".into()));
-    }
-    Scene::builtin(builtin, resolution)
-}
+#[path = "../support/small_scenes.rs"]
+mod small_scenes;
+
+use small_scenes::small;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = decode(data) else {
