@@ -65,6 +65,12 @@ check "friction holds a block on a 30° ramp with μ = 0.6 (moved, m)" "($moved 
   --scene assets/scenes/ramp.toml --constraints edges,volume,contact --friction 0.6 --frames 60
 check "friction lets it slide with μ = 0.3, 1.1781 m in 1 s by Coulomb (slid, m)" "(abs($moved - 1.1781) < 0.0245, \"%.4f\" % $moved)" \
   --scene assets/scenes/ramp.toml --constraints edges,volume,contact --friction 0.3 --frames 60
+# Self-contact: the upper leg of a soft hairpin sags onto the lower and rests there; no
+# contact closer than a tenth of the thickness over 3 s, and some touching at the end.
+check "a bar folded onto itself rests on itself: touching at the end, penetration < d/10 over 3 s (deepest, m)" '(
+  frames[-1]["contacts"] > 0 and max(f["max_penetration"] for f in frames) < 1e-3,
+  "%.1e" % max(f["max_penetration"] for f in frames))' \
+  --scene assets/scenes/folded-bar.toml --constraints neohookean,contact --material E=1e5,nu=0.3 --frames 180
 if [ -f ../shared/meshes/bunny.node ]; then
   check "the bunny dropped on a ball gives no energy (largest rise, J, of 5733)" "(
     $rise < 0.01 * frames[0][\"energy_total\"], \"%.2e\" % $rise)" \

@@ -638,3 +638,71 @@ fn inspect_refuses_a_cut_off_recording() {
         "incomplete recording",
     );
 }
+
+/// A scene of several bodies is recorded body by body: each body's mesh and edges under
+/// `world/bodies/<name>/`, its metrics and energy under `bodies/<name>/`, the very numbers
+/// `tetlab run --json` prints for it; the scene's particles and metrics stay whole.
+#[test]
+fn a_scene_of_several_bodies_is_recorded_body_by_body() {
+    let path = scratch("bodies").join("stack.rrd");
+    let scene = asset("scenes/stacked-cubes.toml");
+    let run = [
+        "--scene",
+        scene.as_str(),
+        "--constraints",
+        "neohookean,contact",
+        "--frames",
+        "3",
+    ];
+    let mut args = vec!["record", "--quiet", "--out", path.to_str().unwrap()];
+    args.extend(run);
+    let output = tetlab(&args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let summary = inspect(&path);
+    let entities = summary["entities"].as_object().unwrap();
+    for body in ["lower", "upper"] {
+        for entity in ["mesh", "edges"] {
+            let entity = format!("world/bodies/{body}/{entity}");
+            assert_eq!(entities[&entity]["frame_rows"], 4, "{entity}");
+        }
+        let mesh = &entities[&format!("world/bodies/{body}/mesh")];
+        assert_eq!(
+            strings(&mesh["static_components"]),
+            ["Mesh3D:triangle_indices"]
+        );
+    }
+    assert!(
+        !entities.contains_key("world/mesh"),
+        "the mesh is the bodies'"
+    );
+    assert_eq!(entities["world/particles"]["frame_rows"], 4);
+    let mut run_args = vec!["run", "--json"];
+    run_args.extend(run);
+    let printed: Vec<Value> = stdout(&tetlab(&run_args))
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    for (b, body) in ["lower", "upper"].into_iter().enumerate() {
+        for (recorded, printed_as) in [
+            ("energy/total", "energy_total"),
+            ("energy/kinetic", "energy_kinetic"),
+            ("energy/elastic", "energy_elastic"),
+            ("metrics/inverted_tets", "inverted_tets"),
+            ("metrics/max_edge_strain", "max_edge_strain"),
+        ] {
+            let name = format!("bodies/{body}/{recorded}");
+            let series = summary["metrics"][&name]
+                .as_array()
+                .unwrap_or_else(|| panic!("{name}"));
+            assert_eq!(series.len(), 4, "{name}");
+            for (value, line) in series.iter().zip(&printed) {
+                assert_eq!(
+                    value[1].as_f64(),
+                    line["bodies"][b][printed_as].as_f64(),
+                    "{name} at frame {}",
+                    line["frame"]
+                );
+            }
+        }
+    }
+}

@@ -645,6 +645,16 @@ fn a_scene_file_of_several_bodies_is_run_and_measured_body_by_body() {
         "{}",
         bodies[0]
     );
+    // Each body's energy, and they add up to the scene's.
+    let part = |b: &Value, name: &str| b[name].as_f64().unwrap_or_else(|| panic!("{name}: {b}"));
+    let sum: f64 = bodies.iter().map(|b| part(b, "energy_total")).sum();
+    let whole = part(&lines[2], "energy_total");
+    assert!((sum - whole).abs() <= 1e-9 * whole.abs(), "{sum} {whole}");
+    assert!(
+        part(&bodies[1], "energy_kinetic") > 100.0 * part(&bodies[0], "energy_kinetic"),
+        "the thrown ball carries the motion: {}",
+        lines[2]
+    );
     // A scene of one body has none.
     let one = json_lines(&["run", "--frames", "1", "--json"]);
     assert!(one[1].get("bodies").is_none(), "{}", one[1]);

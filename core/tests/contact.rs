@@ -110,6 +110,66 @@ fn a_body_dropped_fast_does_not_pass_through() {
     }
 }
 
+/// The folded bar (`assets/scenes/folded-bar.toml`): a hairpin of soft rubber (E = 0.1 MPa)
+/// whose upper leg sags under its weight onto its lower one, on both engines. With contact the
+/// upper leg comes to rest on the lower: it touches at the end, and no contact is ever closer
+/// than a tenth of the thickness over 3 s. Without it the upper leg sinks through the lower
+/// one, which is what the check would see if self-contact were missed.
+#[test]
+fn a_bar_folded_onto_itself_rests_on_itself() {
+    let scene = asset("folded-bar.toml");
+    // The legs, away from the bend (the bar's last 0.2 m): below and above the gap's middle.
+    let (lo, hi) = tetlab_core::scene::mesh::bounds(&scene.mesh.positions);
+    let middle = 0.5 * (lo.y + hi.y);
+    let leg = |p: &DVec3| p.x < hi.x - 0.2;
+    let lower: Vec<usize> = (0..scene.mesh.positions.len())
+        .filter(|&i| leg(&scene.mesh.positions[i]) && scene.mesh.positions[i].y < middle)
+        .collect();
+    let upper: Vec<usize> = (0..scene.mesh.positions.len())
+        .filter(|&i| leg(&scene.mesh.positions[i]) && scene.mesh.positions[i].y > middle)
+        .collect();
+    // How far the upper leg's lowest point is above the lower leg's highest (negative: through).
+    let gap = |simulation: &Simulation| {
+        let y = |i: &usize| simulation.positions()[*i].y;
+        let top = lower.iter().map(y).fold(f64::NEG_INFINITY, f64::max);
+        upper.iter().map(y).fold(f64::INFINITY, f64::min) - top
+    };
+    for engine in ENGINES {
+        for families in ["neohookean,contact", "neohookean"] {
+            let mut simulation = simulation(&scene, families, engine);
+            let mut settings = *simulation.settings();
+            settings.material.young = 1e5;
+            simulation.set_settings(settings);
+            let thickness = simulation.settings().contact.thickness;
+            let mut deepest: f64 = 0.0;
+            for _ in 0..180 {
+                simulation.step();
+                deepest = deepest.max(Metrics::measure_sound(&simulation).unwrap().max_penetration);
+            }
+            let (gap, touching) = (gap(&simulation), Metrics::measure(&simulation).contacts);
+            println!(
+                "{engine:?}, {families}: gap {gap:.4} m, {touching} touching, deepest {deepest:.3e} m"
+            );
+            if families.contains("contact") {
+                assert!(
+                    deepest < 0.1 * thickness,
+                    "{engine:?}: penetration {deepest} m"
+                );
+                assert!(touching > 0, "{engine:?}: the upper leg rests on the lower");
+                assert!(
+                    gap > 0.5 * thickness,
+                    "{engine:?}: the legs are {gap} m apart"
+                );
+            } else {
+                assert!(
+                    gap < -thickness,
+                    "{engine:?}: without contact, a gap of {gap} m"
+                );
+            }
+        }
+    }
+}
+
 /// Two neo-Hookean cubes, the upper thrown sideways onto the lower's edge: the energy account
 /// (elastic energy included) never rises above its lowest by more than its tolerance on either
 /// engine. Before a particle already inside the thickness at a substep's start was held where it

@@ -5,6 +5,7 @@
 
 use glam::DVec3;
 use std::path::Path;
+use tetlab_core::constraints::volume::signed_volume;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::{Scene, SceneError};
 use tetlab_core::simulation::{EngineChoice, Settings, Simulation};
@@ -97,6 +98,13 @@ fn every_mistake_is_named_at_its_place() {
         e.starts_with("s.toml:3:13: translate") && e.contains("within"),
         "{e}"
     );
+    for bend in ["[0, 0.1]", "[190, 0.1]", "[90, 0]", "[90, inf]"] {
+        let e = mistake(&format!("[[body]]\nmesh = \"cube\"\nbend = {bend}\n"));
+        assert!(
+            e.starts_with("s.toml:3:8: bend is") && e.contains("[degrees, inner radius]"),
+            "{e}"
+        );
+    }
     let e = mistake("[[body]]\nmesh = \"teapot\"\n");
     assert!(e.starts_with("s.toml:2:8:") && e.contains("teapot"), "{e}");
     let e = mistake("[[body]]\nmesh = \"cube\"\nresolution = 0\n");
@@ -208,4 +216,32 @@ fn a_launched_body_flies_the_same_on_both_engines_and_after_a_reset() {
             fast[k]
         );
     }
+}
+
+/// `bend` folds a body's rest shape and keeps every tet the right way round (the map's
+/// Jacobian has a positive determinant); `free` lets go of the particles the built-in beam
+/// holds. A beam bent by 180° is a hairpin: its far end comes back over its near one.
+#[test]
+fn a_bent_body_keeps_its_tets_the_right_way_round_and_free_lets_go_of_its_pins() {
+    let held = Scene::parse_file(
+        Path::new("held.toml"),
+        "[[body]]\nmesh = \"beam\"\nresolution = 2\n",
+    )
+    .unwrap();
+    assert!(!held.pinned.is_empty(), "the beam holds its end");
+    let text = "[[body]]\nmesh = \"beam\"\nresolution = 2\nfree = true\n\
+                scale = [1, 0.2, 0.5]\nbend = [180, 0.05]\n";
+    let bent = Scene::parse_file(Path::new("bent.toml"), text).unwrap();
+    assert!(bent.pinned.is_empty(), "free: nothing held");
+    let volumes: Vec<f64> = (bent.mesh.tets.iter())
+        .map(|t| signed_volume(&t.map(|i| bent.mesh.positions[i as usize])))
+        .collect();
+    let smallest = volumes.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(smallest > 0.0, "a tet turned over: {smallest}");
+    // The lower leg stays where the beam was (its underside at y = 1.2) and the upper leg lies
+    // above it, twice the inner radius above the lower leg's top (0.1 high).
+    let (lo, hi) = tetlab_core::scene::mesh::bounds(&bent.mesh.positions);
+    assert!((lo.y - 1.2).abs() < 1e-12, "{lo}");
+    assert!((hi.y - lo.y - (0.1 + 0.1 + 0.1)).abs() < 1e-9, "{lo} {hi}");
+    assert!((hi.x - lo.x) < 1.2, "folded in two: {lo} {hi}");
 }

@@ -159,7 +159,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     let rec = session.as_ref().map(Session::rec);
     if let Some(rec) = rec {
         let roots: &[&str] = if compares { &["", "compare/"] } else { &[""] };
-        send_layout(rec, roots, false, false);
+        send_layout(rec, roots, &[], false, false);
     }
     // The recording's clock runs on through resets: frame k is the k-th frame the lesson ran.
     let mut clock = Clock::default();

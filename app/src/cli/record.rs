@@ -82,7 +82,8 @@ pub fn main(args: &Args, out: &mut impl Write) -> Result<Ending, UsageError> {
     };
     let session = Session::open(destination, args.simulation.frames, args.quiet)?;
     let rec = session.rec();
-    send_layout(rec, &[""], args.modes, args.exact_step);
+    let bodies = crate::record::body_parts::body_plots(&simulation);
+    send_layout(rec, &[""], &bodies, args.modes, args.exact_step);
     describe(rec, &scene, &simulation, args);
     let initial = Metrics::measure_sound(&simulation).map_err(|d| UsageError(d.to_string()))?;
     match run(rec, &session, &scene, &mut simulation, &initial, args) {

@@ -122,14 +122,24 @@ pub struct BodyRecord {
     contacts: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
     max_penetration: Option<f64>,
+    /// Its energy (`tetlab_core::measures::energy_account::Energy::measure_bodies`), J: kinetic,
+    /// gravitational, external, elastic (every active family's) and their sum; the bodies'
+    /// `energy_total` add up to the scene's.
+    energy_kinetic: f64,
+    energy_gravitational: f64,
+    energy_external: f64,
+    energy_elastic: f64,
+    energy_total: f64,
 }
 
 impl BodyRecord {
     /// The records of each body of `simulation`'s scene; none for a scene of one body.
     pub fn of(simulation: &Simulation) -> Vec<BodyRecord> {
         let contact = has_contact(simulation);
+        let families = simulation.families();
         (Metrics::measure_bodies(simulation).into_iter())
-            .map(|(name, m)| BodyRecord {
+            .zip(Energy::measure_bodies(simulation))
+            .map(|((name, m), (_, energy))| BodyRecord {
                 name,
                 inverted_tets: m.inverted_tets,
                 min_volume_ratio: m.min_volume_ratio,
@@ -139,6 +149,11 @@ impl BodyRecord {
                 centre_of_mass: m.centre_of_mass.to_array(),
                 contacts: contact.then_some(m.contacts),
                 max_penetration: contact.then_some(m.max_penetration),
+                energy_kinetic: energy.kinetic,
+                energy_gravitational: energy.gravitational,
+                energy_external: energy.external,
+                energy_elastic: families.all().map(|f| energy.elastic[f]).sum(),
+                energy_total: energy.total,
             })
             .collect()
     }
@@ -339,12 +354,15 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             writeln!(
                 out,
                 "body {}: {} inverted tets, min V/V0 {:.4}, max edge strain {:.3e}, largest speed \
-                 {:.3} m/s, centre of mass at ({x:.3}, {y:.3}, {z:.3}) m",
+                 {:.3} m/s, centre of mass at ({x:.3}, {y:.3}, {z:.3}) m, energy {:.4} J \
+                 (kinetic {:.4} J)",
                 body.name,
                 body.inverted_tets,
                 body.min_volume_ratio,
                 body.max_edge_strain,
-                body.max_speed
+                body.max_speed,
+                body.energy_total,
+                body.energy_kinetic
             )
             .map_err(io)?;
             if let (Some(touching), Some(deepest)) = (body.contacts, body.max_penetration) {

@@ -6,14 +6,28 @@ use tetlab_core::measures::metrics::Metrics;
 /// The default layout: a 3D view per root (side by side) on the left, the four metrics and the
 /// energy account stacked on the right (each plot shows the metric of every root), with `modes`
 /// a plot of the eigenvalues `record --modes` logs below them, and with `exact_step` one of the
-/// distance from the exact step `record --exact-step` logs.
-pub fn send_layout(rec: &RecordingStream, roots: &[&str], modes: bool, exact_step: bool) {
+/// distance from the exact step `record --exact-step` logs. Each plot also shows the series of
+/// each body of `bodies` (`bodies/<name>/`, [`super::body_parts::body_plots`]) under every root.
+pub fn send_layout(
+    rec: &RecordingStream,
+    roots: &[&str],
+    bodies: &[String],
+    modes: bool,
+    exact_step: bool,
+) {
     use rerun::blueprint::{
         Blueprint, BlueprintActivation, Horizontal, Spatial3DView, TimeSeriesView, Vertical,
     };
     // One plot of the entity at `path` under every root.
     let plot = |title: String, path: &str| -> rerun::blueprint::ContainerLike {
-        let contents: Vec<String> = roots.iter().map(|root| format!("+ {root}{path}")).collect();
+        let contents: Vec<String> = (roots.iter())
+            .flat_map(|root| {
+                let each = bodies
+                    .iter()
+                    .map(move |body| format!("+ {root}{body}{path}"));
+                std::iter::once(format!("+ {root}{path}")).chain(each)
+            })
+            .collect();
         TimeSeriesView::new(title).with_contents(contents).into()
     };
     let plots = Metrics::default()

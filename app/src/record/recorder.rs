@@ -2,6 +2,7 @@
 //! and what changes every frame, all derived from [`tetlab_core::teaching::visual`] like the workbench's
 //! view.
 
+use super::body_parts::BodyPart;
 use glam::Vec3;
 use rerun::RecordingStream;
 use tetlab_core::constraints::Families;
@@ -28,7 +29,10 @@ pub enum ArrowsMode {
 /// Entities, under a root (empty, or e.g. `compare/` for a second simulation): `world` (view
 /// coordinates, y up; the viewer draws its grid on y = 0, the ground), `world/particles`,
 /// `world/mesh` and `world/edges` (all faces and edges of a small mesh, the surface of a large
-/// one, as [`visual::display_faces`] and [`visual::display_edges`] choose),
+/// one, as [`visual::display_faces`] and [`visual::display_edges`] choose; for a scene of
+/// several bodies, each body's under `world/bodies/<name>/mesh` and `…/edges` instead, and its
+/// metrics and energy under `bodies/<name>/metrics/<name>` and `bodies/<name>/energy/<part>`,
+/// [`BodyPart`]),
 /// `constraints/<family>` (a constraint file's text, for each in use),
 /// `world/gradients/<family>` (and, for a constraint file that gives its own gradient,
 /// `world/gradients/<family>-yours` where it differs from AD's, or `-ad` where the file's is
@@ -41,7 +45,8 @@ pub struct Recorder<'a> {
     root: String,
     arrows: ArrowsMode,
     tet: usize,
-    edge_strips: Vec<Vec<u32>>,
+    /// Each body's mesh and edges, or the one body's.
+    parts: Vec<BodyPart>,
     inverted: Vec<bool>,
     colours: Vec<Rgba>,
     logged_colours: Option<Vec<Rgba>>,
@@ -72,18 +77,21 @@ impl<'a> Recorder<'a> {
             &rerun::Points3D::update_fields()
                 .with_radii([rerun::Radius::new_scene_units((0.004 * size) as f32)]),
         );
-        let faces = visual::display_faces(&scene.mesh);
-        log(
-            "world/mesh",
-            &rerun::Mesh3D::update_fields()
-                .with_triangle_indices(faces.iter().map(|f| rerun::TriangleIndices::from(*f))),
-        );
-        log(
-            "world/edges",
-            &rerun::LineStrips3D::update_fields()
-                .with_colors([rgba(visual::EDGE)])
-                .with_radii([rerun::Radius::new_ui_points(0.75)]),
-        );
+        let parts = BodyPart::of(scene, simulation);
+        for part in &parts {
+            log(
+                &format!("{}mesh", part.world),
+                &rerun::Mesh3D::update_fields().with_triangle_indices(
+                    part.faces.iter().map(|f| rerun::TriangleIndices::from(*f)),
+                ),
+            );
+            log(
+                &format!("{}edges", part.world),
+                &rerun::LineStrips3D::update_fields()
+                    .with_colors([rgba(visual::EDGE)])
+                    .with_radii([rerun::Radius::new_ui_points(0.75)]),
+            );
+        }
         // The constraint files of the families in use, as written: what the arrows of
         // `world/gradients/<name>` are the gradient of.
         let families = simulation.families();
@@ -115,7 +123,7 @@ impl<'a> Recorder<'a> {
             root: root.to_owned(),
             arrows,
             tet,
-            edge_strips: visual::edge_strips(&visual::display_edges(&scene.mesh)),
+            parts,
             inverted: Vec::new(),
             colours: Vec::new(),
             logged_colours: None,
@@ -190,28 +198,39 @@ impl<'a> Recorder<'a> {
         visual::held_particle_colours(simulation, &mut self.colours);
         let colours_changed = self.logged_colours.as_ref() != Some(&self.colours);
 
-        let mut particles =
+        let particles =
             rerun::Points3D::update_fields().with_positions(self.points.iter().copied());
-        let mut mesh =
-            rerun::Mesh3D::update_fields().with_vertex_positions(self.points.iter().copied());
         if colours_changed {
-            particles = particles.with_colors(self.colours.iter().map(|&c| rgba(c)));
-            mesh = mesh.with_vertex_colors(self.colours.iter().map(|&c| rgba(c)));
+            log(
+                "world/particles",
+                &particles.with_colors(self.colours.iter().map(|&c| rgba(c))),
+            );
+        } else {
+            log("world/particles", &particles);
+        }
+        for part in &self.parts {
+            let points = &self.points[part.particles.clone()];
+            let mut mesh =
+                rerun::Mesh3D::update_fields().with_vertex_positions(points.iter().copied());
+            if colours_changed {
+                let colours = &self.colours[part.particles.clone()];
+                mesh = mesh.with_vertex_colors(colours.iter().map(|&c| rgba(c)));
+            }
+            log(&format!("{}mesh", part.world), &mesh);
+            let strips = (part.strips.iter()).map(|strip| {
+                strip
+                    .iter()
+                    .map(|&i| points[i as usize])
+                    .collect::<Vec<_>>()
+            });
+            log(
+                &format!("{}edges", part.world),
+                &rerun::LineStrips3D::update_fields().with_strips(strips),
+            );
+        }
+        if colours_changed {
             self.logged_colours = Some(self.colours.clone());
         }
-        log("world/particles", &particles);
-        log("world/mesh", &mesh);
-        log(
-            "world/edges",
-            &rerun::LineStrips3D::update_fields().with_strips(self.edge_strips.iter().map(
-                |strip| {
-                    strip
-                        .iter()
-                        .map(|&i| self.points[i as usize])
-                        .collect::<Vec<_>>()
-                },
-            )),
-        );
         self.log_arrows(simulation);
         self.log_contacts(simulation, metrics);
         if self.modes {
@@ -235,6 +254,40 @@ impl<'a> Recorder<'a> {
             ("taken_by_settling", energy.taken.settling),
         ] {
             log(&format!("energy/{name}"), &rerun::Scalars::single(value));
+        }
+        self.log_bodies(simulation);
+    }
+
+    /// Logs each body's headline metrics and energy under `bodies/<name>/` (nothing for a
+    /// scene of one body): [`Metrics::measure_bodies`] and [`Energy::measure_bodies`], the
+    /// numbers `tetlab run --json` prints per body.
+    fn log_bodies(&self, simulation: &Simulation) {
+        let metrics = Metrics::measure_bodies(simulation);
+        let energies = Energy::measure_bodies(simulation);
+        let families = simulation.families();
+        let plots = self.parts.iter().filter_map(|p| p.plots.as_ref());
+        for ((path, (_, metrics)), (_, energy)) in plots.zip(metrics).zip(energies) {
+            let log = |name: String, value: f64| {
+                (self.rec)
+                    .log(
+                        format!("{}{path}{name}", self.root),
+                        &rerun::Scalars::single(value),
+                    )
+                    .ok();
+            };
+            for (name, value) in metrics.headline() {
+                log(format!("metrics/{name}"), value);
+            }
+            let elastic: f64 = families.all().map(|f| energy.elastic[f]).sum();
+            for (name, value) in [
+                ("kinetic", energy.kinetic),
+                ("gravitational", energy.gravitational),
+                ("external", energy.external),
+                ("elastic", elastic),
+                ("total", energy.total),
+            ] {
+                log(format!("energy/{name}"), value);
+            }
         }
     }
 

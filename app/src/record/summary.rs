@@ -34,7 +34,8 @@ pub struct Summary {
     pub entities: BTreeMap<String, Entity>,
     /// The first and last value of the `frame` timeline.
     pub frames: Option<(i64, i64)>,
-    /// The time series under `metrics/`: (frame, value) in frame order.
+    /// The time series under `metrics/` (named without it) and each body's under `bodies/` (named
+    /// in full, `bodies/<name>/energy/total`): (frame, value) in frame order.
     pub metrics: BTreeMap<String, Vec<(i64, f64)>>,
     /// Particles in `world/particles` at each frame, in frame order.
     pub particles: Vec<(i64, usize)>,
@@ -129,7 +130,7 @@ impl Summary {
                 None => (f, f),
             });
         }
-        if path.starts_with("metrics/") {
+        if path.starts_with("metrics/") || path.starts_with("bodies/") {
             let values = chunk.iter_component::<re_sdk_types::components::Scalar>(
                 re_sdk_types::archetypes::Scalars::descriptor_scalars().component,
             );

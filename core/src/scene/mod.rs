@@ -4,8 +4,10 @@
 //! positions to set up an experiment (invert one tet, mirror the body, flatten it, scramble it). [`mesh`]
 //! holds the tet mesh and its file formats.
 
+mod bend;
 pub mod mesh;
 mod scene_file;
+pub use bend::Bend;
 pub use scene_file::{MAX_PLACEMENT, SceneBody};
 
 use crate::constraints::volume::signed_volume;

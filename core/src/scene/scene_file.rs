@@ -16,6 +16,10 @@
 //! translate = [0, 0, 0]       # optional: metres, from where the mesh puts it
 //! velocity = [0, 0, 0]        # optional: m/s, every particle of the body at the start
 //! fixed = false               # optional: true pins every particle (a floor, a ramp, a wall)
+//! free = false                # optional: true lets go of the particles the mesh holds (the beam's end)
+//! bend = [180, 0.02]          # optional: degrees in (0, 180], inner radius in m: folds the body,
+//!                             # laid along x, upwards about z over its middle (after the scale,
+//!                             # before the turn; a hairpin at 180°, [`super::Bend`])
 //! [[body]]
 //! mesh = "cube"
 //! translate = [0, 1.5, 0]
@@ -24,7 +28,7 @@
 //! notes say so. Every mistake is named at file:line:column.
 
 use super::mesh::TetMesh;
-use super::{Builtin, Scene, SceneError};
+use super::{Bend, Builtin, Scene, SceneError};
 use crate::input::limits;
 use crate::input::text_file;
 use glam::{DMat3, DVec3};
@@ -73,6 +77,10 @@ struct RawBody {
     velocity: Option<Spanned<[f64; 3]>>,
     #[serde(default)]
     fixed: bool,
+    #[serde(default)]
+    bend: Option<Spanned<[f64; 2]>>,
+    #[serde(default)]
+    free: bool,
 }
 
 /// A body's scale: one factor, or one per axis.
@@ -277,6 +285,10 @@ impl Scene {
                 ));
             }
             let fixed = body.fixed;
+            let mut part = part;
+            if body.free {
+                part.pinned.clear();
+            }
             scene.add(name, part, placement, velocity);
             if fixed {
                 let body = scene.bodies.last().expect("the body just added");
@@ -295,12 +307,15 @@ impl Scene {
         let first_tet = self.mesh.tets.len() as u32;
         let (lo, hi) = super::mesh::bounds(&part.mesh.positions);
         let centre = 0.5 * (lo + hi);
-        self.mesh.positions.extend(
-            part.mesh
-                .positions
-                .iter()
-                .map(|&p| centre + placement.translate + placement.turn * (p - centre)),
-        );
+        let mut local: Vec<DVec3> = (part.mesh.positions.iter())
+            .map(|&p| placement.scale * (p - centre))
+            .collect();
+        if let Some(bend) = placement.bend {
+            bend.apply(&mut local);
+        }
+        self.mesh
+            .positions
+            .extend((local.iter()).map(|&q| centre + placement.translate + placement.rotation * q));
         self.mesh
             .tets
             .extend(part.mesh.tets.iter().map(|t| t.map(|i| i + first)));
@@ -329,9 +344,11 @@ impl Scene {
     }
 }
 
-/// How a body is placed: x ↦ centre + translate + turn (x − centre), turn = R · scale.
+/// How a body is placed: x ↦ centre + translate + R bend(scale (x − centre)).
 struct Placement {
-    turn: DMat3,
+    scale: DMat3,
+    bend: Option<Bend>,
+    rotation: DMat3,
     translate: DVec3,
 }
 
@@ -381,8 +398,28 @@ fn placement(body: &RawBody) -> Result<Placement, (usize, String)> {
         Some(t) => finite_vector(t, "translate", "m")?,
         None => DVec3::ZERO,
     };
+    let bend = match &body.bend {
+        Some(b) => {
+            let [degrees, radius] = *b.get_ref();
+            let fine = degrees > 0.0 && degrees <= 180.0 && radius > 0.0 && radius <= MAX_PLACEMENT;
+            if !fine {
+                return Err((
+                    b.span().start,
+                    format!(
+                        "bend is [{degrees}, {radius}]: it is [degrees, inner radius], the \
+                         degrees above 0 and at most 180, the radius in m above 0 and at most \
+                         {MAX_PLACEMENT:e}"
+                    ),
+                ));
+            }
+            Some(Bend { degrees, radius })
+        }
+        None => None,
+    };
     Ok(Placement {
-        turn: rotation * DMat3::from_diagonal(scale),
+        scale: DMat3::from_diagonal(scale),
+        bend,
+        rotation,
         translate,
     })
 }
