@@ -1,5 +1,5 @@
-//! Builds the lessons of `assets/lessons/*.toml` and the example constraint files of
-//! `assets/constraints/*.toml` into the library, in file-name order, so that adding a lesson or
+//! Builds the lessons of `assets/lessons/*.toml`, the example constraint files of
+//! `assets/constraints/*.toml` and the scene files of `assets/scenes/*.toml` into the library, in file-name order, so that adding a lesson or
 //! an example is adding a file (and so that the lessons that name an example find it where there
 //! is no file system, in the browser).
 
@@ -51,4 +51,11 @@ fn main() {
         &manifest.join("../assets/constraints"),
     );
     std::fs::write(out.join("constraint_examples.rs"), constraints).expect("OUT_DIR is writable");
+    let scenes = table(
+        "SHIPPED",
+        "ShippedScene",
+        "The scene files in assets/scenes, in file-name order.",
+        &manifest.join("../assets/scenes"),
+    );
+    std::fs::write(out.join("shipped_scenes.rs"), scenes).expect("OUT_DIR is writable");
 }

@@ -245,3 +245,34 @@ fn a_bent_body_keeps_its_tets_the_right_way_round_and_free_lets_go_of_its_pins()
     assert!((hi.y - lo.y - (0.1 + 0.1 + 0.1)).abs() < 1e-9, "{lo} {hi}");
     assert!((hi.x - lo.x) < 1.2, "folded in two: {lo} {hi}");
 }
+
+/// Every scene file of assets/scenes is built into tetlab (what a link names) and loads, as
+/// its file does; those that need the reference meshes skip without ../shared/meshes.
+#[test]
+fn every_shipped_scene_file_loads() {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes");
+    let mut on_disk: Vec<String> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".toml"))
+        .collect();
+    on_disk.sort();
+    let shipped: Vec<&str> = tetlab_core::scene::SHIPPED.iter().map(|s| s.file).collect();
+    assert_eq!(shipped, on_disk);
+    for file in tetlab_core::scene::SHIPPED {
+        let needs_meshes = file.text.contains("shared/meshes");
+        if needs_meshes && tetlab_core::input::shared_meshes::for_test(file.file).is_none() {
+            continue;
+        }
+        let scene = file
+            .scene()
+            .unwrap_or_else(|e| panic!("{}: {e}", file.file));
+        let from_disk = Scene::load_file(&folder.join(file.file)).unwrap();
+        assert_eq!(scene.mesh, from_disk.mesh, "{}", file.file);
+        assert!(
+            scene.bodies.len() >= 2 || file.file == "folded-bar.toml",
+            "{}",
+            file.file
+        );
+    }
+}

@@ -186,6 +186,11 @@ try {
   await drop("broken.msh", "$MeshFormat\n9.9 0 8\n$EndMeshFormat\n");
   await expect("bad-file-reported", (s) => s.error && s.error.includes("broken.msh") && s.tets === meshTets, 10);
 
+  // A link naming a scene file that comes with tetlab opens it: two cubes, one on the other.
+  await page.goto("about:blank");
+  await page.goto(`${url}#scene=stacked-cubes.toml`);
+  await expect("shipped-scene-linked", (s) => s.scene === "stacked cubes" && s.tets === 210 && !s.error, 60);
+
   // The exercises, graded in the page: each opened at its exercise step by a link, a wrong
   // answer dropped (the grade names its particle and a configuration), then a right one (the
   // grade passes), then the step done: every check holds.

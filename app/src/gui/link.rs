@@ -1,5 +1,5 @@
 //! A link to a state of the workbench, in a URL fragment: the built-in scene and its resolution,
-//! the solver settings (the active families among them), the lesson and its step, the camera, and
+//! or a scene file that comes with tetlab (`scene=stacked-cubes.toml`), the solver settings (the active families among them), the lesson and its step, the camera, and
 //! the edits made since the scene was loaded (inversions, mirroring, flattening, scrambling).
 //!
 //! The fragment is `key=value` pairs joined by `&`, URL-encoded (`form_urlencoded`, the `url`
@@ -17,7 +17,7 @@ use glam::Vec3;
 use std::fmt;
 use tetlab_core::constraints::Families;
 use tetlab_core::constraints::material::Material;
-use tetlab_core::scene::{Builtin, Perturbation};
+use tetlab_core::scene::{Builtin, Perturbation, ShippedScene};
 use tetlab_core::simulation::{EngineChoice, Method, Settings};
 
 /// The address the desktop workbench puts before a fragment: where `scripts/web.sh` says to serve
@@ -27,9 +27,9 @@ pub const DEFAULT_PAGE_URL: &str = "http://127.0.0.1:8000/";
 /// Everything a link restores.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Link {
-    /// The built-in scene and its resolution; `None` for a mesh file, which a link cannot carry
-    /// (the default scene is shown).
-    pub scene: Option<(Builtin, u32)>,
+    /// The built-in scene and its resolution, or a shipped scene file; `None` for a mesh file or
+    /// a scene file of the user's, which a link cannot carry (the default scene is shown).
+    pub scene: Option<LinkScene>,
     /// The solver settings.
     pub settings: Settings,
     /// A built-in lesson (its number, from 1) and the step shown (from 0).
@@ -87,25 +87,44 @@ fn parse_edit(text: &str) -> Result<Edit, String> {
 /// The most edits a link replays: every edit is a pass over the body.
 pub const MAX_EDITS: usize = 64;
 
+/// The scene a link names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinkScene {
+    /// A built-in scene at a resolution: `scene=cube&resolution=3`.
+    Builtin(Builtin, u32),
+    /// A scene file of `assets/scenes`, built into tetlab ([`ShippedScene`]):
+    /// `scene=stacked-cubes.toml`.
+    Shipped(&'static str),
+}
+
 impl Link {
     /// The fragment (without `#`).
     ///
     /// ```
-    /// use tetlab::gui::link::Link;
+    /// use tetlab::gui::link::{Link, LinkScene};
     /// use tetlab_core::scene::Builtin;
     /// let mut link = Link::parse("").unwrap();
-    /// link.scene = Some((Builtin::Cube, 3));
+    /// link.scene = Some(LinkScene::Builtin(Builtin::Cube, 3));
     /// link.settings.substeps = 20;
     /// assert_eq!(link.fragment(), "scene=cube&resolution=3&substeps=20");
+    /// assert_eq!(Link::parse(&link.fragment()).unwrap(), link);
+    /// link.scene = Some(LinkScene::Shipped("folded-bar.toml"));
+    /// assert_eq!(link.fragment(), "scene=folded-bar.toml&substeps=20");
     /// assert_eq!(Link::parse(&link.fragment()).unwrap(), link);
     /// ```
     pub fn fragment(&self) -> String {
         let defaults = base_settings(self.lesson.map(|(lesson, _)| lesson));
         let s = &self.settings;
         let mut out = form_urlencoded::Serializer::new(String::new());
-        if let Some((builtin, resolution)) = self.scene {
-            out.append_pair("scene", builtin.name());
-            out.append_pair("resolution", &resolution.to_string());
+        match self.scene {
+            Some(LinkScene::Builtin(builtin, resolution)) => {
+                out.append_pair("scene", builtin.name());
+                out.append_pair("resolution", &resolution.to_string());
+            }
+            Some(LinkScene::Shipped(file)) => {
+                out.append_pair("scene", file);
+            }
+            None => {}
         }
         // Only built-in families travel in a link: the page it is opened on may not have a
         // constraint file that this one loaded.
@@ -195,6 +214,7 @@ impl Link {
             edits: Vec::new(),
         };
         let (mut builtin, mut resolution, mut lesson, mut step) = (None, None, None, None);
+        let mut shipped = None;
         let mut seen: Vec<String> = Vec::new();
         let s = &mut link.settings;
         for (key, value) in form_urlencoded::parse(fragment.as_bytes()) {
@@ -224,11 +244,17 @@ impl Link {
             };
             match key.as_str() {
                 "scene" => {
-                    builtin = Some(Builtin::from_name(&value).ok_or_else(|| {
-                        wrong(format!(
-                            "'{value}' is not a built-in scene (tet, cube, beam or ball)"
-                        ))
-                    })?)
+                    match ShippedScene::named(&value) {
+                        Some(file) => shipped = Some(file.file),
+                        None => builtin = Some(Builtin::from_name(&value).ok_or_else(|| {
+                            let files: Vec<&str> = ShippedScene::names().collect();
+                            wrong(format!(
+                                "'{value}' is not a built-in scene (tet, cube, beam or ball) nor \
+                                 a scene file that comes with tetlab ({})",
+                                files.join(", ")
+                            ))
+                        })?),
+                    }
                 }
                 "resolution" => resolution = Some(count(&value)?),
                 "families" => {
@@ -303,6 +329,13 @@ impl Link {
             message,
         })?;
         link.scene = match (builtin, resolution) {
+            (None, Some(_)) if shipped.is_some() => {
+                return Err(LinkError {
+                    key: "resolution".into(),
+                    message: "given with a scene file, whose bodies say their own".into(),
+                });
+            }
+            (None, None) => shipped.map(LinkScene::Shipped),
             (Some(builtin), resolution) => {
                 let resolution = resolution.unwrap_or(3);
                 tetlab_core::input::limits::RESOLUTION
@@ -311,7 +344,7 @@ impl Link {
                         key: "resolution".into(),
                         message,
                     })?;
-                Some((builtin, resolution))
+                Some(LinkScene::Builtin(builtin, resolution))
             }
             (None, Some(_)) => {
                 return Err(LinkError {
@@ -319,7 +352,6 @@ impl Link {
                     message: "given without a scene".into(),
                 });
             }
-            (None, None) => None,
         };
         link.lesson = match (lesson, step) {
             (Some(lesson), step) => {
@@ -390,7 +422,7 @@ mod tests {
         settings.stiffness[Family::HEIGHT] = 0.5;
         settings.material = Material::parse("E=2e5,nu=0.45").unwrap();
         let link = Link {
-            scene: Some((Builtin::Ball, 2)),
+            scene: Some(LinkScene::Builtin(Builtin::Ball, 2)),
             settings,
             lesson: Some((4, 2)),
             camera: Some(OrbitCamera {
@@ -449,6 +481,12 @@ mod tests {
     fn a_wrong_fragment_names_its_key() {
         for (fragment, key, says) in [
             ("scene=teapot", "scene", "not a built-in scene"),
+            ("scene=teapot.toml", "scene", "stacked-cubes.toml"),
+            (
+                "scene=stacked-cubes.toml&resolution=3",
+                "resolution",
+                "with a scene file",
+            ),
             (
                 "scene=cube&resolution=x",
                 "resolution",

@@ -37,6 +37,9 @@ pub enum SceneRequest {
     Builtin(Builtin, u32),
     /// A mesh file.
     File(String),
+    /// A scene file that comes with tetlab, by its file name
+    /// ([`tetlab_core::scene::ShippedScene`]).
+    Shipped(&'static str),
 }
 
 /// What the user asked of the lesson panel.

@@ -7,8 +7,10 @@
 mod bend;
 pub mod mesh;
 mod scene_file;
+mod shipped;
 pub use bend::Bend;
 pub use scene_file::{MAX_PLACEMENT, SceneBody};
+pub use shipped::{SHIPPED, ShippedScene};
 
 use crate::constraints::volume::signed_volume;
 use crate::input::limits;

@@ -9,7 +9,7 @@ use super::browser;
 use super::files::Opened;
 use super::fonts::install_fonts;
 use super::geometry::SceneCache;
-use super::link::Link;
+use super::link::{Link, LinkScene};
 use super::panels::compare::ComparePanel;
 use super::panels::constraint_editor::ConstraintEditor;
 use super::panels::controls::Controls;
@@ -31,7 +31,7 @@ use super::workbench::Workbench;
 use super::{files, render};
 use std::time::Duration;
 use tetlab_core::constraints::PerFamily;
-use tetlab_core::scene::{Builtin, Perturbation, Scene};
+use tetlab_core::scene::{Builtin, Perturbation, Scene, ShippedScene};
 use tetlab_core::simulation::Settings;
 use tetlab_core::teaching::lesson::{Action as LessonAction, Lesson};
 use web_time::Instant;
@@ -92,9 +92,9 @@ pub struct TetlabApp {
     pub help: Help,
     /// Frames drawn so far (the first one is announced in a browser).
     frames_drawn: u64,
-    /// The built-in scene shown and its resolution (`None` for a mesh file or a lesson's scene):
-    /// what a link names.
-    builtin_shown: Option<(Builtin, u32)>,
+    /// The built-in scene shown and its resolution, or the shipped scene file (`None` for a
+    /// mesh file, a scene file of the user's or a lesson's scene): what a link names.
+    scene_shown: Option<LinkScene>,
     /// The built-in lesson open (its number, from 1): what a link names.
     lesson_number: Option<usize>,
     /// A link just made, to copy to the clipboard on this frame.
@@ -193,7 +193,7 @@ impl TetlabApp {
             modes: ModesPanel::default(),
             help: Help::default(),
             frames_drawn: 0,
-            builtin_shown: Some((builtin, shown_resolution)),
+            scene_shown: Some(LinkScene::Builtin(builtin, shown_resolution)),
             lesson_number: None,
             link_to_copy: None,
             notice: None,
@@ -232,7 +232,7 @@ impl TetlabApp {
         self.viewport.frame();
         self.comparison = None;
         self.error = None;
-        self.builtin_shown = None;
+        self.scene_shown = None;
     }
 
     /// Opens a lesson at its first step: its scene, settings and tet. A lesson that brings
@@ -359,14 +359,32 @@ impl TetlabApp {
                 }
             }
             SceneRequest::File(path) => self.opened(files::open_path(&path)),
+            SceneRequest::Shipped(file) => {
+                if let Err(why) = self.load_shipped(file) {
+                    self.error = Some(why);
+                }
+            }
         }
+    }
+
+    /// Loads a scene file that comes with tetlab ([`ShippedScene`]), which a link can then
+    /// name; an error (a mesh file it needs is not there, as in the browser) names it.
+    pub fn load_shipped(&mut self, file: &str) -> Result<(), String> {
+        let shipped = ShippedScene::named(file)
+            .ok_or_else(|| format!("{file}: not a scene file that comes with tetlab"))?;
+        let scene = shipped
+            .scene()
+            .map_err(|e| format!("{}: {e}", shipped.file))?;
+        self.load(scene);
+        self.scene_shown = Some(LinkScene::Shipped(shipped.file));
+        Ok(())
     }
 
     /// Loads a built-in scene ([`TetlabApp::load`]), which a link can then name.
     pub fn load_builtin(&mut self, builtin: Builtin, resolution: u32) -> Result<(), String> {
         let scene = Scene::builtin(builtin, resolution).map_err(|e| e.to_string())?;
         self.load(scene);
-        self.builtin_shown = Some((builtin, resolution));
+        self.scene_shown = Some(LinkScene::Builtin(builtin, resolution));
         Ok(())
     }
 
@@ -374,7 +392,7 @@ impl TetlabApp {
     /// camera, and the edits made since the scene was loaded.
     pub fn link(&self) -> Link {
         Link {
-            scene: self.builtin_shown,
+            scene: self.scene_shown,
             settings: *self.bench.simulation.settings(),
             lesson: self
                 .lesson_number
@@ -394,10 +412,19 @@ impl TetlabApp {
             for _ in 0..step {
                 self.go_to_step(true);
             }
-        } else if let Some((builtin, resolution)) = link.scene {
-            self.controls.scene.builtin = builtin.name().to_owned();
-            self.controls.scene.resolution = resolution;
-            self.request(SceneRequest::Builtin(builtin, resolution));
+        } else {
+            match link.scene {
+                Some(LinkScene::Builtin(builtin, resolution)) => {
+                    self.controls.scene.builtin = builtin.name().to_owned();
+                    self.controls.scene.resolution = resolution;
+                    self.request(SceneRequest::Builtin(builtin, resolution));
+                }
+                Some(LinkScene::Shipped(file)) => {
+                    self.controls.scene.shipped = file.to_owned();
+                    self.request(SceneRequest::Shipped(file));
+                }
+                None => {}
+            }
         }
         self.set_settings(link.settings);
         for edit in link.edits {

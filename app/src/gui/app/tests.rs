@@ -75,6 +75,35 @@ fn a_link_shows_the_same_state_on_another_workbench() {
     );
 }
 
+/// A scene file that comes with tetlab is loaded from the scene section and named in a link,
+/// which opens it on another workbench; one that needs a mesh that is not there says so.
+#[test]
+fn a_link_names_a_shipped_scene_file() {
+    let mut teacher = TetlabApp::with_preferences(Preferences::default());
+    teacher.request(SceneRequest::Shipped("folded-bar.toml"));
+    assert_eq!(teacher.error, None);
+    assert_eq!(teacher.bench.scene.bodies.len(), 1);
+    let fragment = teacher.link().fragment();
+    assert!(fragment.starts_with("scene=folded-bar.toml"), "{fragment}");
+
+    let mut student = TetlabApp::with_preferences(Preferences::default());
+    student.open_fragment(&fragment);
+    assert_eq!(student.error, None);
+    assert_eq!(student.bench.scene.name, "folded bar");
+    assert_eq!(
+        student.bench.simulation.positions(),
+        teacher.bench.simulation.positions()
+    );
+    assert_eq!(student.link(), teacher.link());
+    // A scene file of the user's is not a link's: the link names no scene.
+    student.load(teacher.bench.scene.clone());
+    assert_eq!(student.link().scene, None);
+    assert_eq!(
+        student.load_shipped("teapot.toml"),
+        Err("teapot.toml: not a scene file that comes with tetlab".to_owned())
+    );
+}
+
 /// The report a browser test reads: the scene, the inversions, the lesson step and its
 /// checks, the error.
 #[test]

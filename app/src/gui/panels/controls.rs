@@ -5,7 +5,7 @@ use crate::gui::request::{Request, SceneRequest};
 use crate::gui::shortcuts::Action;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
-use tetlab_core::scene::Builtin;
+use tetlab_core::scene::{Builtin, ShippedScene};
 use tetlab_core::teaching::stepper::{Advanced, Next};
 
 /// The largest resolution the scene panel offers (a cube of 196 608 tets).
@@ -21,6 +21,8 @@ pub struct SceneChoice {
     pub resolution: u32,
     /// The path typed in the "mesh file" field.
     pub path: String,
+    /// The shipped scene file chosen (`stacked-cubes.toml`, [`ShippedScene`]).
+    pub shipped: String,
 }
 
 impl Default for SceneChoice {
@@ -29,6 +31,7 @@ impl Default for SceneChoice {
             builtin: "cube".into(),
             resolution: 3,
             path: String::new(),
+            shipped: "stacked-cubes.toml".into(),
         }
     }
 }
@@ -158,6 +161,21 @@ impl Panel for Controls {
                 choice.resolution,
             )));
         }
+        // The scene files that come with tetlab, several bodies each, on the desktop and in a
+        // page alike (those of the reference meshes need ../shared/meshes beside tetlab).
+        ui.horizontal(|ui| {
+            egui::ComboBox::from_label("scene file")
+                .selected_text(choice.shipped.clone())
+                .show_ui(ui, |ui| {
+                    for file in ShippedScene::names() {
+                        ui.selectable_value(&mut choice.shipped, file.to_owned(), file);
+                    }
+                });
+            let clicked = ui.button("Load").clicked();
+            if let Some(shipped) = ShippedScene::named(&choice.shipped).filter(|_| clicked) {
+                requests.push(Request::Scene(SceneRequest::Shipped(shipped.file)));
+            }
+        });
         if cfg!(target_arch = "wasm32") {
             // A page cannot open files by path: meshes and lessons are dropped on it.
             ui.label("drop a .msh mesh, a lesson or a constraint .toml on the page to open it");
