@@ -37,6 +37,9 @@ pub enum SceneRequest {
     Builtin(Builtin, u32),
     /// A mesh file.
     File(String),
+    /// A built-in at a resolution added to the scene shown as one more body, dropped onto it
+    /// ([`tetlab_core::scene::Scene::with_body_dropped`]).
+    AddBody(Builtin, u32),
     /// A scene file that comes with tetlab, by its file name
     /// ([`tetlab_core::scene::ShippedScene`]).
     Shipped(&'static str),

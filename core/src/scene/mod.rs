@@ -4,6 +4,7 @@
 //! positions to set up an experiment (invert one tet, mirror the body, flatten it, scramble it). [`mesh`]
 //! holds the tet mesh and its file formats.
 
+mod adding;
 mod bend;
 pub mod mesh;
 mod scene_file;

@@ -302,7 +302,7 @@ impl Scene {
     }
 
     /// Appends `part` as a body named `name`, placed by `placement`, starting at `velocity`.
-    fn add(&mut self, name: String, part: Scene, placement: Placement, velocity: DVec3) {
+    pub(super) fn add(&mut self, name: String, part: Scene, placement: Placement, velocity: DVec3) {
         let first = self.mesh.positions.len() as u32;
         let first_tet = self.mesh.tets.len() as u32;
         let (lo, hi) = super::mesh::bounds(&part.mesh.positions);
@@ -345,11 +345,11 @@ impl Scene {
 }
 
 /// How a body is placed: x ↦ centre + translate + R bend(scale (x − centre)).
-struct Placement {
-    scale: DMat3,
-    bend: Option<Bend>,
-    rotation: DMat3,
-    translate: DVec3,
+pub(super) struct Placement {
+    pub(super) scale: DMat3,
+    pub(super) bend: Option<Bend>,
+    pub(super) rotation: DMat3,
+    pub(super) translate: DVec3,
 }
 
 /// A body's mesh `spec` as a scene of its own: a built-in at `resolution`, or a mesh file found

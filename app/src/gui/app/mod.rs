@@ -359,12 +359,34 @@ impl TetlabApp {
                 }
             }
             SceneRequest::File(path) => self.opened(files::open_path(&path)),
+            SceneRequest::AddBody(builtin, resolution) => {
+                if let Err(why) = self.add_body(builtin, resolution) {
+                    self.error = Some(why);
+                }
+            }
             SceneRequest::Shipped(file) => {
                 if let Err(why) = self.load_shipped(file) {
                     self.error = Some(why);
                 }
             }
         }
+    }
+
+    /// Adds a built-in to the scene shown as one more body, dropped onto it from above
+    /// ([`Scene::with_body_dropped`]); the scene starts again with it, under the same settings.
+    /// Too many tets for tetlab is an error, and the scene stays.
+    pub fn add_body(&mut self, builtin: Builtin, resolution: u32) -> Result<(), String> {
+        let part = Scene::builtin(builtin, resolution).map_err(|e| e.to_string())?;
+        let tets = self.bench.scene.mesh.tets.len() + part.mesh.tets.len();
+        if tets > tetlab_core::input::limits::MAX_TETS {
+            return Err(format!(
+                "Add a body: the scene would have {tets} tets, more than the {} tetlab simulates",
+                tetlab_core::input::limits::MAX_TETS
+            ));
+        }
+        let scene = self.bench.scene.with_body_dropped(part);
+        self.load(scene);
+        Ok(())
     }
 
     /// Loads a scene file that comes with tetlab ([`ShippedScene`]), which a link can then

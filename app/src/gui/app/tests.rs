@@ -104,6 +104,43 @@ fn a_link_names_a_shipped_scene_file() {
     );
 }
 
+/// "Add a body" adds the chosen built-in to the scene shown, over it: a scene of one body
+/// becomes one of two, measured body by body, and with contact on the new body lands on the
+/// old one rather than passing through it.
+#[test]
+fn add_a_body_drops_one_more_onto_the_scene() {
+    let mut app = TetlabApp::with_preferences(Preferences::default());
+    app.request(SceneRequest::Builtin(Builtin::Cube, 2));
+    app.request(SceneRequest::AddBody(Builtin::Cube, 1));
+    assert_eq!(app.error, None);
+    let names: Vec<&str> = app
+        .bench
+        .scene
+        .bodies
+        .iter()
+        .map(|b| b.name.as_str())
+        .collect();
+    assert_eq!(names, ["cube", "cube2"]);
+    assert_eq!(app.bench.simulation.positions().len(), 27 + 8);
+    let mut settings = *app.bench.simulation.settings();
+    settings.active = app
+        .bench
+        .simulation
+        .families()
+        .parse_list("edges,volume,contact")
+        .unwrap();
+    app.set_settings(settings);
+    for _ in 0..60 {
+        app.bench.simulation.step();
+    }
+    let bodies = tetlab_core::measures::metrics::Metrics::measure_bodies(&app.bench.simulation);
+    let upper = bodies[1].1.centre_of_mass.y;
+    assert!(
+        upper > 1.0,
+        "the added cube rests on the first: its centre at {upper}"
+    );
+}
+
 /// The report a browser test reads: the scene, the inversions, the lesson step and its
 /// checks, the error.
 #[test]

@@ -154,13 +154,25 @@ impl Panel for Controls {
                 .text("resolution"),
         )
         .on_hover_text("cells along a side: a cube of resolution n has 6n³ tets (15: 20 250)");
-        if ui.button("Load built-in scene").clicked() {
+        ui.horizontal(|ui| {
             let builtin = Builtin::from_name(&choice.builtin).unwrap_or(Builtin::Cube);
-            requests.push(Request::Scene(SceneRequest::Builtin(
-                builtin,
-                choice.resolution,
-            )));
-        }
+            if ui.button("Load built-in scene").clicked() {
+                requests.push(Request::Scene(SceneRequest::Builtin(
+                    builtin,
+                    choice.resolution,
+                )));
+            }
+            if ui
+                .button("Add a body")
+                .on_hover_text("adds the built-in above to the scene shown, dropped onto it")
+                .clicked()
+            {
+                requests.push(Request::Scene(SceneRequest::AddBody(
+                    builtin,
+                    choice.resolution,
+                )));
+            }
+        });
         // The scene files that come with tetlab, several bodies each, on the desktop and in a
         // page alike (those of the reference meshes need ../shared/meshes beside tetlab).
         ui.horizontal(|ui| {
