@@ -689,6 +689,8 @@ fn a_scene_of_several_bodies_is_recorded_body_by_body() {
             ("energy/elastic", "energy_elastic"),
             ("metrics/inverted_tets", "inverted_tets"),
             ("metrics/max_edge_strain", "max_edge_strain"),
+            ("metrics/contacts", "contacts"),
+            ("metrics/max_penetration", "max_penetration"),
         ] {
             let name = format!("bodies/{body}/{recorded}");
             let series = summary["metrics"][&name]

@@ -258,13 +258,18 @@ impl<'a> Recorder<'a> {
         self.log_bodies(simulation);
     }
 
-    /// Logs each body's headline metrics and energy under `bodies/<name>/` (nothing for a
+    /// Logs each body's headline metrics (with its contacts touching and largest penetration,
+    /// where a family on contacts is active) and energy under `bodies/<name>/` (nothing for a
     /// scene of one body): [`Metrics::measure_bodies`] and [`Energy::measure_bodies`], the
     /// numbers `tetlab run --json` prints per body.
     fn log_bodies(&self, simulation: &Simulation) {
         let metrics = Metrics::measure_bodies(simulation);
         let energies = Energy::measure_bodies(simulation);
         let families = simulation.families();
+        let contact =
+            tetlab_core::simulation::contact::contact_families(families, simulation.active())
+                .next()
+                .is_some();
         let plots = self.parts.iter().filter_map(|p| p.plots.as_ref());
         for ((path, (_, metrics)), (_, energy)) in plots.zip(metrics).zip(energies) {
             let log = |name: String, value: f64| {
@@ -277,6 +282,10 @@ impl<'a> Recorder<'a> {
             };
             for (name, value) in metrics.headline() {
                 log(format!("metrics/{name}"), value);
+            }
+            if contact {
+                log("metrics/contacts".into(), metrics.contacts as f64);
+                log("metrics/max_penetration".into(), metrics.max_penetration);
             }
             let elastic: f64 = families.all().map(|f| energy.elastic[f]).sum();
             for (name, value) in [
