@@ -37,25 +37,33 @@ fn table(name: &str, kind: &str, doc: &str, folder: &Path) -> String {
 fn main() {
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo"));
-    let lessons = table(
-        "BUILTIN",
-        "BuiltinLesson",
-        "The lessons in assets/lessons, in file-name order.",
-        &manifest.join("../assets/lessons"),
-    );
-    std::fs::write(out.join("lessons.rs"), lessons).expect("OUT_DIR is writable");
-    let constraints = table(
-        "EXAMPLES",
-        "Example",
-        "The example constraint files in assets/constraints, in file-name order.",
-        &manifest.join("../assets/constraints"),
-    );
-    std::fs::write(out.join("constraint_examples.rs"), constraints).expect("OUT_DIR is writable");
-    let scenes = table(
-        "SHIPPED",
-        "ShippedScene",
-        "The scene files in assets/scenes, in file-name order.",
-        &manifest.join("../assets/scenes"),
-    );
-    std::fs::write(out.join("shipped_scenes.rs"), scenes).expect("OUT_DIR is writable");
+    // (the constant, its type, what it holds, the folder, the file it is written to)
+    let tables = [
+        (
+            "BUILTIN",
+            "BuiltinLesson",
+            "The lessons in assets/lessons",
+            "lessons",
+            "lessons.rs",
+        ),
+        (
+            "EXAMPLES",
+            "Example",
+            "The example constraint files in assets/constraints",
+            "constraints",
+            "constraint_examples.rs",
+        ),
+        (
+            "SHIPPED",
+            "ShippedScene",
+            "The scene files in assets/scenes",
+            "scenes",
+            "shipped_scenes.rs",
+        ),
+    ];
+    for (name, kind, what, folder, file) in tables {
+        let doc = format!("{what}, in file-name order.");
+        let code = table(name, kind, &doc, &manifest.join("../assets").join(folder));
+        std::fs::write(out.join(file), code).expect("OUT_DIR is writable");
+    }
 }

@@ -152,7 +152,7 @@ impl BodyRecord {
                 energy_kinetic: energy.kinetic,
                 energy_gravitational: energy.gravitational,
                 energy_external: energy.external,
-                energy_elastic: families.all().map(|f| energy.elastic[f]).sum(),
+                energy_elastic: energy.elastic_total(families),
                 energy_total: energy.total,
             })
             .collect()

@@ -242,17 +242,12 @@ impl<'a> Recorder<'a> {
         }
         // The energy account, one series each in one plot.
         let energy = Energy::measure(simulation);
-        let elastic: f64 = simulation.families().all().map(|f| energy.elastic[f]).sum();
-        for (name, value) in [
-            ("kinetic", energy.kinetic),
-            ("gravitational", energy.gravitational),
-            ("external", energy.external),
-            ("elastic", elastic),
-            ("total", energy.total),
+        let parts = energy.parts(simulation.families());
+        for (name, value) in parts.into_iter().chain([
             ("taken_by_ground", energy.taken.ground),
             ("taken_by_damping", energy.taken.damping),
             ("taken_by_settling", energy.taken.settling),
-        ] {
+        ]) {
             log(&format!("energy/{name}"), &rerun::Scalars::single(value));
         }
         self.log_bodies(simulation);
@@ -287,14 +282,7 @@ impl<'a> Recorder<'a> {
                 log("metrics/contacts".into(), metrics.contacts as f64);
                 log("metrics/max_penetration".into(), metrics.max_penetration);
             }
-            let elastic: f64 = families.all().map(|f| energy.elastic[f]).sum();
-            for (name, value) in [
-                ("kinetic", energy.kinetic),
-                ("gravitational", energy.gravitational),
-                ("external", energy.external),
-                ("elastic", elastic),
-                ("total", energy.total),
-            ] {
+            for (name, value) in energy.parts(families) {
                 log(format!("energy/{name}"), value);
             }
         }

@@ -170,6 +170,23 @@ impl Energy {
         }
     }
 
+    /// The elastic energy of every family of `families`, J.
+    pub fn elastic_total(&self, families: &crate::constraints::Families) -> f64 {
+        families.all().map(|f| self.elastic[f]).sum()
+    }
+
+    /// What a plot of the account shows, named: `kinetic`, `gravitational`, `external`,
+    /// `elastic` (every family's, [`Energy::elastic_total`]) and `total`, J.
+    pub fn parts(&self, families: &crate::constraints::Families) -> [(&'static str, f64); 5] {
+        [
+            ("kinetic", self.kinetic),
+            ("gravitational", self.gravitational),
+            ("external", self.external),
+            ("elastic", self.elastic_total(families)),
+            ("total", self.total),
+        ]
+    }
+
     /// [`Energy::measure`] with [`Energy::violation`] too: how far each family without a
     /// measurable store is from holding, which a run's account ([`EnergyWatch`]) needs and a
     /// display does not (it costs a C and a ∇C per constraint of those families every frame).
