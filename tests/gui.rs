@@ -9,6 +9,8 @@ mod gui_support;
 // this process with the others.
 #[path = "gui/constraint_editor.rs"]
 mod constraint_editor;
+#[path = "gui/contact.rs"]
+mod contact;
 #[path = "gui/exercise.rs"]
 mod exercise;
 #[path = "gui/modes.rs"]

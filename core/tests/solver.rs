@@ -178,7 +178,8 @@ fn a_step_allocates_nothing() {
 }
 
 /// With contact, the pairs are found again every frame: the grid holds one entry per surface
-/// particle, and the pairs keep room for twice the most yet, so a cube dropped onto another,
+/// particle, and the pairs keep room for twice the most yet and at least twice the surface's
+/// particles (how many a frame finds changes with the speeds), so a cube dropped onto another,
 /// grabbed by a bottom corner and dragged across it allocates nothing once it has landed.
 #[test]
 fn a_step_with_contact_allocates_nothing_once_its_arrays_have_grown() {

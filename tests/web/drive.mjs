@@ -8,7 +8,7 @@
 // Modes window of that tet), Space (it recovers), M (every tet inverted), drop a lesson file and
 // go to its next step (its checks are read), drop a Gmsh mesh (it loads), drop a broken mesh (the page shows the error); each
 // exercise graded (a wrong answer dropped, then a right one); lesson 6 on the bunny the page
-// fetched; then every built-in lesson's steps done and their checks read (TETLAB_WEB_LESSONS=0
+// fetched; a shipped scene with contact on played (the upper cube rests on the lower); then every built-in lesson's steps done and their checks read (TETLAB_WEB_LESSONS=0
 // leaves that part out).
 
 import puppeteer from "puppeteer-core";
@@ -190,6 +190,21 @@ try {
   await page.goto("about:blank");
   await page.goto(`${url}#scene=stacked-cubes.toml`);
   await expect("shipped-scene-linked", (s) => s.scene === "stacked cubes" && s.tets === 210 && !s.error, 60);
+
+  // The same scene with contact on, played: the upper cube rests on the lower (its centre stays
+  // near 1.26 m; through it, it would end near 0.25 m), touching it, and not inside it.
+  await page.goto("about:blank");
+  await page.goto(`${url}#scene=stacked-cubes.toml&families=edges,volume,contact`);
+  await expect("contact-scene-linked", (s) => s.scene === "stacked cubes" && s.bodies.length === 2 && !s.error, 60);
+  await page.keyboard.press("Space");
+  const rested = await expect("contact-scene-rests", (s) => s.frame >= 120 && s.contacts > 0 &&
+    s.max_penetration < 1e-3 && s.bodies[1].centre_y > 1.2, 120);
+  if (rested) {
+    console.log(`     ${rested.engine}: ${rested.contacts} contacts touching, penetration ` +
+      `${rested.max_penetration.toExponential(2)} m, upper centre at ${rested.bodies[1].centre_y.toFixed(4)} m`);
+  }
+  await page.keyboard.press("Space");
+  await expect("contact-scene-paused", (s) => !s.playing, 10);
 
   // The exercises, graded in the page: each opened at its exercise step by a link, a wrong
   // answer dropped (the grade names its particle and a configuration), then a right one (the

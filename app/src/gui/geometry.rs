@@ -80,7 +80,8 @@ pub const ARROWS_ON_ALL_UP_TO: usize = 64;
 
 /// Selected tets and particles.
 pub const SELECTED: Rgba = [250, 200, 40, 255];
-/// The constraint step-by-step mode projects next: its particles and the lines between them.
+/// The constraint step-by-step mode projects next, and the selected contact: its particles and
+/// the lines between them.
 pub const PENDING: Rgba = [40, 220, 220, 255];
 /// The particle under the pointer.
 const HOVERED: Rgba = [255, 255, 255, 255];
@@ -341,27 +342,9 @@ pub fn update(
     let arrows = &mut scratch.arrows;
     arrows.clear();
     let pending = bench.stepping.and_then(|s| s.pending(simulation));
+    let radius = (0.02 * cache.size) as f32;
     if let Some(projection) = &pending {
-        let particles = projection.particles();
-        for a in 0..particles.len() {
-            for b in a + 1..particles.len() {
-                line(
-                    &mut geometry.lines,
-                    positions[particles[a] as usize].as_vec3(),
-                    positions[particles[b] as usize].as_vec3(),
-                    PENDING,
-                );
-            }
-        }
-        let radius = (0.02 * cache.size) as f32;
-        for &i in particles {
-            octahedron(
-                &mut geometry.triangles,
-                positions[i as usize].as_vec3(),
-                radius,
-                PENDING,
-            );
-        }
+        outline(geometry, positions, projection.particles(), radius);
         visual::projection_arrows(
             simulation.families(),
             positions,
@@ -374,6 +357,19 @@ pub fn update(
         tet_arrows(bench, options, arrows);
         if options.arrows {
             visual::contact_arrows(simulation, options.arrow_scale as f64, arrows);
+            if let Some(particle) = bench.selected_particle {
+                if let Some(&pair) = simulation.contacts_of(particle).first() {
+                    let pair = simulation.contact_pairs()[pair];
+                    outline(geometry, positions, &pair, radius);
+                }
+                visual::selected_contact_arrows(
+                    simulation,
+                    particle,
+                    options.arrow_scale as f64,
+                    options.correction_gain as f64,
+                    arrows,
+                );
+            }
         }
     }
     if let Some(mode) = bench.mode_shown.filter(|m| m.tet < tets.len()) {
@@ -401,6 +397,25 @@ pub fn update(
             arrow.quantity.colour(simulation.families()),
             arrow,
         );
+    }
+}
+
+/// The particles of one constraint (the projection step-by-step mode makes next, the selected
+/// contact) outlined: a line between every two of them and a marker on each.
+fn outline(geometry: &mut Geometry, positions: &[DVec3], particles: &[u32], radius: f32) {
+    for a in 0..particles.len() {
+        for b in a + 1..particles.len() {
+            line(
+                &mut geometry.lines,
+                positions[particles[a] as usize].as_vec3(),
+                positions[particles[b] as usize].as_vec3(),
+                PENDING,
+            );
+        }
+    }
+    for &i in particles {
+        let at = positions[i as usize].as_vec3();
+        octahedron(&mut geometry.triangles, at, radius, PENDING);
     }
 }
 

@@ -36,6 +36,23 @@ pub struct Report {
     pub lanes: &'static str,
     /// How long the last simulation step took, in milliseconds.
     pub step_ms: f64,
+    /// The engine that steps the simulation ("reference (f64)", "fast (f32, 1 thread)").
+    pub engine: String,
+    /// The contact pairs touching ([`tetlab_core::measures::metrics::Metrics::contacts`]).
+    pub contacts: usize,
+    /// The largest penetration of the frame's contact pairs, in metres.
+    pub max_penetration: f64,
+    /// Each body of the scene: its name and the height of its centre of mass.
+    pub bodies: Vec<BodyReport>,
+}
+
+/// One body of the scene, as the report gives it.
+#[derive(Clone, Debug, Serialize)]
+pub struct BodyReport {
+    /// Its name in the scene.
+    pub name: String,
+    /// The height (y) of its centre of mass, in metres.
+    pub centre_y: f64,
 }
 
 /// The Modes window's numbers: the eigenvalues of the selected tet's energy Hessian.
@@ -153,6 +170,10 @@ impl TetlabApp {
             modes: self.modes_report(),
             lanes: tetlab_core::numbers::lanes::REGISTERS,
             step_ms: self.step_time.as_secs_f64() * 1e3,
+            engine: bench.simulation.describe_engine(),
+            contacts: bench.metrics.contacts,
+            max_penetration: bench.metrics.max_penetration,
+            bodies: bodies(&bench.simulation),
         }
     }
 
@@ -192,4 +213,14 @@ impl TetlabApp {
             to: [to.x, to.y],
         })
     }
+}
+
+/// Each body's name and the height of its centre of mass (one body for a scene of one).
+fn bodies(simulation: &tetlab_core::simulation::Simulation) -> Vec<BodyReport> {
+    (tetlab_core::measures::metrics::Metrics::measure_bodies(simulation).into_iter())
+        .map(|(name, metrics)| BodyReport {
+            name,
+            centre_y: metrics.centre_of_mass.y,
+        })
+        .collect()
 }

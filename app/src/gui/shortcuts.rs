@@ -88,7 +88,7 @@ pub const SHORTCUTS: [(Key, Action, &str); 24] = [
     (
         Key::E,
         Action::Inspector,
-        "inspector (numbers of the selected tet)",
+        "inspector (numbers of the selected tet and particle's contacts)",
     ),
     (
         Key::D,

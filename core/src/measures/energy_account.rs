@@ -78,10 +78,14 @@ impl Energy {
     /// ```
     pub fn measure(simulation: &Simulation) -> Energy {
         let whole = 0..simulation.positions().len() as u32;
-        let rest = |family: Family| simulation.body().sets[family].rest_squared();
+        let positions = simulation.positions();
+        let squares = |family: Family| {
+            let now = squared_values(simulation, family, positions);
+            (now, simulation.body().sets[family].rest_squared())
+        };
         Energy {
             taken: simulation.state().taken,
-            ..Energy::measure_part(simulation, &whole, rest)
+            ..Energy::measure_part(simulation, &whole, squares)
         }
     }
 
@@ -89,7 +93,8 @@ impl Energy {
     /// name and its [`Energy`], of its particles and of the constraints whose first particle is
     /// its (a body's elements have none outside it). The bodies' totals add up to the scene's
     /// ([`Energy::measure`]); what left the scene ([`Energy::taken`]) is not told apart by body
-    /// and is zero here. Empty for a scene of one body.
+    /// and is zero here. Empty for a scene of one body. Each family's constraints are evaluated
+    /// once, now and at rest, whatever the number of bodies.
     ///
     /// ```
     /// use tetlab_core::measures::energy_account::Energy;
@@ -108,26 +113,46 @@ impl Energy {
     /// assert!(bodies[1].1.kinetic > 100.0 * bodies[0].1.kinetic);
     /// ```
     pub fn measure_bodies(simulation: &Simulation) -> Vec<(String, Energy)> {
-        let rest_positions = simulation.rest_positions();
-        (simulation.bodies().iter())
-            .map(|body| {
-                let part = &body.particles;
-                let rest = |family| squared_values(simulation, family, rest_positions, part);
-                (
-                    body.name.clone(),
-                    Energy::measure_part(simulation, part, rest),
-                )
+        let bodies = simulation.bodies();
+        let starts: Vec<u32> = bodies.iter().map(|b| b.particles.start).collect();
+        // Σ C² per body, now and at rest, of each family that stores energy.
+        let mut squares = PerFamily::<Vec<(f64, f64)>>::default();
+        let resolved = simulation.resolved();
+        for family in simulation.families().all() {
+            if !simulation.active()[family] || !resolved.stores_energy(family) {
+                continue;
+            }
+            let sums = &mut squares[family];
+            sums.resize(bodies.len(), (0.0, 0.0));
+            let set = simulation.constraints(family);
+            let now = simulation.constraint_values(family, simulation.positions());
+            let rest = simulation.constraint_values(family, simulation.rest_positions());
+            for (c, ((now, _), (rest, _))) in now.zip(rest).enumerate() {
+                let first = set.particles(c)[0];
+                let body = starts.partition_point(|&s| s <= first).saturating_sub(1);
+                let square = |v: f64| if v.is_finite() { v * v } else { 0.0 };
+                if let Some(sum) = sums.get_mut(body) {
+                    sum.0 += square(now);
+                    sum.1 += square(rest);
+                }
+            }
+        }
+        (bodies.iter().enumerate())
+            .map(|(b, body)| {
+                let of = |family: Family| squares[family].get(b).copied().unwrap_or_default();
+                let energy = Energy::measure_part(simulation, &body.particles, of);
+                (body.name.clone(), energy)
             })
             .collect()
     }
 
     /// The energy of the particles `part` of `simulation` and of the constraints whose first
-    /// particle is among them, with `rest_squared(family)` their Σ C(x⁰)² ([`Energy::taken`]
-    /// left zero).
+    /// particle is among them, with `squares(family)` their Σ C² now and at rest, asked only of
+    /// an active family that stores energy ([`Energy::taken`] left zero).
     fn measure_part(
         simulation: &Simulation,
         part: &Range<u32>,
-        rest_squared: impl Fn(Family) -> f64,
+        squares: impl Fn(Family) -> (f64, f64),
     ) -> Energy {
         let body = simulation.body();
         let gravity = simulation.settings().gravity;
@@ -155,8 +180,8 @@ impl Energy {
             if !simulation.active()[family] || !resolved.stores_energy(family) {
                 return 0.0;
             }
-            let now = squared_values(simulation, family, positions, part);
-            0.5 * (now - rest_squared(family)) / resolved.compliance[family]
+            let (now, rest) = squares(family);
+            0.5 * (now - rest) / resolved.compliance[family]
         });
         let elastic_sum: f64 = simulation.families().all().map(|f| elastic[f]).sum();
         Energy {
@@ -204,13 +229,10 @@ impl Energy {
     }
 }
 
-/// Σ_c C_c(x)² over `family`'s constraints at positions `x` whose first particle is in `part`
-/// (a C that is not finite left out).
-fn squared_values(simulation: &Simulation, family: Family, x: &[DVec3], part: &Range<u32>) -> f64 {
-    let set = simulation.constraints(family);
-    (simulation.constraint_values(family, x).enumerate())
-        .filter(|(c, _)| part.contains(&set.particles(*c)[0]))
-        .map(|(_, (c, _))| if c.is_finite() { c * c } else { 0.0 })
+/// Σ_c C_c(x)² over `family`'s constraints at positions `x` (a C that is not finite left out).
+fn squared_values(simulation: &Simulation, family: Family, x: &[DVec3]) -> f64 {
+    (simulation.constraint_values(family, x))
+        .map(|(c, _)| if c.is_finite() { c * c } else { 0.0 })
         .sum()
 }
 

@@ -11,12 +11,25 @@ use glam::DVec3;
 impl Simulation {
     /// The constraints one sweep projects, in order: every constraint of each active family
     /// (edges, then heights, then volumes), each family's in the order of
-    /// [`super::Settings::order_seed`], as (family, index in the family).
+    /// [`super::Settings::order_seed`], as (family, index in the family); then each active
+    /// family that binds to contacts over the pairs of [`Simulation::contact_pairs`], in the
+    /// order the seed gives them, as (family, index of the pair).
     pub fn projection_order(&self) -> impl Iterator<Item = (Family, usize)> + '_ {
-        self.families.units(self.active()).flat_map(move |unit| {
+        let families = self.families.units(self.active()).flat_map(move |unit| {
             let set = &self.body.sets[unit.lead];
             (0..set.len()).map(move |k| (unit.lead, set.in_order(k)))
-        })
+        });
+        let contact =
+            super::contact::ContactPlan::new(&self.families, &self.resolved, &self.state.contacts);
+        let contacts = contact.into_iter().flat_map(|plan| {
+            let n = plan.found.len();
+            let order = plan.order.clone();
+            plan.families.clone().into_iter().flat_map(move |family| {
+                let order = order.clone();
+                (0..n).map(move |k| (family, order.as_ref().map_or(k, |o| o[k] as usize)))
+            })
+        });
+        families.chain(contacts)
     }
 
     /// The constraints of `family` on tet `tet`, as indices in the family: its edges (six), its
@@ -86,7 +99,12 @@ impl Simulation {
     ///
     /// A family projected together with another ([`crate::constraints::Row::projected_with`])
     /// shows its own C and ∇C, and its Δλ and the Δx of the pair's projection: what a sweep does.
+    ///
+    /// For a family that binds to contacts, `c` is a pair of [`Simulation::contact_pairs`].
     pub fn projection(&self, family: Family, c: usize) -> Projection {
+        if self.families.binding(family) == crate::constraints::Binding::Contacts {
+            return self.contact_projection(family, c);
+        }
         let unit = self.families.unit_of(family, self.active());
         let h = self.substep_length();
         let describe = Describe {

@@ -73,6 +73,28 @@ impl<'a> OnState<'a> {
         self.project_which(unit, Which::One(c), plan);
     }
 
+    /// Projects pair `c` of the frame's contacts by the contact family `family` alone, exactly
+    /// as a sweep's contact pass does (step-by-step mode).
+    pub fn project_contact(&mut self, family: Family, c: usize, plan: &Plan) {
+        self.contacts_which(plan, Some((family, c)));
+    }
+
+    fn contacts_which(&mut self, plan: &Plan, only: Option<(Family, usize)>) {
+        let Some(contact) = &plan.contact else {
+            return;
+        };
+        let s = &mut *self.state;
+        crate::simulation::contact::project_pairs(
+            self.families,
+            &plan.rules,
+            contact,
+            (&contact.found, only),
+            (&mut s.positions, &mut s.previous, &s.inverse_masses),
+            &mut s.contact_lambdas,
+            &mut self.skipped,
+        );
+    }
+
     fn project_which(&mut self, unit: Unit, which: Which, plan: &Plan) {
         let sweep = Sweep {
             sets: &self.body.sets,
@@ -124,26 +146,15 @@ impl Substeps for OnState<'_> {
         }
         if let Some(contact) = &plan.contact {
             let wanted = contact.found.len() * contact.families.len();
-            super::contact::keep_room(&mut self.state.contact_lambdas, wanted);
+            let room = contact.room() * contact.families.len();
+            super::contact::keep_room(&mut self.state.contact_lambdas, room);
             self.state.contact_lambdas.resize(wanted, 0.0);
             self.state.contact_lambdas.fill(0.0);
         }
     }
 
     fn contacts(&mut self, plan: &Plan) {
-        let Some(contact) = &plan.contact else {
-            return;
-        };
-        let s = &mut *self.state;
-        crate::simulation::contact::project_pairs(
-            self.families,
-            &plan.rules,
-            contact,
-            &contact.found,
-            (&mut s.positions, &mut s.previous, &s.inverse_masses),
-            &mut s.contact_lambdas,
-            &mut self.skipped,
-        );
+        self.contacts_which(plan, None);
     }
 
     fn project(&mut self, unit: Unit, plan: &Plan) {

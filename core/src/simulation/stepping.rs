@@ -75,7 +75,7 @@ impl Simulation {
         let found = (self.contact_finder).find(surface, &state.positions, &state.velocities, reach);
         let contacts = std::sync::Arc::make_mut(&mut state.contacts);
         contacts.clear();
-        super::contact::keep_room(contacts, found.len());
+        super::contact::keep_room(contacts, found.len().max(surface.particles.len()));
         contacts.extend_from_slice(found);
     }
 
@@ -169,8 +169,11 @@ impl Simulation {
 
     /// One substep on the reference engine: [`Simulation::begin_substep`], `iterations` sweeps
     /// ([`Simulation::project`] of every constraint of [`Simulation::projection_order`], then
-    /// `Simulation::end_sweep`), `Simulation::end_substep`: done here in tight loops.
+    /// `Simulation::end_sweep`), `Simulation::end_substep`: done here in tight loops. Like
+    /// [`Simulation::begin_substep`], it finds the contact pairs afresh first.
     pub fn substep(&mut self) {
+        self.hold_off_settling();
+        self.find_contacts();
         self.on_state(|on, plan| {
             substep::begin_substep(on, plan, true);
             on.sweeps(plan);
@@ -187,14 +190,22 @@ impl Simulation {
 
     /// Projects constraint `c` of `family` once, exactly as a sweep does (with its partner, if it
     /// leads a pair).
+    ///
+    /// For a family that binds to contacts, `c` is a pair of [`Simulation::contact_pairs`],
+    /// projected as the sweep's contact pass projects it.
     pub fn project(&mut self, family: Family, c: usize) {
+        if self.families.binding(family) == crate::constraints::Binding::Contacts {
+            self.on_state(|on, plan| on.project_contact(family, c, plan));
+            return;
+        }
         let unit = self.families.unit_of(family, self.active());
         self.on_state(|on, plan| on.project_one(unit, c, plan));
     }
 
-    /// The end of one sweep, after the constraint families: the grab, then the ground y ≥ 0.
+    /// The end of one sweep, after the constraint families and the contacts, which step-by-step
+    /// mode projects one at a time: the grab, then the ground y ≥ 0.
     pub(crate) fn end_sweep(&mut self) {
-        self.on_state(|on, plan| substep::end_sweep(on, plan));
+        self.on_state(|on, plan| substep::close_sweep(on, plan));
     }
 
     /// The last stage of a substep: Δp = x − predicted x, then velocities from the positions.

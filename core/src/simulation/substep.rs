@@ -287,6 +287,12 @@ pub fn end_sweep(engine: &mut impl Substeps, plan: &Plan) {
     if plan.contact.is_some() {
         engine.contacts(plan);
     }
+    close_sweep(engine, plan);
+}
+
+/// The end of a sweep after its contacts: the compliant grab, then the ground and the plane
+/// (step-by-step mode projects the contacts one at a time before it).
+pub fn close_sweep(engine: &mut impl Substeps, plan: &Plan) {
     if let Some((particle, target, compliance)) = plan.soft_grab {
         let target = engine.target(target);
         project_soft_grab(engine.grabbed(particle), target, compliance, plan.h);

@@ -81,9 +81,28 @@ pub fn inspect(simulation: &Simulation, family: Family, c: usize) -> Inspection 
 
 /// What else the family shows of the inspected constraint ([`crate::constraints::AnyConstraint::describe_state`]: F and
 /// det F for the neo-Hookean pair), one line each.
+/// Of a contact pair: whether p₀ lies over the triangle, C at the substep's start and the floor
+/// the pair is held at, which say whether and how the contact pass projects it.
 pub fn state_lines(simulation: &Simulation, projection: &Projection) -> Vec<String> {
+    let (family, c) = (projection.family, projection.constraint);
+    if let Some(contact) = simulation
+        .contact_state(family, c)
+        .filter(|_| simulation.families().binding(family) == crate::constraints::Binding::Contacts)
+    {
+        let over = match contact.over {
+            Some([a, b, c]) => {
+                format!("p₀ is over the triangle: its foot at b = ({a:.3}, {b:.3}, {c:.3})")
+            }
+            None => "p₀ is not over the triangle: the pair is left alone".to_owned(),
+        };
+        let floor = format!(
+            "C at the substep's start = {:+.4e}; held at C ≥ {:+.4e} (projected only below it)",
+            contact.at_start, contact.floor
+        );
+        return vec![over, floor];
+    }
     let (points, rest_shape) = particles_of(simulation, projection);
-    (simulation.families().constraint(projection.family)).describe_state(&points, &rest_shape)
+    (simulation.families().constraint(family)).describe_state(&points, &rest_shape)
 }
 
 /// The constraint's particles now and at rest.
@@ -115,6 +134,40 @@ mod tests {
     use crate::constraints::PerFamily;
     use crate::scene::{Builtin, Perturbation, Scene};
     use crate::simulation::Settings;
+
+    /// A contact pair inspected: its gradient agrees with central differences, and its lines
+    /// say whether the particle is over its triangle.
+    #[test]
+    fn a_contact_pair_is_inspected_like_a_constraint() {
+        let text = "[[body]]\nmesh = \"cube\"\nresolution = 2\n\
+                    [[body]]\nmesh = \"cube\"\nresolution = 2\ntranslate = [0.3, 1.003, 0.2]\n";
+        let scene = Scene::parse_file(std::path::Path::new("t.toml"), text).unwrap();
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        let families = simulation.families().clone();
+        let active = families.parse_list("edges,volume,contact").unwrap();
+        let contact = families.parse("contact").unwrap();
+        simulation.set_settings(Settings {
+            active,
+            ..Settings::default()
+        });
+        for _ in 0..5 {
+            simulation.step();
+        }
+        let pairs = simulation.contact_pairs().len();
+        assert!(pairs > 0);
+        let mut over = 0;
+        for c in 0..pairs {
+            let inspection = inspect(&simulation, contact, c);
+            let p = &inspection.projection;
+            assert_eq!(p.particles, simulation.contact_pairs()[c]);
+            assert!(inspection.relative_error < 1e-6, "{inspection:?}");
+            assert_eq!(p.rest, simulation.settings().contact.thickness);
+            let lines = state_lines(&simulation, p);
+            assert_eq!(lines.len(), 2, "{lines:?}");
+            over += usize::from(lines[0].starts_with("p₀ is over"));
+        }
+        assert!(over > 0, "no pair of {pairs} lies over its triangle");
+    }
 
     #[test]
     fn a_tet_shows_six_edges_four_heights_and_one_volume_all_checked() {

@@ -149,12 +149,13 @@ impl StepByStep {
 
 /// How many constraints one sweep projects.
 fn sweep_length(simulation: &Simulation) -> usize {
-    simulation
-        .settings()
-        .active
-        .families()
+    let families = simulation.families();
+    let contact = crate::simulation::contact::contact_families(families, simulation.active());
+    let pairs = contact.count() * simulation.contact_pairs().len();
+    let constraints: usize = (simulation.settings().active.families())
         .map(|f| simulation.constraint_count(f))
-        .sum()
+        .sum();
+    constraints + pairs
 }
 
 #[cfg(test)]
@@ -219,6 +220,61 @@ mod tests {
             assert_eq!(whole.positions(), stepped.positions(), "{method:?}");
             assert_eq!(whole.velocities(), stepped.velocities(), "{method:?}");
         }
+    }
+
+    /// Two cubes, one resting on the other, with contact: a sweep steps through the contact
+    /// pairs one at a time after the families, each pending projection is what its advance
+    /// applies, and the whole substep gives the same bits as [`Simulation::substep`].
+    #[test]
+    fn contact_pairs_are_stepped_one_at_a_time() {
+        let text = "[[body]]\nmesh = \"cube\"\nresolution = 1\n\
+                    [[body]]\nmesh = \"cube\"\nresolution = 1\ntranslate = [0.3, 1.002, 0]\n";
+        let scene = crate::scene::Scene::parse_file(std::path::Path::new("t.toml"), text).unwrap();
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        let families = simulation.families().clone();
+        let active = families.parse_list("edges,volume,contact").unwrap();
+        let contact = families.parse("contact").unwrap();
+        simulation.set_settings(Settings {
+            active,
+            substeps: 4,
+            ..Settings::default()
+        });
+        for _ in 0..3 {
+            simulation.step();
+        }
+        let mut whole = simulation.clone();
+        whole.substep();
+        let mut stepper = StepByStep::default();
+        let (mut pairs, mut moved) = (0, 0);
+        loop {
+            let pending = stepper.pending(&simulation);
+            let before = simulation.positions().to_vec();
+            match (pending, stepper.advance(&mut simulation)) {
+                (Some(expected), Advanced::Projected(done)) => {
+                    assert_eq!(expected, done);
+                    if done.family == contact {
+                        pairs += 1;
+                        for (k, &i) in done.particles().iter().enumerate() {
+                            let step = simulation.positions()[i as usize] - before[i as usize];
+                            assert_eq!(step, done.delta_x[k], "pair {}", done.constraint);
+                            moved += usize::from(step != glam::DVec3::ZERO);
+                        }
+                    }
+                }
+                (
+                    None,
+                    Advanced::EndedSweep {
+                        ended_substep: true,
+                    },
+                ) => break,
+                (None, _) => {}
+                other => panic!("pending and advance disagree: {other:?}"),
+            }
+        }
+        assert_eq!(pairs, simulation.contact_pairs().len());
+        assert!(pairs > 0 && moved > 0, "{pairs} pairs, {moved} moved");
+        assert_eq!(whole.positions(), simulation.positions());
+        assert_eq!(whole.velocities(), simulation.velocities());
     }
 
     #[test]

@@ -7,7 +7,7 @@ use crate::gui::request::Request;
 use crate::gui::workbench::Workbench;
 use eframe::egui;
 use glam::DVec3;
-use tetlab_core::constraints::Formula;
+use tetlab_core::constraints::{Binding, Formula};
 use tetlab_core::simulation::{Method, Simulation};
 use tetlab_core::teaching::inspector::{Inspection, inspect, inspect_tet, state_lines};
 
@@ -46,6 +46,7 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
         constraint(ui, simulation, &inspection, method, "next projection");
         ui.separator();
     }
+    contacts(ui, bench);
     let Some(tet) = bench.selected_tet else {
         ui.label("Select a tet (click a particle) to inspect its constraints.");
         return;
@@ -82,6 +83,53 @@ pub fn contents(ui: &mut egui::Ui, bench: &Workbench) {
     }
 }
 
+/// The contacts of the selected particle, each family that binds to contacts on each pair:
+/// the pair's numbers as the contact pass sees them (its ∇C is drawn in the view).
+fn contacts(ui: &mut egui::Ui, bench: &Workbench) {
+    let simulation = &bench.simulation;
+    let Some(particle) = bench.selected_particle else {
+        return;
+    };
+    let families = simulation.families();
+    let contact: Vec<_> =
+        tetlab_core::simulation::contact::contact_families(families, simulation.active()).collect();
+    if contact.is_empty() {
+        return;
+    }
+    let pairs = simulation.contacts_of(particle);
+    let method = simulation.settings().method;
+    egui::CollapsingHeader::new(format!("Contacts of particle {particle} ({})", pairs.len()))
+        .id_salt("contacts of the selected particle")
+        .default_open(true)
+        .show(ui, |ui| {
+            if pairs.is_empty() {
+                ui.label(
+                    "None this frame: the broad phase found no triangle this particle may reach \
+                 within the frame.",
+                );
+                return;
+            }
+            for &family in &contact {
+                formula(ui, &families.row(family).formula);
+                for &c in pairs.iter().take(MAX_CONTACTS_SHOWN) {
+                    ui.separator();
+                    let inspection = inspect(simulation, family, c);
+                    constraint(ui, simulation, &inspection, method, ("contact", family, c));
+                }
+            }
+            if pairs.len() > MAX_CONTACTS_SHOWN {
+                ui.label(format!(
+                    "and {} more, farther or not over their triangles",
+                    pairs.len() - MAX_CONTACTS_SHOWN
+                ));
+            }
+        });
+    ui.separator();
+}
+
+/// How many of the selected particle's contact pairs the inspector lists.
+const MAX_CONTACTS_SHOWN: usize = 4;
+
 /// The family's constraint and gradients, one line of math each.
 fn formula(ui: &mut egui::Ui, formula: &Formula) {
     egui::Frame::group(ui.style()).show(ui, |ui| {
@@ -107,6 +155,9 @@ fn constraint(
         (Some(d), Method::Xpbd) => format!("next Δλ = {d:+.4e}"),
         (Some(d), Method::Pbd) => format!("next k′s = {d:+.4e}"),
         (None, _) if p.degenerate => "skipped: ∇C undefined (degenerate)".to_owned(),
+        (None, _) if families.binding(p.family) == Binding::Contacts => {
+            "not projected now (see below)".to_owned()
+        }
         (None, _) => "skipped: every particle fixed".to_owned(),
     };
     ui.label(

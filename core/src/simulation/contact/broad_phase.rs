@@ -6,17 +6,21 @@
 //! box, grown by a margin m, looks in the cells it overlaps. A pair is kept when the particle may touch the
 //! triangle ([`super::ContactSurface::may_touch`]), lies within m of the triangle's plane on its
 //! outer side or at most one thickness d under it (−d ≤ h ≤ m), and its foot on the plane lies
-//! within m of the triangle. The margin covers the largest motion of the frame:
-//! m = d + 2 v_max Δt + g Δt², v_max the fastest surface particle's speed at the frame's start,
-//! since the particle and the triangle may close on each other at that speed each, and gravity
-//! adds g Δt² at most to what they close by. A particle that would cross a triangle within the
-//! frame is therefore paired with it at the frame's start, and is stopped by its contact in the
-//! substep where it would cross: a fast body does not tunnel.
+//! within m of the triangle. The margin is the pair's own and covers the most the two can close
+//! on each other within the frame: m = d + (v_p + v_t) Δt + g Δt², v_p the particle's speed and
+//! v_t the fastest of the triangle's corners at the frame's start, and gravity adds g Δt² at
+//! most to what they close by. A particle that would cross a triangle within the frame is
+//! therefore paired with it at the frame's start, and is stopped by its contact in the substep
+//! where it would cross: a fast body does not tunnel. A triangle looks in the cells its box
+//! covers grown by the most any pair of it may need, d + (v_t + v_max) Δt + g Δt², v_max the
+//! fastest surface particle; each pair then keeps to its own margin, so that one fast particle
+//! grows the search but not the pairs of every slow triangle.
 //!
 //! A uniform grid rather than a bounding-volume hierarchy: the bodies are of one scale (a
 //! triangle's size varies little across a tet mesh), the grid is rebuilt in one sort a frame
 //! and holds exactly one entry per surface particle, so it never grows after the first frame
-//! (the pairs found keep room for twice the most yet: [`super::keep_room`]); a hierarchy would have to be refitted or
+//! (the pairs found keep room for twice the most yet, and at least twice the surface's particles:
+//! [`super::keep_room`]); a hierarchy would have to be refitted or
 //! rebuilt every frame too (docs/performance.md has the measured cost).
 
 use super::ContactSurface;
@@ -30,7 +34,7 @@ pub struct ContactFinder {
     cells: Vec<(u64, u32)>,
     /// The pairs found: [particle, triangle's three corners], sorted.
     found: Vec<[u32; 4]>,
-    /// The margin of the last search, m.
+    /// The largest margin a pair of the last search could have: d + 2 v_max Δt + g Δt².
     margin: f64,
 }
 
@@ -57,24 +61,29 @@ impl ContactFinder {
     ) -> &[[u32; 4]] {
         self.cells.clear();
         self.found.clear();
+        let speed = |i: u32| {
+            let v = velocities.get(i as usize).map_or(0.0, |v| v.length());
+            if v.is_finite() { v } else { 0.0 }
+        };
         let fastest = surface
             .particles
             .iter()
-            .map(|&i| velocities.get(i as usize).map_or(0.0, |v| v.length()))
-            .filter(|v| v.is_finite())
+            .map(|&i| speed(i))
             .fold(0.0f64, f64::max);
-        let margin =
-            reach.thickness + 2.0 * fastest * reach.dt + reach.gravity.abs() * reach.dt * reach.dt;
-        self.margin = margin;
-        if surface.triangles.is_empty() || !margin.is_finite() {
+        // m for a pair closing at `closing` m/s.
+        let margin = |closing: f64| {
+            reach.thickness + closing * reach.dt + reach.gravity.abs() * reach.dt * reach.dt
+        };
+        let largest_margin = margin(2.0 * fastest);
+        self.margin = largest_margin;
+        if surface.triangles.is_empty() || !largest_margin.is_finite() {
             return &self.found;
         }
+        let triangle_speed = |t: &[u32; 3]| t.iter().map(|&i| speed(i)).fold(0.0f64, f64::max);
         let bounds = |t: &[u32; 3]| {
             let [a, b, c] = t.map(|i| positions[i as usize]);
-            (
-                a.min(b).min(c) - DVec3::splat(margin),
-                a.max(b).max(c) + DVec3::splat(margin),
-            )
+            let grown = DVec3::splat(margin(triangle_speed(t) + fastest));
+            (a.min(b).min(c) - grown, a.max(b).max(c) + grown)
         };
         // The cell: the mean grown box's largest side, so that a triangle covers a few cells,
         // and at least an eighth of the largest, so that none covers more than 9 a side (a
@@ -106,6 +115,7 @@ impl ContactFinder {
             let (low, high) = (index(low), index(high));
             let span = high - low;
             let corners = triangle.map(|i| positions[i as usize]);
+            let triangle_speed = triangle_speed(triangle);
             for x in 0..=span.x as i64 {
                 for y in 0..=span.y as i64 {
                     for z in 0..=span.z as i64 {
@@ -120,6 +130,7 @@ impl ContactFinder {
                                 continue;
                             }
                             let x = positions[particle as usize];
+                            let margin = margin(speed(particle) + triangle_speed);
                             if near(x, corners, margin, reach.thickness) {
                                 let [a, b, c] = *triangle;
                                 self.found.push([particle, a, b, c]);
@@ -130,7 +141,7 @@ impl ContactFinder {
             }
         }
         let len = self.found.len();
-        super::keep_room(&mut self.found, len);
+        super::keep_room(&mut self.found, len.max(surface.particles.len()));
         self.found.sort_unstable();
         self.found.dedup();
         &self.found
@@ -141,7 +152,7 @@ impl ContactFinder {
         &self.found
     }
 
-    /// The margin of the last search, m.
+    /// The largest margin a pair of the last search could have: d + 2 v_max Δt + g Δt².
     pub fn margin(&self) -> f64 {
         self.margin
     }
@@ -176,4 +187,50 @@ fn hash([x, y, z]: [i64; 3]) -> u64 {
     h = h.rotate_left(31);
     h ^= (z as u64).wrapping_mul(0x1656_67B1_9E37_79F9);
     h ^ (h >> 29)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three tets: A on the ground, B 0.5 m above A's apex, C 100 m away.
+    fn scene(velocity_of_b: DVec3, velocity_of_c: DVec3) -> Vec<[u32; 4]> {
+        let tets = [[0, 1, 2, 3], [4, 5, 6, 7], [8, 9, 10, 11]];
+        let surface = ContactSurface::of(&tets, 12);
+        let shape = [DVec3::ZERO, DVec3::X, DVec3::Z, DVec3::new(0.3, 1.0, 0.3)];
+        let at = |offset: DVec3| shape.map(|p| p + offset);
+        let positions: Vec<DVec3> =
+            [at(DVec3::ZERO), at(1.5 * DVec3::Y), at(100.0 * DVec3::X)].concat();
+        let velocities: Vec<DVec3> =
+            [[DVec3::ZERO; 4], [velocity_of_b; 4], [velocity_of_c; 4]].concat();
+        let reach = Reach {
+            thickness: 0.01,
+            dt: 1.0 / 60.0,
+            gravity: 9.81,
+        };
+        let mut finder = ContactFinder::default();
+        finder
+            .find(&surface, &positions, &velocities, reach)
+            .to_vec()
+    }
+
+    /// A body that will close a 0.5 m gap within the frame (40 m/s for 1/60 s) is paired with
+    /// what it will reach; a body at rest is not, even while another body far away moves fast:
+    /// each pair keeps to its own margin.
+    #[test]
+    fn each_pair_has_the_margin_of_its_own_motion() {
+        let falling = scene(-40.0 * DVec3::Y, DVec3::ZERO);
+        let b = 4..8;
+        assert!(
+            (falling.iter()).any(|p| p[0] == 3 && p[1..].iter().all(|i| b.contains(i))),
+            "A's apex is paired with B's underside: {falling:?}"
+        );
+        assert_eq!(scene(DVec3::ZERO, DVec3::ZERO), Vec::<[u32; 4]>::new());
+        let far_and_fast = scene(DVec3::ZERO, 100.0 * DVec3::Z);
+        assert_eq!(
+            far_and_fast,
+            Vec::<[u32; 4]>::new(),
+            "B at rest, C fast and far"
+        );
+    }
 }

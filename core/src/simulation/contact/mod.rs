@@ -13,11 +13,13 @@
 
 mod broad_phase;
 pub(crate) mod contact_settings;
+pub(crate) mod describe;
 pub(crate) mod project;
 pub(crate) mod surface;
 
 pub use broad_phase::{ContactFinder, Reach};
 pub use contact_settings::ContactSettings;
+pub use describe::ContactState;
 pub use surface::ContactSurface;
 
 use crate::constraints::{Binding, Families, Family, MAX_FAMILIES};
@@ -40,6 +42,14 @@ pub struct ContactPlan {
 }
 
 impl ContactPlan {
+    /// How many pairs the frame's arrays keep room for: half what the pairs found hold room for
+    /// (they keep room for twice the most found yet, and for at least twice as many as the
+    /// surface has particles, since how many pairs a frame finds changes with the bodies'
+    /// speeds: [`keep_room`]).
+    pub fn room(&self) -> usize {
+        (self.found.capacity() / 2).max(self.found.len())
+    }
+
     /// The plan of a frame under `resolved` with the pairs `found`: `None` when no active family
     /// binds to contacts.
     pub fn new(
@@ -77,12 +87,13 @@ pub fn contact_families<'a>(
 /// an engine's arrays in its precision: the positions, where the particles were at the
 /// substep's start, the inverse masses; `lambdas` holds each family's multipliers in turn
 /// (`found.len()` each); `rules` are the families' rules. Adds each family's skipped
-/// projections to `skipped`.
+/// projections to `skipped`. With `only` = (family, pair), that one pair of that one family is
+/// projected (step-by-step mode), as the pass would project it.
 pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
     families: &Families,
     rules: &crate::constraints::PerFamily<crate::simulation::projection::Rule<f64>>,
     contact: &ContactPlan,
-    found: &[[u32; 4]],
+    (found, only): (&[[u32; 4]], Option<(Family, usize)>),
     (positions, previous, inverse_masses): (&mut [V], &mut [V], &[V::Real]),
     lambdas: &mut [V::Real],
     skipped: &mut crate::constraints::PerFamily<crate::simulation::projection::SkipCounts>,
@@ -93,6 +104,9 @@ pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
     let n = found.len();
     let settings = contact.settings;
     for (k, &family) in contact.families.iter().enumerate() {
+        if only.is_some_and(|(f, _)| f != family) {
+            continue;
+        }
         let pass = project::ContactPass {
             found,
             order: contact.order.as_deref(),
@@ -106,6 +120,7 @@ pub(crate) fn project_pairs<V: crate::numbers::vector::Vector3>(
                 V::Real::from_f64(settings.static_friction),
                 V::Real::from_f64(settings.kinetic_friction),
             ],
+            only: only.map(|(_, c)| c),
         };
         let counted = families.visit(family, pass);
         skipped[family] = skipped[family] + counted;

@@ -46,6 +46,9 @@ pub(crate) struct ContactPass<'a, V: Vector3> {
     pub rule: Rule<V::Real>,
     /// μ_s and μ_k.
     pub friction: [V::Real; 2],
+    /// Project this pair alone (an index into `found`; step-by-step mode), or every pair in
+    /// `order` (`None`).
+    pub only: Option<usize>,
 }
 
 impl<V: Vector3> Visit for ContactPass<'_, V>
@@ -59,44 +62,15 @@ where
         if N != 4 {
             return skipped;
         }
+        if let Some(c) = self.only {
+            if c < self.found.len() {
+                self.pair(constraint, c, &mut skipped);
+            }
+            return skipped;
+        }
         for k in 0..self.found.len() {
             let c = self.order.map_or(k, |order| order[k] as usize);
-            let ids = self.found[c];
-            let p: [V; N] = std::array::from_fn(|i| self.positions[ids[i] as usize]);
-            let Some(b) = over_triangle(p[0], [p[1], p[2], p[3]]) else {
-                continue;
-            };
-            // The particle must have been on the triangle's outer side at the substep's start
-            // (or at most one thickness under it): a particle found behind it, deeper than the
-            // substep could have taken it, came in another way (past an edge of the surface,
-            // where no triangle holds it) and is not thrown out through this one.
-            let start: [V; N] = std::array::from_fn(|i| self.previous[ids[i] as usize]);
-            let corners = [start[0], start[1], start[2], start[3]];
-            let height = crate::constraints::contact::evaluate(&corners, V::Real::ZERO);
-            if !at_least(height.value, -self.thickness) {
-                continue;
-            }
-            // A particle already closer than the thickness at the substep's start (one that came
-            // over the triangle's edge into the layer, not through its face, or was pushed in by
-            // another projection) is stopped at its floor C_start = min(0, C at the substep's
-            // start), so contact gives it no speed, and then leaves the layer with where it
-            // started (the module docs).
-            let floor = constraint.evaluate(&start, self.thickness, &start).value;
-            let floor = if floor.finite() { floor } else { V::Real::ZERO };
-            let floor = if floor < V::Real::ZERO {
-                floor
-            } else {
-                V::Real::ZERO
-            };
-            let w: [V::Real; N] = std::array::from_fn(|i| self.inverse_masses[ids[i] as usize]);
-            let mut e = constraint.evaluate(&p, self.thickness, &p);
-            e.value -= floor;
-            if above(V::Real::ZERO, e.value) {
-                self.stop_the_approach(c, e, ids, w, b, &mut skipped);
-            }
-            if floor < V::Real::ZERO {
-                self.leave_the_layer(constraint, ids, w);
-            }
+            self.pair(constraint, c, &mut skipped);
         }
         skipped
     }
@@ -106,6 +80,52 @@ impl<V: Vector3> ContactPass<'_, V>
 where
     V::Real: Real<Mask = bool> + PartialOrd,
 {
+    /// Projects pair `c` of `found`, as the module docs say; counts a skipped projection in
+    /// `skipped`.
+    fn pair<const N: usize, C: Constraint<N>>(
+        &mut self,
+        constraint: &C,
+        c: usize,
+        skipped: &mut SkipCounts,
+    ) {
+        let ids = self.found[c];
+        let p: [V; N] = std::array::from_fn(|i| self.positions[ids[i] as usize]);
+        let Some(b) = over_triangle(p[0], [p[1], p[2], p[3]]) else {
+            return;
+        };
+        // The particle must have been on the triangle's outer side at the substep's start
+        // (or at most one thickness under it): a particle found behind it, deeper than the
+        // substep could have taken it, came in another way (past an edge of the surface,
+        // where no triangle holds it) and is not thrown out through this one.
+        let start: [V; N] = std::array::from_fn(|i| self.previous[ids[i] as usize]);
+        let corners = [start[0], start[1], start[2], start[3]];
+        let height = crate::constraints::contact::evaluate(&corners, V::Real::ZERO);
+        if !at_least(height.value, -self.thickness) {
+            return;
+        }
+        // A particle already closer than the thickness at the substep's start (one that came
+        // over the triangle's edge into the layer, not through its face, or was pushed in by
+        // another projection) is stopped at its floor C_start = min(0, C at the substep's
+        // start), so contact gives it no speed, and then leaves the layer with where it
+        // started (the module docs).
+        let floor = constraint.evaluate(&start, self.thickness, &start).value;
+        let floor = if floor.finite() { floor } else { V::Real::ZERO };
+        let floor = if floor < V::Real::ZERO {
+            floor
+        } else {
+            V::Real::ZERO
+        };
+        let w: [V::Real; N] = std::array::from_fn(|i| self.inverse_masses[ids[i] as usize]);
+        let mut e = constraint.evaluate(&p, self.thickness, &p);
+        e.value -= floor;
+        if above(V::Real::ZERO, e.value) {
+            self.stop_the_approach(c, e, ids, w, b, skipped);
+        }
+        if floor < V::Real::ZERO {
+            self.leave_the_layer(constraint, ids, w);
+        }
+    }
+
     /// Projects pair `c` (`ids`, inverse masses `w`, the foot at barycentric `b`) to its floor
     /// from `e` (C less the floor, below 0), then applies friction to what that moved it apart.
     /// A skipped projection is counted in `skipped`.

@@ -41,7 +41,7 @@ impl Substeps for OnArrays<'_> {
         found.clear();
         if let Some(contact) = &plan.contact {
             let renumber = &s.renumber;
-            crate::simulation::contact::keep_room(found, contact.found.len());
+            crate::simulation::contact::keep_room(found, contact.room());
             found.extend((contact.found.iter()).map(|pair| pair.map(|i| renumber[i as usize])));
         }
     }
@@ -95,7 +95,8 @@ impl Substeps for OnArrays<'_> {
         if let Some(contact) = &plan.contact {
             let (found, lambdas) = &mut s.contacts;
             let wanted = found.len() * contact.families.len();
-            crate::simulation::contact::keep_room(lambdas, wanted);
+            let room = contact.room() * contact.families.len();
+            crate::simulation::contact::keep_room(lambdas, room);
             lambdas.resize(wanted, 0.0);
             lambdas.fill(0.0);
         }
@@ -111,7 +112,7 @@ impl Substeps for OnArrays<'_> {
             &s.families,
             &plan.rules,
             contact,
-            found,
+            (found, None),
             (&mut s.positions, &mut s.previous, &s.inverse_masses),
             lambdas,
             &mut s.skipped,

@@ -11,7 +11,7 @@ pub use arrows::{
 };
 pub use surface::{
     ALL_FACES_UP_TO, contact_arrows, display_edges, display_faces, edge_strips, faces_with_tets,
-    held_particle_colours, inverted_tets, particle_colours,
+    held_particle_colours, inverted_tets, particle_colours, selected_contact_arrows,
 };
 
 use crate::constraints::volume::signed_volume;
@@ -128,6 +128,53 @@ mod tests {
             assert_eq!(a.vector, a.value * 10.0);
             assert_eq!(a.quantity.colour(simulation.families()), CORRECTION);
         }
+    }
+
+    /// The selected contact: ∇C of the contact family at the pair's four particles, the
+    /// longest as long as a pending projection's, and nothing for a particle without contacts.
+    #[test]
+    fn the_selected_contact_gets_its_gradient_arrows() {
+        let text = "[[body]]\nmesh = \"cube\"\nresolution = 2\n\
+                    [[body]]\nmesh = \"cube\"\nresolution = 2\ntranslate = [0.3, 1.003, 0.2]\n";
+        let scene = Scene::parse_file(std::path::Path::new("t.toml"), text).unwrap();
+        let mut simulation = Simulation::new(&scene, Settings::default());
+        let families = simulation.families().clone();
+        let active = families.parse_list("edges,volume,contact").unwrap();
+        simulation.set_settings(Settings {
+            active,
+            ..Settings::default()
+        });
+        for _ in 0..5 {
+            simulation.step();
+        }
+        let contact = families.parse("contact").unwrap();
+        let over = |i: usize| {
+            let pairs = simulation.contacts_of(i);
+            let first = pairs.first()?;
+            simulation
+                .contact_state(contact, *first)?
+                .over
+                .map(|_| *first)
+        };
+        let upper = simulation.bodies()[1].particles.clone();
+        let (particle, pair) = (upper.map(|i| i as usize))
+            .find_map(|i| over(i).map(|c| (i, c)))
+            .expect("a particle of the upper cube over a triangle of the lower");
+        let mut arrows = Vec::new();
+        selected_contact_arrows(&simulation, particle, 1.0, 1.0, &mut arrows);
+        let gradients: Vec<_> = (arrows.iter())
+            .filter(|a| a.quantity == Quantity::Gradient(contact))
+            .collect();
+        let particles: Vec<u32> = gradients.iter().map(|a| a.particle).collect();
+        assert_eq!(particles, simulation.contact_pairs()[pair]);
+        let projection = simulation.projection(contact, pair);
+        for (a, g) in gradients.iter().zip(projection.gradients) {
+            assert_eq!(a.value, g);
+        }
+        let far = (0..simulation.positions().len()).find(|&i| simulation.contacts_of(i).is_empty());
+        let mut none = Vec::new();
+        selected_contact_arrows(&simulation, far.unwrap(), 1.0, 1.0, &mut none);
+        assert!(none.is_empty());
     }
 
     #[test]

@@ -167,3 +167,29 @@ pub fn contact_arrows(simulation: &Simulation, gain: f64, out: &mut Vec<super::A
         }
     }
 }
+
+/// The arrows of the selected contact: for the nearest contact pair of `particle` that lies
+/// over its triangle ([`Simulation::contacts_of`]), ∇C of each active family on contacts at its
+/// four particles and the Δx the contact pass would give them
+/// ([`super::projection_arrows`], as step-by-step mode draws a pending projection). None where
+/// the particle has no such pair. Appended to `out`.
+pub fn selected_contact_arrows(
+    simulation: &Simulation,
+    particle: usize,
+    gain: f64,
+    correction_gain: f64,
+    out: &mut Vec<super::Arrow>,
+) {
+    let families = simulation.families();
+    let Some(&pair) = simulation.contacts_of(particle).first() else {
+        return;
+    };
+    for family in crate::simulation::contact::contact_families(families, simulation.active()) {
+        let over = simulation.contact_state(family, pair).and_then(|s| s.over);
+        if over.is_some() {
+            let projection = simulation.projection(family, pair);
+            let positions = simulation.positions();
+            super::projection_arrows(families, positions, &projection, gain, correction_gain, out);
+        }
+    }
+}

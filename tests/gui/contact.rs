@@ -1,0 +1,64 @@
+//! A contact selected in the workbench: two cubes stacked, contact on, a particle of the upper
+//! cube's underside clicked; the inspector lists its contact pairs with C, ∇C beside central
+//! differences, and where the particle stands over its triangle.
+
+use super::gui_support::{click_at, workbench};
+use eframe::egui;
+use egui_kittest::kittest::Queryable;
+use tetlab::gui::viewport;
+
+#[test]
+fn the_inspector_shows_the_contacts_of_the_clicked_particle() {
+    let mut harness = workbench("cube", 2);
+    super::open_by_path(&mut harness, "../assets/scenes/stacked-cubes.toml");
+    harness
+        .get_all_by_label("contact")
+        .next()
+        .expect("the solver panel's contact")
+        .click();
+    harness.run_steps(2);
+    for _ in 0..10 {
+        harness.get_by_label("Step frame").click();
+        harness.run_steps(1);
+    }
+    // The particle of the upper cube's underside nearest the camera (which looks from +x, +y,
+    // +z): a corner the user sees resting on the lower cube.
+    let (particle, at) = {
+        let state = harness.state();
+        let simulation = &state.bench.simulation;
+        let upper = simulation.bodies()[1].particles.clone();
+        let positions = simulation.positions();
+        let lowest = (upper.clone())
+            .map(|i| positions[i as usize].y)
+            .fold(f64::INFINITY, f64::min);
+        let particle = (upper.map(|i| i as usize))
+            .filter(|&i| positions[i].y < lowest + 0.01)
+            .max_by(|&a, &b| {
+                let near = |i: usize| positions[i].x + positions[i].z;
+                near(a).total_cmp(&near(b))
+            })
+            .unwrap();
+        let camera = state.viewport.camera;
+        let (at, _) = viewport::project(&camera, state.viewport.rect, positions[particle]).unwrap();
+        (particle, at)
+    };
+    click_at(&mut harness, at);
+    assert_eq!(harness.state().bench.selected_particle, Some(particle));
+    let pairs = harness.state().bench.simulation.contacts_of(particle);
+    assert!(!pairs.is_empty(), "the corner rests on the lower cube");
+    // The view draws ∇C at the four particles of its nearest pair (as for a pending projection).
+    harness.run_steps(2);
+    harness.snapshot("contact_selected");
+    harness.key_press(egui::Key::E);
+    harness.run_steps(2);
+    assert!(harness.state().inspector.open);
+    harness.get_by_label_contains(&format!(
+        "Contacts of particle {particle} ({})",
+        pairs.len()
+    ));
+    harness.get_by_label_contains(&format!("contact #{}   C = ", pairs[0]));
+    let over = "p₀ is over the triangle: its foot at b = (";
+    assert!(harness.query_all_by_label_contains(over).next().is_some());
+    harness.get_by_label_contains("C = e₀ · n − d ≥ 0");
+    harness.snapshot("contact_inspector");
+}
