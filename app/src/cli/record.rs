@@ -8,7 +8,6 @@ use crate::record::{ArrowsMode, Destination, Ending, Recorder, Session, send_lay
 use rerun::RecordingStream;
 use std::io::Write;
 use std::path::PathBuf;
-use tetlab_core::constraints::Family;
 use tetlab_core::measures::exact_step::ExactStepGap;
 use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::scene::Scene;
@@ -139,7 +138,7 @@ fn describe(rec: &RecordingStream, scene: &Scene, simulation: &Simulation, args:
         scene.name,
         simulation.positions().len(),
         simulation.tets().len(),
-        simulation.constraint_count(Family::EDGES),
+        simulation.body().edges.len(),
         args.simulation.describe(simulation),
         args.arrows,
         args.tet

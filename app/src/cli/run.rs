@@ -7,7 +7,6 @@ use super::simulation_args::SimulationArgs;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write;
-use tetlab_core::constraints::Family;
 use tetlab_core::input::limits::{self, Number};
 use tetlab_core::measures::energy_account::{Energy, EnergyWatch};
 use tetlab_core::measures::ensemble::{Ensemble, Member, Tally};
@@ -229,7 +228,7 @@ impl FrameRecord {
             exact_step_relative: None,
             particles: first.then(|| simulation.positions().len()),
             tets: first.then(|| simulation.tets().len()),
-            edges: first.then(|| simulation.constraint_count(Family::EDGES)),
+            edges: first.then(|| simulation.body().edges.len()),
             engine: first.then(|| simulation.engine().name()),
             threads: first.then(|| simulation.threads()),
             order_seed: first.then_some(settings.settings.order_seed),
@@ -268,11 +267,16 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
             scene.name,
             simulation.positions().len(),
             simulation.tets().len(),
-            simulation.constraint_count(Family::EDGES)
+            simulation.body().edges.len()
         )
         .map_err(io)?;
         for note in &scene.notes {
             writeln!(out, "  note: {note}").map_err(io)?;
+        }
+        for body in &scene.bodies {
+            if let Some(made_of) = body.made_of() {
+                writeln!(out, "  body {}: {made_of}", body.name).map_err(io)?;
+            }
         }
         let perturbation = args.simulation.perturb.map(|p| p.to_string());
         writeln!(

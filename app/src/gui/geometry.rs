@@ -7,7 +7,6 @@
 use super::vertices::{Geometry, Vertex};
 use super::workbench::{ModeShown, Workbench};
 use glam::{DVec3, Vec3};
-use tetlab_core::constraints::Family;
 use tetlab_core::constraints::volume::signed_volume;
 use tetlab_core::scene::mesh::TetMesh;
 use tetlab_core::teaching::visual::{self, Arrow, Rgba};
@@ -265,7 +264,7 @@ pub fn update(
         } else if bench.selected_tet == Some(tet) {
             SELECTED
         } else if options.colour_by_volume {
-            let rest = simulation.constraints(Family::VOLUME).rest()[tet];
+            let rest = simulation.rest_volume(tet);
             let ratio = if rest > 0.0 {
                 signed_volume(&tets[tet].map(|i| positions[i as usize])) / rest
             } else {
@@ -532,7 +531,10 @@ mod tests {
         let geometry = build(&bench, &cache, &ViewOptions::default(), None);
         assert_eq!(geometry.triangles.len() % 3, 0);
         assert_eq!(geometry.lines.len() % 2, 0);
-        let arrow_colour = visual::family_colour(bench.simulation.families(), Family::VOLUME);
+        let arrow_colour = visual::family_colour(
+            bench.simulation.families(),
+            tetlab_core::constraints::Family::VOLUME,
+        );
         assert!(
             geometry
                 .overlay_lines

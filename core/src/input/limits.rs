@@ -195,6 +195,14 @@ pub const FRICTION: Bounds<f64> = Bounds {
     max: 10.0,
 };
 
+/// A body's density in kg/m³ (a scene file's `density`): from well below cork (10) to above
+/// osmium (22 590); the default is [`crate::simulation::DENSITY`].
+pub const DENSITY: Bounds<f64> = Bounds {
+    name: "density",
+    min: 1.0,
+    max: 1e5,
+};
+
 /// Frames a headless run simulates.
 pub const FRAMES: Bounds<u64> = Bounds {
     name: "frames",

@@ -6,11 +6,12 @@
 //! - K = Σᵢ ½ mᵢ |vᵢ|², the kinetic energy of the free particles (held ones have no mass here);
 //! - U_g = Σᵢ mᵢ g yᵢ, gravity's, above the ground's height y = 0;
 //! - U_f = −Σᵢ fᵢ·(xᵢ − x⁰ᵢ), the constant external forces', zero at the rest shape;
-//! - U_c = Σ_c ½ (C_c(x)² − C_c(x⁰)²) / α for each active family that stores energy
+//! - U_c = Σ_c ½ (C_c(x)² − C_c(x⁰)²) / α_c for each active family that stores energy
 //!   ([`crate::simulation::Resolved::stores_energy`]: compliant, under XPBD or a material): the
 //!   energy XPBD's compliance stands for (the material's, for the neo-Hookean pair), zero at
 //!   the rest shape (the pair is pre-stressed: its terms do not vanish there, their sum's
-//!   gradient does).
+//!   gradient does); α_c is the family's, or the compliance of the own material of the body
+//!   the constraint belongs to.
 //!
 //! Two kinds of family have a store the account cannot measure: a rigid one (α = 0), which holds
 //! exactly what it holds, and one under PBD's stiffness k, which is no material constant (the
@@ -29,6 +30,7 @@
 //! does.
 
 use crate::constraints::{Family, PerFamily};
+use crate::scene::SceneBody;
 use crate::simulation::{Simulation, Taken};
 use glam::DVec3;
 use std::ops::Range;
@@ -80,8 +82,13 @@ impl Energy {
         let whole = 0..simulation.positions().len() as u32;
         let positions = simulation.positions();
         let squares = |family: Family| {
-            let now = squared_values(simulation, family, positions);
-            (now, simulation.body().sets[family].rest_squared())
+            let set = &simulation.body().sets[family];
+            let mut now = Squares::default();
+            for (c, (value, _)) in simulation.constraint_values(family, positions).enumerate() {
+                now.add(value, set.own_compliance(c));
+            }
+            let (plain, own) = set.rest_squared();
+            (now, Squares { plain, own })
         };
         Energy {
             taken: simulation.state().taken,
@@ -114,26 +121,24 @@ impl Energy {
     /// ```
     pub fn measure_bodies(simulation: &Simulation) -> Vec<(String, Energy)> {
         let bodies = simulation.bodies();
-        let starts: Vec<u32> = bodies.iter().map(|b| b.particles.start).collect();
         // Σ C² per body, now and at rest, of each family that stores energy.
-        let mut squares = PerFamily::<Vec<(f64, f64)>>::default();
+        let mut squares = PerFamily::<Vec<(Squares, Squares)>>::default();
         let resolved = simulation.resolved();
         for family in simulation.families().all() {
             if !simulation.active()[family] || !resolved.stores_energy(family) {
                 continue;
             }
             let sums = &mut squares[family];
-            sums.resize(bodies.len(), (0.0, 0.0));
+            sums.resize(bodies.len(), Default::default());
             let set = simulation.constraints(family);
             let now = simulation.constraint_values(family, simulation.positions());
             let rest = simulation.constraint_values(family, simulation.rest_positions());
             for (c, ((now, _), (rest, _))) in now.zip(rest).enumerate() {
-                let first = set.particles(c)[0];
-                let body = starts.partition_point(|&s| s <= first).saturating_sub(1);
-                let square = |v: f64| if v.is_finite() { v * v } else { 0.0 };
-                if let Some(sum) = sums.get_mut(body) {
-                    sum.0 += square(now);
-                    sum.1 += square(rest);
+                let body = SceneBody::owner(bodies, set.particles(c)[0]);
+                if let Some(sum) = body.and_then(|b| sums.get_mut(b)) {
+                    let own = set.own_compliance(c);
+                    sum.0.add(now, own);
+                    sum.1.add(rest, own);
                 }
             }
         }
@@ -147,12 +152,12 @@ impl Energy {
     }
 
     /// The energy of the particles `part` of `simulation` and of the constraints whose first
-    /// particle is among them, with `squares(family)` their Σ C² now and at rest, asked only of
-    /// an active family that stores energy ([`Energy::taken`] left zero).
+    /// particle is among them, with `squares(family)` their squared values now and at rest,
+    /// asked only of an active family that stores energy ([`Energy::taken`] left zero).
     fn measure_part(
         simulation: &Simulation,
         part: &Range<u32>,
-        squares: impl Fn(Family) -> (f64, f64),
+        squares: impl Fn(Family) -> (Squares, Squares),
     ) -> Energy {
         let body = simulation.body();
         let gravity = simulation.settings().gravity;
@@ -181,7 +186,8 @@ impl Energy {
                 return 0.0;
             }
             let (now, rest) = squares(family);
-            0.5 * (now - rest) / resolved.compliance[family]
+            let alpha = resolved.compliance[family];
+            0.5 * ((now.plain - rest.plain) / alpha + (now.own - rest.own))
         });
         let elastic_sum: f64 = simulation.families().all().map(|f| elastic[f]).sum();
         Energy {
@@ -229,11 +235,25 @@ impl Energy {
     }
 }
 
-/// Σ_c C_c(x)² over `family`'s constraints at positions `x` (a C that is not finite left out).
-fn squared_values(simulation: &Simulation, family: Family, x: &[DVec3]) -> f64 {
-    (simulation.constraint_values(family, x))
-        .map(|(c, _)| if c.is_finite() { c * c } else { 0.0 })
-        .sum()
+/// A family's squared values: Σ C² over the constraints that take the family's compliance α,
+/// and Σ C² / α_c over those with one of their own (a body's material,
+/// [`crate::simulation::ConstraintSet::own_compliance`]); a C that is not finite left out.
+#[derive(Clone, Copy, Debug, Default)]
+struct Squares {
+    plain: f64,
+    own: f64,
+}
+
+impl Squares {
+    /// Adds C of a constraint whose own compliance is `own`.
+    fn add(&mut self, value: f64, own: Option<f64>) {
+        if value.is_finite() {
+            match own {
+                Some(alpha) => self.own += value * value / alpha,
+                None => self.plain += value * value,
+            }
+        }
+    }
 }
 
 /// max_c and Σ_c of the relative violation of `family`'s constraints at positions `x`

@@ -140,16 +140,19 @@ impl Metrics {
         let positions = simulation.positions();
         let range = particles.start as usize..particles.end as usize;
         let tet_range = tets.start as usize..tets.end as usize;
-        let rest_volumes = &simulation.constraints(Family::VOLUME).rest()[tet_range.clone()];
-        let total_rest: f64 = rest_volumes.iter().sum();
+        let rest_volumes = || tet_range.clone().map(|t| simulation.rest_volume(t));
+        let total_rest: f64 = rest_volumes().sum();
         // The scale of "a sliver": the mean size of a rest volume (a degenerate tet may be a hair
         // negative, and a mesh of them could make a signed mean negative or zero).
         let mean_rest =
-            rest_volumes.iter().map(|v| v.abs()).sum::<f64>() / rest_volumes.len().max(1) as f64;
+            rest_volumes().map(|v| v.abs()).sum::<f64>() / tet_range.len().max(1) as f64;
         let mut inverted_tets = 0;
         let mut min_volume_ratio: Option<f64> = None;
         let mut total = 0.0;
-        for (tet, &rest) in simulation.tets()[tet_range].iter().zip(rest_volumes) {
+        for (tet, rest) in simulation.tets()[tet_range.clone()]
+            .iter()
+            .zip(rest_volumes())
+        {
             let v = signed_volume(&tet.map(|i| positions[i as usize]));
             total += v;
             if v < 0.0 {
@@ -161,10 +164,10 @@ impl Metrics {
             }
         }
         let mut max_edge_strain: f64 = 0.0;
-        let edges = simulation.constraints(Family::EDGES);
-        for (c, &rest) in edges.rest().iter().enumerate() {
-            if rest > 0.0 && particles.contains(&edges.particles(c)[0]) {
-                let [a, b] = [edges.particles(c)[0], edges.particles(c)[1]];
+        let rest_positions = simulation.rest_positions();
+        for &[a, b] in &simulation.body().edges {
+            let rest = rest_positions[a as usize].distance(rest_positions[b as usize]);
+            if rest > 0.0 && particles.contains(&a) {
                 let length = positions[a as usize].distance(positions[b as usize]);
                 max_edge_strain = larger(max_edge_strain, (length - rest).abs() / rest);
             }

@@ -20,6 +20,11 @@
 //! bend = [180, 0.02]          # optional: degrees in (0, 180], inner radius in m: folds the body,
 //!                             # laid along x, upwards about z over its middle (after the scale,
 //!                             # before the turn; a hairpin at 180°, [`super::Bend`])
+//! density = 1000              # optional: kg/m³, its masses (1000 otherwise)
+//! material = "E=1e5,nu=0.3"   # optional: its own material, for the families a material gives
+//!                             # (the neo-Hookean pair, a file's `stiffness`); the scene's otherwise
+//! constraints = "neohookean"  # optional: the built-in families laid on it, as --constraints
+//!                             # writes them (all otherwise); each runs where the scene switches it on
 //! [[body]]
 //! mesh = "cube"
 //! translate = [0, 1.5, 0]
@@ -29,6 +34,8 @@
 
 use super::mesh::TetMesh;
 use super::{Bend, Builtin, Scene, SceneError};
+use crate::constraints::material::Material;
+use crate::constraints::{Binding, Families, Family, PerFamily};
 use crate::input::limits;
 use crate::input::text_file;
 use glam::{DMat3, DVec3};
@@ -48,6 +55,75 @@ pub struct SceneBody {
     pub tets: Range<u32>,
     /// The velocity of each of its particles at the start, in m/s.
     pub velocity: DVec3,
+    /// Its density in kg/m³, which its masses are lumped from ([`crate::simulation::DENSITY`]
+    /// unless the file gives one).
+    pub density: f64,
+    /// Its own material, for the families whose compliance and rest values a material gives
+    /// ([`crate::constraints::Row::compliance_from_material`]); `None`: the settings'.
+    pub material: Option<Material>,
+    /// The built-in families whose constraints are laid on it; `None`: every family. A family
+    /// is projected on it where it is also switched on for the scene
+    /// ([`crate::simulation::Settings::active`]); a constraint file's family is laid on every
+    /// body.
+    pub constraints: Option<PerFamily<bool>>,
+}
+
+impl SceneBody {
+    /// The body among `bodies` (consecutive, in order, as a scene keeps them) that owns
+    /// particle `i`: the one a constraint whose first particle is `i` belongs to. `None` for a
+    /// particle beyond them (or no bodies at all).
+    ///
+    /// ```
+    /// use tetlab_core::scene::{SceneBody, Scene};
+    /// let text = "[[body]]\nmesh = \"tet\"\n[[body]]\nmesh = \"tet\"\ntranslate = [0, 2, 0]\n";
+    /// let scene = Scene::parse_file("two.toml".as_ref(), text).unwrap();
+    /// assert_eq!(SceneBody::owner(&scene.bodies, 3), Some(0));
+    /// assert_eq!(SceneBody::owner(&scene.bodies, 4), Some(1));
+    /// assert_eq!(SceneBody::owner(&scene.bodies, 8), None);
+    /// ```
+    pub fn owner(bodies: &[SceneBody], i: u32) -> Option<usize> {
+        let k = bodies
+            .partition_point(|b| b.particles.start <= i)
+            .checked_sub(1)?;
+        bodies[k].particles.contains(&i).then_some(k)
+    }
+
+    /// What the body is made of where the file says so, for a reader: `500 kg/m³, material
+    /// E=100000,nu=0.3, constraints neohookean`; `None` where it says nothing of it.
+    ///
+    /// ```
+    /// use tetlab_core::scene::Scene;
+    /// let text = "[[body]]\nmesh = \"tet\"\ndensity = 500\nconstraints = \"edges,volume\"\n\
+    ///             [[body]]\nmesh = \"tet\"\ntranslate = [2, 0, 0]\n";
+    /// let scene = Scene::parse_file("two.toml".as_ref(), text).unwrap();
+    /// let made_of = scene.bodies[0].made_of().unwrap();
+    /// assert_eq!(made_of, "500 kg/m³, constraints edges+volume");
+    /// assert_eq!(scene.bodies[1].made_of(), None);
+    /// ```
+    pub fn made_of(&self) -> Option<String> {
+        let mut parts = Vec::new();
+        if self.density != crate::simulation::DENSITY {
+            parts.push(format!("{} kg/m³", self.density));
+        }
+        if let Some(material) = &self.material {
+            parts.push(format!("material {}", material.describe()));
+        }
+        if let Some(listed) = &self.constraints {
+            parts.push(format!(
+                "constraints {}",
+                Families::builtin().describe(listed)
+            ));
+        }
+        (!parts.is_empty()).then(|| parts.join(", "))
+    }
+
+    /// Whether `family` of `families` is laid on this body ([`SceneBody::constraints`]).
+    pub fn takes(&self, families: &Families, family: Family) -> bool {
+        match &self.constraints {
+            Some(listed) => families.file(family).is_some() || listed[family],
+            None => true,
+        }
+    }
 }
 
 #[derive(serde::Deserialize)]
@@ -81,6 +157,12 @@ struct RawBody {
     bend: Option<Spanned<[f64; 2]>>,
     #[serde(default)]
     free: bool,
+    #[serde(default)]
+    density: Option<Spanned<f64>>,
+    #[serde(default)]
+    material: Option<Spanned<String>>,
+    #[serde(default)]
+    constraints: Option<Spanned<String>>,
 }
 
 /// A body's scale: one factor, or one per axis.
@@ -289,7 +371,10 @@ impl Scene {
             if body.free {
                 part.pinned.clear();
             }
+            let made_of = made_of(body).map_err(|(at, message)| error(Some(at), message))?;
             scene.add(name, part, placement, velocity);
+            let added = scene.bodies.last_mut().expect("the body just added");
+            (added.density, added.material, added.constraints) = made_of;
             if fixed {
                 let body = scene.bodies.last().expect("the body just added");
                 scene.pinned.extend(body.particles.clone());
@@ -327,6 +412,9 @@ impl Scene {
             particles: first..self.mesh.positions.len() as u32,
             tets: first_tet..self.mesh.tets.len() as u32,
             velocity,
+            density: crate::simulation::DENSITY,
+            material: None,
+            constraints: None,
         });
     }
 
@@ -422,6 +510,52 @@ fn placement(body: &RawBody) -> Result<Placement, (usize, String)> {
         rotation,
         translate,
     })
+}
+
+/// What a body is made of: its density, its own material and its families, each checked.
+type MadeOf = (f64, Option<Material>, Option<PerFamily<bool>>);
+
+fn made_of(body: &RawBody) -> Result<MadeOf, (usize, String)> {
+    let density = match &body.density {
+        Some(d) => {
+            limits::DENSITY
+                .check(*d.get_ref())
+                .map_err(|e| (d.span().start, format!("{e} (kg/m³)")))?;
+            *d.get_ref()
+        }
+        None => crate::simulation::DENSITY,
+    };
+    let material = match &body.material {
+        Some(m) => Some(
+            Material::parse(m.get_ref()).map_err(|e| (m.span().start, format!("material: {e}")))?,
+        ),
+        None => None,
+    };
+    let constraints = match &body.constraints {
+        Some(list) => {
+            let families = Families::builtin();
+            let at = list.span().start;
+            let listed = families
+                .parse_list(list.get_ref())
+                .map_err(|e| (at, format!("constraints: {e}")))?;
+            if let Some(f) = listed
+                .families()
+                .find(|&f| families.binding(f) == Binding::Contacts)
+            {
+                return Err((
+                    at,
+                    format!(
+                        "constraints: {} is found between bodies, not laid on one: switch it on \
+                         for the scene (--constraints, or the solver panel)",
+                        families.name(f)
+                    ),
+                ));
+            }
+            Some(listed)
+        }
+        None => None,
+    };
+    Ok((density, material, constraints))
 }
 
 /// A vector of the file, each component finite and within [`MAX_PLACEMENT`].

@@ -4,6 +4,7 @@
 
 use super::reference::project_unit;
 use super::{ConstraintSet, DENSITY, Simulation};
+use crate::constraints::material::Material;
 use crate::constraints::{Family, Projected, VisitProjected};
 use crate::simulation::projection::Rule;
 use glam::DVec3;
@@ -33,43 +34,75 @@ impl Simulation {
     }
 
     /// The constraints of `family` on tet `tet`, as indices in the family: its edges (six), its
-    /// four heights, or its volume ([`crate::constraints::Binding::of_tet`]).
+    /// four heights, or its volume ([`crate::constraints::Binding::of_tet`]); none where the
+    /// tet's body does not take the family ([`crate::scene::SceneBody::constraints`]).
     pub(crate) fn tet_constraints(
         &self,
         tet: usize,
         family: Family,
     ) -> impl Iterator<Item = usize> + '_ {
-        let edges = self.body.sets[Family::EDGES].all_particles();
-        self.families
-            .binding(family)
-            .of_tet(tet, self.body.tets[tet], edges)
+        let set = &self.body.sets[family];
+        let binding = self.families.binding(family);
+        // An edge family's constraints are found by their particles among its own; a tet's
+        // by their place in the binding.
+        let looked_up = binding == crate::constraints::Binding::Edges;
+        (binding.of_tet(tet, self.body.tets[tet], set.all_particles())).filter_map(move |k| {
+            if looked_up {
+                Some(k)
+            } else {
+                set.of_binding(k)
+            }
+        })
     }
 
     /// The shortest edge of the rest shape (0 without edges).
     pub fn shortest_edge(&self) -> f64 {
-        let lengths = self.body.sets[Family::EDGES].rest().iter().copied();
+        let rest = &self.body.rest_positions;
+        let length = |&[a, b]: &[u32; 2]| rest[a as usize].distance(rest[b as usize]);
+        let lengths = self.body.edges.iter().map(length);
         lengths.filter(|&l| l > 0.0).reduce(f64::min).unwrap_or(0.0)
     }
 
     /// Why the settings may blow up, when an active family takes its compliance from the
     /// material and the substeps are too long for it
     /// ([`crate::constraints::material::Material::substeps_needed`]): a warning
-    /// every front end shows.
+    /// every front end shows. In a scene of several bodies, each body's material and density
+    /// count ([`crate::scene::SceneBody::material`]), and the warning names the body that needs
+    /// the most.
     pub fn stability_warning(&self) -> Option<String> {
         let settings = &self.settings;
         let material_family = self.resolved.material_family()?;
         let shortest = self.shortest_edge();
-        let material = settings.material;
-        let needed = material.substeps_needed(settings.dt, shortest, DENSITY);
+        let whole = (None, settings.material, DENSITY);
+        let bodies = (self.body.bodies.iter())
+            .filter(|b| b.takes(&self.families, material_family))
+            .map(|b| {
+                (
+                    Some(b.name.as_str()),
+                    b.material.unwrap_or(settings.material),
+                    b.density,
+                )
+            });
+        let needs = |&(_, material, density): &(Option<&str>, Material, f64)| {
+            material.substeps_needed(settings.dt, shortest, density)
+        };
+        let worst = if self.body.bodies.is_empty() {
+            whole
+        } else {
+            bodies.max_by_key(needs)?
+        };
+        let needed = needs(&worst);
+        let (body, material, density) = worst;
         (needed > u64::from(settings.substeps)).then(|| {
             format!(
-                "{} with material {} needs at least {needed} substeps per frame of {:.4} s on this \
-                 mesh (pressure waves {:.3e} m/s, shortest edge {:.3e} m); with {} it may blow \
-                 up",
+                "{}{} with material {} needs at least {needed} substeps per frame of {:.4} s on \
+                 this mesh (pressure waves {:.3e} m/s, shortest edge {:.3e} m); with {} it may \
+                 blow up",
                 self.families.row(material_family).group,
+                body.map_or(String::new(), |name| format!(" on body \"{name}\"")),
                 material.describe(),
                 settings.dt,
-                material.wave_speed(DENSITY),
+                material.wave_speed(density),
                 shortest,
                 settings.substeps
             )

@@ -111,7 +111,8 @@ impl Simulation {
         let mesh = &scene.mesh;
         let resolved = Resolved::new(&settings, &families);
         let material = settings.material;
-        let sets = families.per_family(|f| ConstraintSet::new(&families, f, mesh, &material));
+        let made_of = (&material, scene.bodies.as_slice());
+        let sets = families.per_family(|f| ConstraintSet::new(&families, f, mesh, made_of));
         let edges = mesh.edges();
         let positions = &mesh.positions;
         let mean_edge = if edges.is_empty() {
@@ -123,10 +124,11 @@ impl Simulation {
         let body = Body {
             rest_positions: mesh.positions.clone(),
             tets: mesh.tets.clone(),
-            lumped_inverse_masses: masses::lumped_inverse_masses(mesh),
+            lumped_inverse_masses: masses::lumped_inverse_masses(mesh, &scene.bodies),
             forces: Vec::new(),
             plane_strain: false,
             mean_edge,
+            edges,
             sets,
             start_velocities: start_velocities(scene),
             bodies: scene.bodies.clone(),
@@ -220,8 +222,9 @@ impl Simulation {
             let body = self.body_mut();
             for family in families.all() {
                 if families.row(family).rest_uses_material {
-                    let rest = &body.rest_positions;
-                    body.sets[family].measure_rest(&families, family, rest, &material);
+                    let (rest, bodies) = (&body.rest_positions, &body.bodies);
+                    let made_of = (&material, bodies.as_slice());
+                    body.sets[family].measure_rest(&families, family, rest, made_of);
                 }
             }
         }
@@ -245,7 +248,8 @@ impl Simulation {
         };
         let (families, settings) = (self.families.clone(), self.settings);
         for family in stale.families() {
-            let set = ConstraintSet::new(&families, family, &mesh, &settings.material);
+            let made_of = (&settings.material, self.body.bodies.as_slice());
+            let set = ConstraintSet::new(&families, family, &mesh, made_of);
             let len = set.len();
             self.body_mut().sets[family] = set;
             self.state_mut().lambdas[family] = vec![0.0; len];
@@ -347,6 +351,13 @@ impl Simulation {
     /// The tets, as indices into the positions.
     pub fn tets(&self) -> &[[u32; 4]] {
         &self.body.tets
+    }
+
+    /// The signed volume of tet `t` at rest, m³ (whether or not a volume constraint is laid on
+    /// it).
+    pub fn rest_volume(&self, t: usize) -> f64 {
+        let rest = &self.body.rest_positions;
+        crate::constraints::volume::signed_volume(&self.body.tets[t].map(|i| rest[i as usize]))
     }
 
     /// The external forces on the particles in N, besides gravity: empty when there are none.

@@ -196,7 +196,45 @@ impl<R: Real> Default for Rule<R> {
     }
 }
 
+impl<R: Real> Rule<R> {
+    /// The rule for a constraint of its own compliance: α̃ = `own` (its α / h²) in each lane
+    /// where `own` is a number, the family's where it is NaN. PBD's stiffness k is the
+    /// family's for every constraint (own compliances come from a body's material, and a family
+    /// a material gives is never projected by k).
+    ///
+    /// ```
+    /// use tetlab_core::simulation::projection::Rule;
+    /// let family = Rule::Xpbd { alpha_tilde: 2.0 };
+    /// assert!(matches!(family.with_own(5.0), Rule::Xpbd { alpha_tilde } if alpha_tilde == 5.0));
+    /// assert!(matches!(family.with_own(f64::NAN), Rule::Xpbd { alpha_tilde } if alpha_tilde == 2.0));
+    /// ```
+    #[inline(always)]
+    pub fn with_own(self, own: R) -> Rule<R> {
+        let pick = |alpha_tilde: R| R::select(own.finite(), own, alpha_tilde);
+        match self {
+            Rule::Xpbd { alpha_tilde } => Rule::Xpbd {
+                alpha_tilde: pick(alpha_tilde),
+            },
+            Rule::CompliantPbd { alpha_tilde } => Rule::CompliantPbd {
+                alpha_tilde: pick(alpha_tilde),
+            },
+            Rule::Pbd { k } => Rule::Pbd { k },
+        }
+    }
+}
+
 impl Rule<f64> {
+    /// The rule of constraint `c` of `set`, whose family's rule is this one, in a substep of
+    /// length `h`: α̃ = α_c / h² where the constraint has a compliance of its own
+    /// ([`crate::simulation::ConstraintSet::own_compliance`]).
+    #[inline]
+    pub fn of_constraint(self, set: &crate::simulation::ConstraintSet, c: usize, h: f64) -> Self {
+        match set.own_compliance(c) {
+            Some(alpha) => self.with_own(alpha / (h * h)),
+            None => self,
+        }
+    }
+
     /// The same rule in another precision.
     pub fn to<R: Real>(self) -> Rule<R> {
         match self {

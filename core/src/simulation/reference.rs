@@ -292,6 +292,7 @@ pub(super) fn project_unit<const N: usize, const K: usize, P: Projected<N, K>>(
     let weights = particles.map(|i| inverse_masses[i as usize]);
     let lambda = families.map(|f| lambdas[f][c]);
     let size = (reach, lead.size()[c]);
+    let rules = std::array::from_fn(|k| rules[k].of_constraint(&sets[families[k]], c, h));
     let correction = correct_in_reach(evaluations, weights, lambda, rules, size, || p);
     UnitProjection {
         particles,

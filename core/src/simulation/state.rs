@@ -44,6 +44,10 @@ pub struct Body {
     pub plane_strain: bool,
     /// The mean rest edge length, the scale of "settled".
     pub mean_edge: f64,
+    /// The mesh's edges, sorted pairs in order, whichever families are laid on them (the edge
+    /// family's constraints are those of the bodies that take it,
+    /// [`crate::scene::SceneBody::constraints`]).
+    pub edges: Vec<[u32; 2]>,
     /// The constraints of each family, as its binding makes them (those of a family the
     /// simulation has not used are not built).
     pub sets: PerFamily<ConstraintSet>,

@@ -31,6 +31,16 @@ impl Panel for SolverPanel {
         if let Some(settings) = edit(ui, context.bench.simulation.families(), current) {
             requests.push(Request::Settings(Box::new(settings)));
         }
+        // What a scene file gave a body of its own, which the settings above do not change.
+        for body in context.bench.simulation.bodies() {
+            if let Some(made_of) = body.made_of() {
+                ui.label(format!("body {}: {made_of}", body.name))
+                    .on_hover_text(
+                        "Its own, from the scene file: the material above is the other bodies'; a \
+                     family runs on it where it is listed there and switched on here",
+                    );
+            }
+        }
     }
 }
 

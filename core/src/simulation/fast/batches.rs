@@ -133,6 +133,12 @@ pub struct Batches {
     /// per batch.
     stored: Vec<F32x8>,
     stored_len: usize,
+    /// Each lane's compliance α from its body's own material (NaN: the family's), a row per
+    /// batch; empty where no element has one ([`crate::simulation::ConstraintSet::own_compliance`]).
+    own: Vec<[f64; LANES]>,
+    /// `own` as α / h² in f32, for the substep length `own_h`: what the kernels read.
+    own_tilde: Vec<F32x8>,
+    own_h: f64,
 }
 
 /// The rest values of a family's batches, a row each, and what their elements store,
@@ -142,6 +148,8 @@ pub(crate) struct RestRows<'a> {
     values: &'a [F32x8],
     stored: &'a [F32x8],
     len: usize,
+    /// Each batch's own α̃ per lane (NaN: the family's); empty where none has one.
+    own: &'a [F32x8],
 }
 
 impl<'a> RestRows<'a> {
@@ -152,7 +160,21 @@ impl<'a> RestRows<'a> {
             values: &self.values[range.clone()],
             stored: &self.stored[range.start * self.len..range.end * self.len],
             len: self.len,
+            own: self.own.get(range).unwrap_or_default(),
         }
+    }
+
+    /// Whether some element has a compliance of its own.
+    #[inline(always)]
+    pub(crate) fn has_own(self) -> bool {
+        !self.own.is_empty()
+    }
+
+    /// Batch `b`'s own α̃ per lane, NaN where a lane takes the family's; `None` where no
+    /// element of the family has one.
+    #[inline(always)]
+    pub(crate) fn own(self, b: usize) -> Option<F32x8> {
+        self.own.get(b).copied()
     }
 
     /// Batch `b`'s rest values and what its elements store.
@@ -515,13 +537,14 @@ impl Layout {
 }
 
 impl Batches {
-    /// A family's batches on `layout`: the constraint of element e has rest value `rest(e)`
-    /// and stores `stored(e)` (`stored_len` numbers).
+    /// A family's batches on `layout`: the constraint of element e has rest value `rest(e)`,
+    /// stores `stored(e)` (`stored_len` numbers) and has the compliance `own[e]` of its own
+    /// (NaN: the family's; `own` empty: none has one).
     pub(crate) fn new(
         layout: &Layout,
         rest: impl Fn(u32) -> f32,
-        stored_len: usize,
-        stored: impl Fn(u32) -> Vec<f32>,
+        (stored_len, stored): (usize, impl Fn(u32) -> Vec<f32>),
+        own: &[f64],
     ) -> Self {
         let mut rows = Vec::with_capacity(layout.elements.len() * stored_len);
         if stored_len > 0 {
@@ -542,6 +565,35 @@ impl Batches {
             lambda: vec![F32x8::ZERO; layout.batch_count()],
             stored: rows,
             stored_len,
+            own: if own.is_empty() {
+                Vec::new()
+            } else {
+                (layout.elements.iter())
+                    .map(|lanes| lanes.map(|e| own[e as usize]))
+                    .collect()
+            },
+            own_tilde: vec![
+                F32x8::from_f64(f64::NAN);
+                if own.is_empty() {
+                    0
+                } else {
+                    layout.batch_count()
+                }
+            ],
+            own_h: f64::NAN,
+        }
+    }
+
+    /// Works out the own α̃ = α / h² for substeps of length `h`, when `h` changed (nothing to
+    /// do where no element has an own compliance): rounded to f32 from the f64 quotient, as the
+    /// family's α̃ is ([`crate::simulation::projection::Rule::to`]).
+    pub(crate) fn set_substep(&mut self, h: f64) {
+        if self.own.is_empty() || self.own_h == h {
+            return;
+        }
+        self.own_h = h;
+        for (tilde, alpha) in self.own_tilde.iter_mut().zip(&self.own) {
+            *tilde = F32x8::new(alpha.map(|a| (a / (h * h)) as f32));
         }
     }
 
@@ -558,6 +610,7 @@ impl Batches {
                 values: &self.rest,
                 stored: &self.stored,
                 len: self.stored_len,
+                own: &self.own_tilde,
             },
             &mut self.lambda,
         )
@@ -581,8 +634,12 @@ impl Batches {
 
     /// The bytes its arrays take (their capacities).
     pub(crate) fn heap_bytes(&self) -> usize {
-        (self.rest.capacity() + self.lambda.capacity() + self.stored.capacity())
+        (self.rest.capacity()
+            + self.lambda.capacity()
+            + self.stored.capacity()
+            + self.own_tilde.capacity())
             * size_of::<F32x8>()
+            + self.own.capacity() * size_of::<[f64; LANES]>()
     }
 }
 

@@ -68,7 +68,7 @@ struct Access<'a> {
 /// the sums. Returns the projections of each value skipped for a counted reason.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn project_batches<const N: usize, const K: usize, P: Projected<N, K>>(
+fn project_batches<const N: usize, const K: usize, const OWN: bool, P: Projected<N, K>>(
     constraint: &P,
     particles: &[[[u32; LANES]; N]],
     weights: &[[F32x8; N]],
@@ -88,6 +88,16 @@ fn project_batches<const N: usize, const K: usize, P: Projected<N, K>>(
         ($b:expr, $evaluations:expr) => {{
             let b = $b;
             let lambdas = std::array::from_fn(|k| lambda[k][b]);
+            // A family's own compliances, where some body has them (`OWN`, a separate
+            // instantiation, so that the loop without them is as it was).
+            let rules: [Rule<F32x8>; K] = if OWN {
+                std::array::from_fn(|k| match rest[k].own(b) {
+                    Some(own) => rules[k].with_own(own),
+                    None => rules[k],
+                })
+            } else {
+                rules
+            };
             let d = correct_in_reach(
                 $evaluations,
                 weights[b],
@@ -225,16 +235,20 @@ pub(crate) fn project<const N: usize, const K: usize, P: Projected<N, K>>(
         sums: sums.map(|sums| Particles::new(sums, particle_count)),
     };
     let skips = sweep(layout, order, team, lambdas, |range, lambdas| {
-        project_batches::<N, K, P>(
-            constraint,
-            &particles[range.clone()],
-            &weights[range.clone()],
-            (&size[range.clone()], reach),
-            rest.map(|rest| rest.batches(range.clone())),
-            lambdas,
-            access,
-            rules,
-        )
+        let rest = rest.map(|rest| rest.batches(range.clone()));
+        let batches = (&particles[range.clone()], &weights[range.clone()]);
+        let size = (&size[range.clone()], reach);
+        if rest.iter().any(|rest| rest.has_own()) {
+            let (particles, weights) = batches;
+            project_batches::<N, K, true, P>(
+                constraint, particles, weights, size, rest, lambdas, access, rules,
+            )
+        } else {
+            let (particles, weights) = batches;
+            project_batches::<N, K, false, P>(
+                constraint, particles, weights, size, rest, lambdas, access, rules,
+            )
+        }
     });
     (colours.iter().map(|c| c.elements).sum(), skips)
 }

@@ -9,8 +9,10 @@ use crate::simulation::state::Body;
 use glam::Vec3A;
 
 /// The layouts of the elements families bind to; every family of a binding shares that
-/// binding's (each is empty when no active family uses it), except that a family on single
-/// particles has its own: each file's `where` chooses its particles.
+/// binding's (each is empty when no active family uses it), except a family whose elements are
+/// not the binding's whole list: one on single particles (each file's `where` chooses its
+/// particles), or one that some bodies of the scene do not take
+/// ([`crate::scene::SceneBody::constraints`]); each such has its own.
 #[derive(Default)]
 pub(super) struct Layouts {
     edges: Layout,
@@ -18,8 +20,8 @@ pub(super) struct Layouts {
     tet_vertices: Layout,
     triangles: Layout,
     hinges: Layout,
-    /// Of each active family on single particles.
-    particles: Vec<(Family, Layout)>,
+    /// Of each active family that has its own elements.
+    own: Vec<(Family, Layout)>,
     /// Of contacts: empty, since contacts are found every frame and projected apart from the
     /// sweep's layouts (`crate::simulation::contact`).
     contacts: Layout,
@@ -28,75 +30,46 @@ pub(super) struct Layouts {
 impl Layouts {
     /// The layouts the `active` families of `families` bind to on `body`, its particles
     /// renumbered by `renumber`, weighted by `inverse_masses` and sized by `rest_positions` (both
-    /// in the new numbering).
+    /// in the new numbering). Each is built from the constraints of a family as its set holds
+    /// them (whose rest values they are, in the binding's order), so that element e is
+    /// constraint e of every family that uses the layout.
     pub(super) fn new(
         families: &Families,
         active: &PerFamily<bool>,
         body: &Body,
         renumber: &[u32],
-        (inverse_masses, rest_positions): (&[f32], &[Vec3A]),
+        masses: (&[f32], &[Vec3A]),
     ) -> Layouts {
-        let uses = |binding: Binding| active.families().any(|f| families.binding(f) == binding);
-        let renumbered = |constraints: &[[u32; 4]]| -> Vec<[u32; 4]> {
-            constraints
-                .iter()
-                .map(|c| c.map(|i| renumber[i as usize]))
-                .collect()
-        };
         let mut layouts = Layouts::default();
-        if uses(Binding::Edges) {
-            // In the order of the edge binding ([`Binding::particles`]), whose rest values they
-            // are: the built-in edge family's, always built.
-            let (pairs, _) = body.sets[Family::EDGES].all_particles().as_chunks::<2>();
-            let edges: Vec<[u32; 2]> = pairs
-                .iter()
-                .map(|edge| edge.map(|i| renumber[i as usize]))
-                .collect();
-            layouts.edges = Layout::new(&edges, inverse_masses, rest_positions);
-        }
-        if uses(Binding::Contacts) {
-            layouts.contacts = Layout::new::<4>(&[], inverse_masses, rest_positions);
-        }
-        if uses(Binding::Tets) {
-            let tets = renumbered(&body.tets);
-            layouts.tets = Layout::new(&tets, inverse_masses, rest_positions);
-        }
-        if uses(Binding::TetVertices) {
-            // Each (tet, vertex) constraint is an element of its own, its particles in the
-            // constraint's order ([`Binding::particles`]), coloured apart from its tet's others.
-            let mesh = crate::scene::mesh::TetMesh {
-                positions: Vec::new(),
-                tets: body.tets.clone(),
+        // The binding's whole list: of a family laid on every body (a file's is).
+        let whole = |f: Family| body.sets[f].is_whole();
+        for binding in [
+            Binding::Edges,
+            Binding::Tets,
+            Binding::TetVertices,
+            Binding::Triangles,
+            Binding::Hinges,
+        ] {
+            let users = || {
+                active
+                    .families()
+                    .filter(move |&f| families.binding(f) == binding)
             };
-            let flat = Binding::TetVertices.particles(&mesh);
-            let (constraints, _) = flat.as_chunks::<4>();
-            let constraints = renumbered(constraints);
-            // Role by role: every tet's first height, then every tet's second, …, so that a
-            // tet's four heights take colours far apart (see `batches`).
-            let n = constraints.len();
-            let visit: Vec<usize> = (0..4).flat_map(|k| (k..n).step_by(4)).collect();
-            layouts.tet_vertices =
-                Layout::new_visiting(&constraints, visit, inverse_masses, rest_positions);
+            let Some(first) = users().find(|&f| whole(f)).or_else(|| users().next()) else {
+                continue;
+            };
+            let shared = body.sets[first].all_particles();
+            *layouts.shared_mut(binding) = layout(binding, shared, renumber, masses);
+            for family in users().filter(|&f| body.sets[f].all_particles() != shared) {
+                let flat = body.sets[family].all_particles();
+                (layouts.own).push((family, layout(binding, flat, renumber, masses)));
+            }
         }
-        // The surface's triangles and hinges, in the order of their binding, as the sets of the
-        // active families that bind to them hold them (whose rest values they are).
-        let of_binding = |binding: Binding| {
-            active
-                .families()
-                .find(|&f| families.binding(f) == binding)
-                .map(|f| body.sets[f].all_particles())
-        };
-        if let Some(flat) = of_binding(Binding::Triangles) {
-            let (triangles, _) = flat.as_chunks::<3>();
-            let triangles: Vec<[u32; 3]> = triangles
-                .iter()
-                .map(|t| t.map(|i| renumber[i as usize]))
-                .collect();
-            layouts.triangles = Layout::new(&triangles, inverse_masses, rest_positions);
-        }
-        if let Some(flat) = of_binding(Binding::Hinges) {
-            let (hinges, _) = flat.as_chunks::<4>();
-            layouts.hinges = Layout::new(&renumbered(hinges), inverse_masses, rest_positions);
+        if active
+            .families()
+            .any(|f| families.binding(f) == Binding::Contacts)
+        {
+            layouts.contacts = Layout::new::<4>(&[], masses.0, masses.1);
         }
         // Each family on single particles: one colour, since no two of its constraints share
         // a particle.
@@ -104,15 +77,23 @@ impl Layouts {
             .families()
             .filter(|&f| families.binding(f) == Binding::Particles)
         {
-            let (chosen, _) = body.sets[family].all_particles().as_chunks::<1>();
-            let chosen: Vec<[u32; 1]> = chosen
-                .iter()
-                .map(|p| p.map(|i| renumber[i as usize]))
-                .collect();
-            let layout = Layout::new(&chosen, inverse_masses, rest_positions);
-            layouts.particles.push((family, layout));
+            let flat = body.sets[family].all_particles();
+            let own = layout(Binding::Particles, flat, renumber, masses);
+            layouts.own.push((family, own));
         }
         layouts
+    }
+
+    /// The layout every family of `binding` shares, unless it has its own.
+    fn shared_mut(&mut self, binding: Binding) -> &mut Layout {
+        match binding {
+            Binding::Edges => &mut self.edges,
+            Binding::Tets => &mut self.tets,
+            Binding::TetVertices => &mut self.tet_vertices,
+            Binding::Triangles => &mut self.triangles,
+            Binding::Hinges => &mut self.hinges,
+            Binding::Contacts | Binding::Particles => &mut self.contacts,
+        }
     }
 
     /// The layout `family` (of `families`) uses.
@@ -120,6 +101,9 @@ impl Layouts {
     /// # Panics
     /// For a family on single particles that was not active when the layouts were built.
     pub(super) fn of(&self, families: &Families, family: Family) -> &Layout {
+        if let Some((_, own)) = self.own.iter().find(|(f, _)| *f == family) {
+            return own;
+        }
         match families.binding(family) {
             Binding::Edges => &self.edges,
             Binding::Tets => &self.tets,
@@ -127,10 +111,7 @@ impl Layouts {
             Binding::Triangles => &self.triangles,
             Binding::Hinges => &self.hinges,
             Binding::Contacts => &self.contacts,
-            Binding::Particles => {
-                let own = self.particles.iter().find(|(f, _)| *f == family);
-                &own.expect("an active family's layout").1
-            }
+            Binding::Particles => panic!("an active family's layout"),
         }
     }
 
@@ -144,7 +125,7 @@ impl Layouts {
             &mut self.hinges,
         ]
         .into_iter()
-        .chain(self.particles.iter_mut().map(|(_, layout)| layout))
+        .chain(self.own.iter_mut().map(|(_, layout)| layout))
     }
 
     /// Every one.
@@ -157,7 +138,7 @@ impl Layouts {
             &self.hinges,
         ]
         .into_iter()
-        .chain(self.particles.iter().map(|(_, layout)| layout))
+        .chain(self.own.iter().map(|(_, layout)| layout))
     }
 
     /// The order of each active family's colours that the settings ask for
@@ -176,5 +157,49 @@ impl Layouts {
                 .projection_order(family, colours)
                 .unwrap_or_default()
         })
+    }
+}
+
+/// The layout of the elements `flat` (in the simulation's numbering, the binding's arity each)
+/// of `binding`, renumbered by `renumber`, weighted and sized by `masses`.
+fn layout(binding: Binding, flat: &[u32], renumber: &[u32], masses: (&[f32], &[Vec3A])) -> Layout {
+    fn renumbered<const N: usize>(flat: &[u32], renumber: &[u32]) -> Vec<[u32; N]> {
+        let (elements, _) = flat.as_chunks::<N>();
+        (elements.iter())
+            .map(|e| e.map(|i| renumber[i as usize]))
+            .collect()
+    }
+    let (inverse_masses, rest_positions) = masses;
+    match binding {
+        Binding::Particles => Layout::new(
+            &renumbered::<1>(flat, renumber),
+            inverse_masses,
+            rest_positions,
+        ),
+        Binding::Edges => Layout::new(
+            &renumbered::<2>(flat, renumber),
+            inverse_masses,
+            rest_positions,
+        ),
+        Binding::Triangles => Layout::new(
+            &renumbered::<3>(flat, renumber),
+            inverse_masses,
+            rest_positions,
+        ),
+        Binding::TetVertices => {
+            // Each (tet, vertex) constraint is an element of its own, its particles in the
+            // constraint's order ([`Binding::particles`]), coloured apart from its tet's others:
+            // role by role, every tet's first height, then every tet's second, …, so that a
+            // tet's four heights take colours far apart (see `batches`).
+            let constraints = renumbered::<4>(flat, renumber);
+            let n = constraints.len();
+            let visit: Vec<usize> = (0..4).flat_map(|k| (k..n).step_by(4)).collect();
+            Layout::new_visiting(&constraints, visit, inverse_masses, rest_positions)
+        }
+        Binding::Tets | Binding::Hinges | Binding::Contacts => Layout::new(
+            &renumbered::<4>(flat, renumber),
+            inverse_masses,
+            rest_positions,
+        ),
     }
 }

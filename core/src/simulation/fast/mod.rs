@@ -212,16 +212,15 @@ impl FastSimulation {
             }
             let set = &body.sets[family];
             let rest = set.rest();
+            let stored = |element: u32| {
+                let stored = set.stored(element as usize).iter();
+                stored.map(|&x| x as f32).collect()
+            };
             Batches::new(
                 layouts.of(families, family),
                 |element| rest[element as usize] as f32,
-                set.stored_len(),
-                |element| {
-                    set.stored(element as usize)
-                        .iter()
-                        .map(|&x| x as f32)
-                        .collect()
-                },
+                (set.stored_len(), stored),
+                set.own_compliances(),
             )
         });
         debug_assert!(layouts.all().all(|l| l.colouring_is_valid(n)));

@@ -258,11 +258,17 @@ impl VisitProjected for ProjectUnit<'_> {
         constraint: &P,
     ) -> usize {
         let rules = families.map(|f| self.rules[f]);
+        let mut batches = self.sets.get_disjoint_mut(families);
+        for set in batches.iter_mut() {
+            // An own compliance's α̃ follows h (nothing to do where none has one, or h is as
+            // it was).
+            set.set_substep(self.previous.1);
+        }
         let (count, skipped) = kernel::project::<N, K, P>(
             constraint,
             self.layout,
             self.order,
-            self.sets.get_disjoint_mut(families),
+            batches,
             self.positions,
             (self.rest_positions, self.previous),
             self.sums,

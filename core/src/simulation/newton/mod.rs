@@ -25,7 +25,7 @@ use super::engine::{Engine, Frame, Start};
 use super::reference::OnState;
 use super::state::Body;
 use super::substep::{self, Plan, Substeps};
-use crate::constraints::{Families, PerFamily, Unit};
+use crate::constraints::{Families, Family, PerFamily, Unit};
 use crate::simulation::Resolved;
 use crate::simulation::projection::SkipCounts;
 use glam::DVec3;
@@ -286,10 +286,15 @@ pub fn equilibrium(start: Start<'_>, options: &Options) -> Result<(Vec<DVec3>, R
         dofs: &dofs,
         start: None,
     };
+    let own_stiffest = |f: Family| {
+        let own = body.sets[f].own_compliances().iter();
+        own.filter(|a| !a.is_nan())
+            .fold(0.0f64, |k, a| k.max(1.0 / a))
+    };
     let stiffness = families
         .all()
         .filter_map(|f| match terms[f] {
-            Term::Compliant(k) => Some(k),
+            Term::Compliant(k) => Some(k.max(own_stiffest(f))),
             _ => None,
         })
         .fold(1.0f64, f64::max);

@@ -212,10 +212,13 @@ impl Objective<'_> {
     }
 
     /// The stiffness a constraint enters with and what is added to its C: (1/α, 0) for a
-    /// compliant one, (ρ, λ/ρ) for a rigid one.
+    /// compliant one (α its own where its body's material gives one), (ρ, λ/ρ) for a rigid one.
     fn scale(&self, family: Family, c: usize, multipliers: &Multipliers) -> (f64, f64) {
         match self.terms[family] {
-            Term::Compliant(k) => (k, 0.0),
+            Term::Compliant(k) => {
+                let own = self.body.sets[family].own_compliance(c);
+                (own.map_or(k, |alpha| 1.0 / alpha), 0.0)
+            }
             Term::Rigid => (
                 multipliers.rho,
                 multipliers.rigid[family][c] / multipliers.rho,
