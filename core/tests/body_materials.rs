@@ -280,3 +280,23 @@ fn the_stability_warning_weighs_each_bodys_own_material() {
     );
     assert_eq!(simulation.stability_warning(), None);
 }
+
+#[test]
+fn a_tets_energy_is_its_bodys() {
+    // The energy of one tet (the modes panel's, `tetlab modes`): with its body's material.
+    use tetlab_core::energy::element::ElementEnergy;
+    let two = scene(SIDE_BY_SIDE);
+    let mut both = Simulation::new(&two, settings(EngineChoice::Reference, Material::default()));
+    let mut alone = Simulation::new(&scene(ALONE), settings(EngineChoice::Reference, soft()));
+    run(&mut both, 10);
+    run(&mut alone, 10);
+    let first = two.bodies[1].tets.start as usize;
+    for t in 0..two.bodies[1].tets.len() {
+        let (mine, x) = ElementEnergy::of_tet(&both, first + t).unwrap();
+        let (its, y) = ElementEnergy::of_tet(&alone, t).unwrap();
+        assert_eq!(x, y, "tet {t}: the same corners, bit for bit");
+        let at = |x: [DVec3; 4]| x.map(|p| p.to_array());
+        assert_eq!(mine.energy(&at(x)), its.energy(&at(y)), "tet {t}");
+        assert_eq!(mine.corner_mass(), its.corner_mass(), "tet {t}");
+    }
+}

@@ -9,6 +9,7 @@
 use crate::constraints::differentiable::value_and_gradient;
 use crate::constraints::{Binding, Families, Family, PerFamily, Stored};
 use crate::numbers::vector::Real;
+use crate::scene::SceneBody;
 use crate::scene::mesh::TetMesh;
 use crate::simulation::{DENSITY, Settings, Simulation};
 use glam::DVec3;
@@ -58,6 +59,9 @@ pub struct ElementEnergy {
     terms: Vec<Term>,
     /// Per family whose constraints are on the tet, in table order: its compliance.
     pub compliances: Vec<(Family, Compliance)>,
+    /// The density its corner masses are lumped with, kg/m³ ([`DENSITY`] unless the tet's body
+    /// has its own, [`ElementEnergy::of_tet`]).
+    density: f64,
 }
 
 impl ElementEnergy {
@@ -126,12 +130,31 @@ impl ElementEnergy {
             rest_shape,
             terms,
             compliances,
+            density: DENSITY,
         })
     }
 
     /// The energy of `simulation`'s active families on its tet `tet`, at rest at the tet's rest
-    /// corners, with the simulation's compliances and material; and the tet's corners now. An
-    /// error when no family is active or there is no such tet.
+    /// corners, with the simulation's compliances and material; and the tet's corners now. In a
+    /// scene of several bodies, the families laid on the tet's body, with its own material and
+    /// density where it has them ([`crate::scene::SceneBody`]), as the simulation projects
+    /// them. An error when no family is active or there is no such tet.
+    ///
+    /// ```
+    /// use tetlab_core::energy::element::ElementEnergy;
+    /// use tetlab_core::scene::Scene;
+    /// use tetlab_core::simulation::{Settings, Simulation};
+    /// let text = "[[body]]\nmesh = \"tet\"\n[[body]]\nmesh = \"tet\"\ntranslate = [2, 0, 0]\n\
+    ///             density = 250\nconstraints = \"volume\"\n";
+    /// let scene = Scene::parse_file("two.toml".as_ref(), text).unwrap();
+    /// let simulation = Simulation::new(&scene, Settings::default()); // edges and volume
+    /// let (first, _) = ElementEnergy::of_tet(&simulation, 0).unwrap();
+    /// let (second, _) = ElementEnergy::of_tet(&simulation, 1).unwrap();
+    /// assert_eq!(first.compliances.len(), 2, "edges and volume");
+    /// assert_eq!(second.compliances.len(), 1, "its volume alone");
+    /// let (m1, m2) = (first.corner_mass(), second.corner_mass());
+    /// assert!((4.0 * m2 - m1).abs() < 1e-12 * m1, "a quarter of the density: {m1} {m2}");
+    /// ```
     pub fn of_tet(
         simulation: &Simulation,
         tet: usize,
@@ -141,13 +164,18 @@ impl ElementEnergy {
             .get(tet)
             .ok_or_else(|| format!("there is no tet {tet} ({} tets)", simulation.tets().len()))?;
         let at = |positions: &[DVec3]| corners.map(|i| positions[i as usize]);
-        let settings = simulation.settings();
-        let energy = ElementEnergy::new(
-            simulation.families(),
-            &settings.active,
-            settings,
-            at(simulation.rest_positions()),
-        )?;
+        let families = simulation.families();
+        let bodies = simulation.bodies();
+        let body = SceneBody::owner(bodies, corners[0]).map(|b| &bodies[b]);
+        let mut settings = *simulation.settings();
+        if let Some(material) = body.and_then(|b| b.material) {
+            settings.material = material;
+        }
+        let active = families
+            .per_family(|f| settings.active[f] && body.is_none_or(|b| b.takes(families, f)));
+        let rest = at(simulation.rest_positions());
+        let mut energy = ElementEnergy::new(families, &active, &settings, rest)?;
+        energy.density = body.map_or(DENSITY, |b| b.density);
         Ok((energy, at(simulation.positions())))
     }
 
@@ -166,10 +194,10 @@ impl ElementEnergy {
         self.rest_shape
     }
 
-    /// The mass of each corner: density × |V₀| / 4, the tet's own share of the lumped masses
-    /// the simulation uses ([`crate::simulation::DENSITY`]).
+    /// The mass of each corner: ρ × |V₀| / 4, the tet's own share of the lumped masses the
+    /// simulation uses ([`crate::simulation::DENSITY`], or its body's density).
     pub fn corner_mass(&self) -> f64 {
-        DENSITY * crate::constraints::volume::signed_volume(&self.rest_shape).abs() / 4.0
+        self.density * crate::constraints::volume::signed_volume(&self.rest_shape).abs() / 4.0
     }
 
     /// C and ∇C of term `t` at the corners `x`, in any number type `T` that compares to a bool:

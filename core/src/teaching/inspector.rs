@@ -139,20 +139,9 @@ mod tests {
     /// say whether the particle is over its triangle.
     #[test]
     fn a_contact_pair_is_inspected_like_a_constraint() {
-        let text = "[[body]]\nmesh = \"cube\"\nresolution = 2\n\
-                    [[body]]\nmesh = \"cube\"\nresolution = 2\ntranslate = [0.3, 1.003, 0.2]\n";
-        let scene = Scene::parse_file(std::path::Path::new("t.toml"), text).unwrap();
-        let mut simulation = Simulation::new(&scene, Settings::default());
-        let families = simulation.families().clone();
-        let active = families.parse_list("edges,volume,contact").unwrap();
-        let contact = families.parse("contact").unwrap();
-        simulation.set_settings(Settings {
-            active,
-            ..Settings::default()
-        });
-        for _ in 0..5 {
-            simulation.step();
-        }
+        let at = [0.3, 1.003, 0.2];
+        let simulation = crate::simulation::contact::cube_on_cube(2, at, Settings::default(), 5);
+        let contact = simulation.families().parse("contact").unwrap();
         let pairs = simulation.contact_pairs().len();
         assert!(pairs > 0);
         let mut over = 0;

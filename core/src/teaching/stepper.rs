@@ -227,21 +227,13 @@ mod tests {
     /// applies, and the whole substep gives the same bits as [`Simulation::substep`].
     #[test]
     fn contact_pairs_are_stepped_one_at_a_time() {
-        let text = "[[body]]\nmesh = \"cube\"\nresolution = 1\n\
-                    [[body]]\nmesh = \"cube\"\nresolution = 1\ntranslate = [0.3, 1.002, 0]\n";
-        let scene = crate::scene::Scene::parse_file(std::path::Path::new("t.toml"), text).unwrap();
-        let mut simulation = Simulation::new(&scene, Settings::default());
-        let families = simulation.families().clone();
-        let active = families.parse_list("edges,volume,contact").unwrap();
-        let contact = families.parse("contact").unwrap();
-        simulation.set_settings(Settings {
-            active,
+        let settings = Settings {
             substeps: 4,
             ..Settings::default()
-        });
-        for _ in 0..3 {
-            simulation.step();
-        }
+        };
+        let at = [0.3, 1.002, 0.0];
+        let mut simulation = crate::simulation::contact::cube_on_cube(1, at, settings, 3);
+        let contact = simulation.families().parse("contact").unwrap();
         let mut whole = simulation.clone();
         whole.substep();
         let mut stepper = StepByStep::default();

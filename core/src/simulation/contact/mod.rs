@@ -146,3 +146,28 @@ pub fn keep_room<T>(array: &mut Vec<T>, len: usize) {
         array.reserve_exact(room - array.len());
     }
 }
+
+/// The unit tests' scene of contact: a cube of `resolution` cells on the ground and another
+/// placed `at` (x, y, z) from where the mesh puts it, on `settings` with edges, volume and
+/// contact switched on, run for `frames` frames.
+#[cfg(test)]
+pub(crate) fn cube_on_cube(
+    resolution: u32,
+    at: [f64; 3],
+    settings: super::Settings,
+    frames: usize,
+) -> super::Simulation {
+    let [x, y, z] = at;
+    let text = format!(
+        "[[body]]\nmesh = \"cube\"\nresolution = {resolution}\n\
+         [[body]]\nmesh = \"cube\"\nresolution = {resolution}\ntranslate = [{x}, {y}, {z}]\n"
+    );
+    let scene = crate::scene::Scene::parse_file(std::path::Path::new("t.toml"), &text).unwrap();
+    let mut simulation = super::Simulation::new(&scene, settings);
+    let active = (simulation.families().parse_list("edges,volume,contact")).unwrap();
+    simulation.set_settings(super::Settings { active, ..settings });
+    for _ in 0..frames {
+        simulation.step();
+    }
+    simulation
+}

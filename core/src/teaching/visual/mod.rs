@@ -134,20 +134,9 @@ mod tests {
     /// longest as long as a pending projection's, and nothing for a particle without contacts.
     #[test]
     fn the_selected_contact_gets_its_gradient_arrows() {
-        let text = "[[body]]\nmesh = \"cube\"\nresolution = 2\n\
-                    [[body]]\nmesh = \"cube\"\nresolution = 2\ntranslate = [0.3, 1.003, 0.2]\n";
-        let scene = Scene::parse_file(std::path::Path::new("t.toml"), text).unwrap();
-        let mut simulation = Simulation::new(&scene, Settings::default());
-        let families = simulation.families().clone();
-        let active = families.parse_list("edges,volume,contact").unwrap();
-        simulation.set_settings(Settings {
-            active,
-            ..Settings::default()
-        });
-        for _ in 0..5 {
-            simulation.step();
-        }
-        let contact = families.parse("contact").unwrap();
+        let at = [0.3, 1.003, 0.2];
+        let simulation = crate::simulation::contact::cube_on_cube(2, at, Settings::default(), 5);
+        let contact = simulation.families().parse("contact").unwrap();
         let over = |i: usize| {
             let pairs = simulation.contacts_of(i);
             let first = pairs.first()?;
