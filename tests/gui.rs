@@ -647,13 +647,7 @@ fn a_scene_file_of_several_bodies_opens_in_the_view() {
 fn a_stack_rests_on_contact_in_the_workbench() {
     let mut harness = workbench("cube", 2);
     open_by_path(&mut harness, "../assets/scenes/stacked-cubes.toml");
-    // The solver panel's checkbox, above the compare panel's.
-    harness
-        .get_all_by_label("contact")
-        .next()
-        .expect("the solver panel's contact")
-        .click();
-    harness.run_steps(2);
+    tick(&mut harness, "contact");
     assert!(
         harness.query_by_label_contains("mu_s").is_some(),
         "the friction is shown"
@@ -685,6 +679,15 @@ fn open_by_path(harness: &mut Harness<'static, TetlabApp>, path: &str) {
     harness.run_steps(1);
     harness.get_by_label("Open").click();
     harness.run_steps(3);
+}
+
+/// Ticks the solver panel's checkbox `label` (the first of that label: the solver panel's is
+/// above the compare panel's).
+fn tick(harness: &mut Harness<'static, TetlabApp>, label: &str) {
+    (harness.get_all_by_label(label).next())
+        .unwrap_or_else(|| panic!("the solver panel's {label}"))
+        .click();
+    harness.run_steps(2);
 }
 
 /// A panel and the requests it made, drawn on its own.

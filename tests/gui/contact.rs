@@ -11,12 +11,7 @@ use tetlab::gui::viewport;
 fn the_inspector_shows_the_contacts_of_the_clicked_particle() {
     let mut harness = workbench("cube", 2);
     super::open_by_path(&mut harness, "../assets/scenes/stacked-cubes.toml");
-    harness
-        .get_all_by_label("contact")
-        .next()
-        .expect("the solver panel's contact")
-        .click();
-    harness.run_steps(2);
+    super::tick(&mut harness, "contact");
     for _ in 0..10 {
         harness.get_by_label("Step frame").click();
         harness.run_steps(1);
@@ -73,12 +68,7 @@ fn bodies_of_their_own_stuff_play_in_the_workbench() {
     harness.get_by_label("body block: 2000 kg/m³, constraints edges+volume");
     harness.get_by_label("body soft: 500 kg/m³, material E=1e5,nu=0.3, constraints neohookean");
     for family in ["neo-Hookean", "contact"] {
-        harness
-            .get_all_by_label(family)
-            .next()
-            .expect(family)
-            .click();
-        harness.run_steps(2);
+        super::tick(&mut harness, family);
     }
     let top = |harness: &egui_kittest::Harness<'_, tetlab::gui::TetlabApp>, b: usize| {
         let simulation = &harness.state().bench.simulation;
