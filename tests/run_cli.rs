@@ -726,3 +726,34 @@ fn contact_is_reported_and_refused_where_it_cannot_run() {
         assert_usage_error(&wrong, said);
     }
 }
+
+/// A particle under a surface is the solver's error, and `run` says so: a cube thrown down at
+/// 8 m/s onto another goes 13 cm into it with one substep a frame, and is held a thickness
+/// above it at the default 100.
+#[test]
+fn a_particle_under_a_surface_is_warned_about() {
+    let scene = asset("scenes/dropped-cube.toml");
+    let common = [
+        "run",
+        "--scene",
+        &scene,
+        "--constraints",
+        "edges,volume,contact",
+        "--frames",
+        "20",
+    ];
+    let one = tetlab(&[&common[..], &["--substeps", "1"]].concat());
+    let text = stdout(&one);
+    assert!(one.status.success(), "{text}");
+    let warning = (text.lines())
+        .find(|line| line.starts_with("warning: contact let a particle"))
+        .unwrap_or_else(|| panic!("a warning: {text}"));
+    assert!(
+        warning.contains("under a surface at frame") && warning.contains("the solver's error"),
+        "{warning}"
+    );
+    let held = tetlab(&common);
+    let text = stdout(&held);
+    assert!(held.status.success(), "{text}");
+    assert!(!text.contains("under a surface"), "{text}");
+}

@@ -11,7 +11,7 @@ use tetlab_core::input::limits::{self, Number};
 use tetlab_core::measures::energy_account::{Energy, EnergyWatch};
 use tetlab_core::measures::ensemble::{Ensemble, Member, Tally};
 use tetlab_core::measures::exact_step::ExactStepGap;
-use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::measures::metrics::{Metrics, penetration_warning};
 use tetlab_core::measures::outcome::Outcome;
 use tetlab_core::simulation::newton::NewtonEngine;
 use tetlab_core::simulation::{EngineChoice, Simulation};
@@ -292,15 +292,10 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     // exact frame converged.
     let mut largest_gap: Option<(f64, f64, u64)> = None;
     let mut gaps_converged = true;
-    // The largest penetration of the run, and its frame.
-    let mut deepest = (0.0f64, 0u64);
     for _ in 0..args.simulation.frames {
         let before = args.exact_step.then(|| simulation.clone());
         let metrics = SimulationArgs::step(&mut simulation)?;
         outcome.observe(&simulation, &metrics);
-        if metrics.max_penetration > deepest.0 {
-            deepest = (metrics.max_penetration, simulation.frame());
-        }
         let gap = before.map(|before| ExactStepGap::measure(&before, &simulation));
         if let Some(gap) = gap {
             gaps_converged &= gap.converged;
@@ -341,17 +336,22 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
         )
         .map_err(io)?;
         if has_contact(&simulation) {
+            let thickness = simulation.settings().contact.thickness;
             writeln!(
                 out,
                 "contact: {} touching at the end, largest penetration {:.3e} m (of the \
                  thickness {} m; over the run {:.3e} m, frame {})",
                 outcome.last.contacts,
                 outcome.last.max_penetration,
-                simulation.settings().contact.thickness.show(),
-                deepest.0,
-                deepest.1
+                thickness.show(),
+                outcome.deepest.0,
+                outcome.deepest.1
             )
             .map_err(io)?;
+            let (depth, frame) = outcome.deepest;
+            if let Some(warning) = penetration_warning(depth, frame, thickness) {
+                writeln!(out, "{warning}").map_err(io)?;
+            }
         }
         for body in BodyRecord::of(&simulation) {
             let [x, y, z] = body.centre_of_mass;

@@ -7,7 +7,7 @@ use std::collections::VecDeque;
 use tetlab_core::constraints::{Families, PerFamily};
 use tetlab_core::measures::energy_account::Energy;
 use tetlab_core::measures::exact_step::ExactStepGap;
-use tetlab_core::measures::metrics::Metrics;
+use tetlab_core::measures::metrics::{Metrics, penetration_warning};
 use tetlab_core::scene::{Builtin, Perturbation, Scene, reflect_through_opposite_face};
 use tetlab_core::simulation::divergence::Divergence;
 use tetlab_core::simulation::newton::NewtonEngine;
@@ -102,6 +102,11 @@ pub struct Workbench {
     energy_watch: WorkbenchWatch,
     /// Where the energy grew past the watch's bound: its warning, as `tetlab run` prints it.
     pub energy_warning: Option<String>,
+    /// The largest penetration of the frames played since the last reset, and its frame.
+    deepest: (f64, u64),
+    /// Where contact let a particle under a surface: the warning `tetlab run` prints
+    /// ([`penetration_warning`]).
+    pub penetration_warning: Option<String>,
 }
 
 /// An eigenmode drawn on a tet: arrows of its eigenvector at the corners, and the tet moved
@@ -164,6 +169,8 @@ impl Workbench {
             slow_frame: None,
             energy_watch: WorkbenchWatch::default(),
             energy_warning: None,
+            deepest: (0.0, 0),
+            penetration_warning: None,
         };
         workbench.select_tet(0);
         workbench.record();
@@ -238,6 +245,11 @@ impl Workbench {
         self.newton_warning =
             (self.simulation.engine_as::<NewtonEngine>()).and_then(|newton| newton.warning());
         self.after_change();
+        if self.metrics.max_penetration > self.deepest.0 {
+            self.deepest = (self.metrics.max_penetration, self.simulation.frame());
+        }
+        let thickness = self.simulation.settings().contact.thickness;
+        self.penetration_warning = penetration_warning(self.deepest.0, self.deepest.1, thickness);
     }
 
     /// Advances one substep (Δt / substeps), without counting a frame.
@@ -290,6 +302,7 @@ impl Workbench {
     pub fn reset(&mut self) {
         self.energy_watch.stop();
         self.energy_warning = None;
+        (self.deepest, self.penetration_warning) = ((0.0, 0), None);
         self.stepping = None;
         self.last_advance = None;
         self.simulation.reset();

@@ -1,6 +1,6 @@
 //! What a headless run came to: the last frame's metrics, the last frame with an inverted tet,
-//! the largest speed any particle reached, and how far the centre of mass travelled, with the
-//! verdicts read from them (recovered, thrown). `tetlab run` reports one; an ensemble
+//! the largest speed any particle reached, the deepest contact, and how far the centre of mass
+//! travelled, with the verdicts read from them (recovered, thrown, a particle under a surface). `tetlab run` reports one; an ensemble
 //! ([`crate::measures::ensemble`]) counts them over projection orders.
 
 use crate::measures::metrics::Metrics;
@@ -19,6 +19,9 @@ pub struct Outcome {
     pub last_inverted_frame: Option<u64>,
     /// The largest particle speed seen, in m/s, and the frame it was seen at.
     pub largest_speed: (f64, u64),
+    /// The largest penetration seen ([`Metrics::max_penetration`]), in m, and the frame it was
+    /// seen at.
+    pub deepest: (f64, u64),
     /// The centre of mass at frame 0, where the run started.
     pub start: DVec3,
     /// The diagonal of the body's rest bounding box, in metres: what "thrown" is measured by.
@@ -34,6 +37,7 @@ impl Outcome {
             frame: simulation.frame(),
             last_inverted_frame: (initial.inverted_tets > 0).then_some(simulation.frame()),
             largest_speed: (initial.max_speed, simulation.frame()),
+            deepest: (initial.max_penetration, simulation.frame()),
             start: initial.centre_of_mass,
             body_length: simulation.rest_diagonal(),
         }
@@ -48,6 +52,9 @@ impl Outcome {
         }
         if metrics.max_speed > self.largest_speed.0 {
             self.largest_speed = (metrics.max_speed, self.frame);
+        }
+        if metrics.max_penetration > self.deepest.0 {
+            self.deepest = (metrics.max_penetration, self.frame);
         }
     }
 

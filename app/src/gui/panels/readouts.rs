@@ -39,6 +39,7 @@ fn show(ui: &mut egui::Ui, context: &Context<'_>, requests: &mut Vec<Request>) {
         &bench.newton_warning,
         &bench.slow_frame,
         &bench.energy_warning,
+        &bench.penetration_warning,
     ]
     .into_iter()
     .flatten()
