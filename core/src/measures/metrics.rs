@@ -46,7 +46,7 @@ pub struct Metrics {
     /// triangle, the most by which it is closer than the thickness d, max(0, d − h) with h its
     /// height above the triangle (the built-in contact's −C). A particle under the triangle's
     /// plane (h < 0) counts only where it is inside the body the triangle bounds; one that went
-    /// round the rim of a part thinner than its depth is outside it ([`contacts_of`]).
+    /// round the rim of a part thinner than its depth is outside it.
     pub max_penetration: f64,
 }
 
