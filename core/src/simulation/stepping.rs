@@ -17,9 +17,15 @@ impl Simulation {
     pub fn step(&mut self) {
         self.refresh_inverse_masses();
         self.state.frame_corrections.fill(DVec3::ZERO);
+        self.find_contacts();
+        if self.frame == 0 && self.settling.is_none() && self.starts_inside_the_layer() {
+            // Set down with a particle inside the thickness of a surface: contact moves it out
+            // of the layer, bending its body, whose constraints would undo the bend with speed
+            // (contact's `project` module docs). The start settles as an edit does.
+            self.settling = Some(0);
+        }
         self.hold_off_settling();
         let settling = self.edits_settle_now();
-        self.find_contacts();
         // The slot is taken out while its engine steps the rest of the simulation.
         let mut slot = std::mem::take(&mut self.engine);
         let engine = slot.ready(self.engine(), self.start());
@@ -77,6 +83,19 @@ impl Simulation {
         contacts.clear();
         super::contact::keep_room(contacts, found.len().max(surface.particles.len()));
         contacts.extend_from_slice(found);
+    }
+
+    /// Whether some contact pair found for the coming frame has its particle over its triangle
+    /// and closer to it than the thickness d (C < 0 by the built-in contact's formula).
+    fn starts_inside_the_layer(&self) -> bool {
+        let thickness = self.settings.contact.thickness;
+        let positions = &self.state.positions;
+        self.state.contacts.iter().any(|pair| {
+            let p = pair.map(|i| positions[i as usize]);
+            let over = super::contact::project::over_triangle(p[0], [p[1], p[2], p[3]]);
+            let e = crate::constraints::contact::evaluate(&p, thickness);
+            over.is_some() && !e.degenerate && e.value < 0.0
+        })
     }
 
     /// Gives each particle its inverse mass (the lumped one, 0 where pinned or rigidly held):
