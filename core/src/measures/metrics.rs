@@ -5,7 +5,6 @@
 
 use crate::constraints::volume::signed_volume;
 use crate::constraints::{Constraint, Families, Family, PerFamily, SubstepStart, Visit};
-use crate::simulation::contact::project::over_triangle;
 use crate::simulation::divergence::{Cause, Divergence};
 use crate::simulation::{ConstraintSet, Simulation};
 use glam::DVec3;
@@ -253,22 +252,18 @@ fn contacts_of(simulation: &Simulation, particles: &Range<u32>) -> (usize, f64) 
         if !particles.contains(&pair[0]) {
             continue;
         }
-        let p = pair.map(|i| positions[i as usize]);
-        if over_triangle(p[0], [p[1], p[2], p[3]]).is_none() {
+        let Some(c) = crate::simulation::contact::over_and_closing(positions, *pair, thickness)
+        else {
             continue;
-        }
-        let e = crate::constraints::contact::evaluate(&p, thickness);
-        if e.degenerate {
-            continue;
-        }
-        let height = e.value + thickness;
+        };
+        let height = c + thickness;
         if height < 0.0 && !inside_the_body_of(simulation, *pair) {
             continue;
         }
         if height <= TOUCHING * thickness {
             touching += 1;
         }
-        deepest = larger(deepest, -e.value);
+        deepest = larger(deepest, -c);
     }
     (touching, deepest)
 }

@@ -90,11 +90,8 @@ impl Simulation {
     fn starts_inside_the_layer(&self) -> bool {
         let thickness = self.settings.contact.thickness;
         let positions = &self.state.positions;
-        self.state.contacts.iter().any(|pair| {
-            let p = pair.map(|i| positions[i as usize]);
-            let over = super::contact::project::over_triangle(p[0], [p[1], p[2], p[3]]);
-            let e = crate::constraints::contact::evaluate(&p, thickness);
-            over.is_some() && !e.degenerate && e.value < 0.0
+        (self.state.contacts.iter()).any(|&pair| {
+            super::contact::over_and_closing(positions, pair, thickness).is_some_and(|c| c < 0.0)
         })
     }
 

@@ -73,6 +73,26 @@ impl ContactPlan {
     }
 }
 
+/// The built-in contact's C = h − d of `pair` ([particle, a, b, c]) at `positions`, with the
+/// thickness d, where its particle is over its triangle and the triangle has an area; `None`
+/// otherwise: what the metrics and the start of a scene read of a pair.
+///
+/// ```
+/// use glam::DVec3;
+/// use tetlab_core::simulation::contact::over_and_closing;
+/// let positions = [DVec3::new(0.2, 0.005, 0.2), DVec3::ZERO, DVec3::Z, DVec3::X];
+/// let c = over_and_closing(&positions, [0, 1, 2, 3], 0.01).unwrap();
+/// assert!((c + 0.005).abs() < 1e-15, "5 mm into a 1 cm layer");
+/// let beside = [DVec3::new(2.0, 0.005, 0.2), DVec3::ZERO, DVec3::Z, DVec3::X];
+/// assert_eq!(over_and_closing(&beside, [0, 1, 2, 3], 0.01), None);
+/// ```
+pub fn over_and_closing(positions: &[glam::DVec3], pair: [u32; 4], thickness: f64) -> Option<f64> {
+    let p = pair.map(|i| positions[i as usize]);
+    project::over_triangle(p[0], [p[1], p[2], p[3]])?;
+    let e = crate::constraints::contact::evaluate(&p, thickness);
+    (!e.degenerate).then_some(e.value)
+}
+
 /// The families among `active` that bind to contacts.
 pub fn contact_families<'a>(
     families: &'a Families,
