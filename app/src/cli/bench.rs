@@ -104,6 +104,16 @@ struct Report {
     /// After the run, per active family: √(mean (C / rest value)²).
     #[serde(serialize_with = "active_only")]
     relative_error: Option<Named<Option<f64>>>,
+    /// The GPU engine's adapter ("NVIDIA H100 (Vulkan)").
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gpu: Option<String>,
+    /// The GPU engine's dispatches a frame (one per colour of each family, sweep and substep,
+    /// and the per-particle stages).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dispatches_per_frame: Option<u64>,
+    /// A frame's time over its dispatches, in µs (the submission and the read-back included).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    us_per_dispatch: Option<f64>,
 }
 
 /// A map of the families that have a value (the active ones), so that none is written `null`.
@@ -166,6 +176,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<(), UsageError> {
     super::simulation_args::warn_if_unstable(&simulation);
     let report = match settings.engine {
         EngineChoice::Fast => time_fast(args, &scene, &mut simulation)?,
+        EngineChoice::Gpu => time_gpu(args, &scene, &mut simulation)?,
         _ => time_reference(args, &scene, &mut simulation)?,
     };
     write_report(&report, args.json, out).map_err(UsageError::stdout)
@@ -192,6 +203,44 @@ fn time_reference(
         simulation.heap_bytes(),
         None,
     ))
+}
+
+/// The GPU engine: the frame's time, its dispatches, and the adapter. A frame that ran on the
+/// CPU instead (contact, or no GPU) is an error: it is not the GPU's time.
+fn time_gpu(args: &Args, scene: &Scene, simulation: &mut Simulation) -> Result<Report, UsageError> {
+    use tetlab_core::simulation::gpu::{GpuEngine, gpu};
+    let elapsed = time(args, simulation, Simulation::step, |_| {});
+    Metrics::measure_sound(simulation).map_err(|d| UsageError(d.to_string()))?;
+    let projections = simulation.projections_per_frame();
+    let described = simulation.describe_engine();
+    let engine = (simulation.engine_as::<GpuEngine>()).expect("bench runs the GPU engine");
+    if let Err(why) = engine.ready() {
+        return Err(UsageError(format!("--engine gpu: {why}")));
+    }
+    if engine.dispatches() == 0 {
+        return Err(UsageError(format!(
+            "--engine gpu: the frames ran on the CPU ({described})"
+        )));
+    }
+    let dispatches = engine.dispatches();
+    let bytes = usize::try_from(engine.device_bytes()).unwrap_or(usize::MAX);
+    let mut report = report(
+        args,
+        scene,
+        simulation.families(),
+        *simulation.active(),
+        "gpu (f32)",
+        1,
+        projections,
+        elapsed,
+        None,
+        bytes,
+        None,
+    );
+    report.gpu = gpu().ok().map(|g| g.details());
+    report.dispatches_per_frame = Some(dispatches);
+    report.us_per_dispatch = Some(report.ms_per_frame * 1e3 / dispatches as f64);
+    Ok(report)
 }
 
 /// The fast engine `simulation` steps on (its settings choose it).
@@ -340,6 +389,9 @@ fn report(
         regions: None,
         lines_from_other_threads: None,
         relative_error: None,
+        gpu: None,
+        dispatches_per_frame: None,
+        us_per_dispatch: None,
     }
 }
 
@@ -386,6 +438,9 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
         "memory                 {:.0} bytes per tet",
         r.bytes_per_tet
     )?;
+    if r.gpu.is_some() {
+        write!(out, " on the GPU")?;
+    }
     if let Some(rss) = r.peak_rss_bytes {
         write!(out, "; peak resident {:.1} MB", rss as f64 / 1e6)?;
     }
@@ -393,6 +448,15 @@ fn write_report(r: &Report, json: bool, out: &mut impl Write) -> std::io::Result
     if let Some(c) = &r.colours {
         let each = of_active(c.0.iter().map(|(n, v)| (n, v.to_string())).collect());
         writeln!(out, "colours                {each}")?;
+    }
+    if let Some(gpu) = &r.gpu {
+        writeln!(out, "GPU                    {gpu}")?;
+    }
+    if let (Some(n), Some(us)) = (r.dispatches_per_frame, r.us_per_dispatch) {
+        writeln!(
+            out,
+            "dispatches per frame   {n} ({us:.2} us each, all told)"
+        )?;
     }
     if let Some(lanes) = &r.lanes {
         writeln!(out, "SIMD lanes             {lanes}")?;

@@ -32,7 +32,8 @@ pub struct Args {
     /// that checks it; repeatable.
     #[arg(long = "constraint-file", value_name = "FILE", conflicts_with = "list")]
     constraint_files: Vec<PathBuf>,
-    /// The engine instead of the lesson's: auto, reference, fast or newton, as for `tetlab run`.
+    /// The engine instead of the lesson's: auto, reference, fast, newton or gpu, as for `tetlab
+    /// run`.
     #[arg(long, value_parser = EngineChoice::parse, conflicts_with = "list")]
     engine: Option<EngineChoice>,
     /// Threads for the fast engine (1..=256) [default: every core].
@@ -122,6 +123,7 @@ pub fn run(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
         }
     }
     if let Some(engine) = args.engine {
+        super::simulation_args::available(engine)?;
         lesson.settings.engine = engine;
     }
     if args.order_seed.is_some() {

@@ -109,8 +109,9 @@ pub struct SolverArgs {
     pub solver: Method,
     /// Which solver steps the simulation: reference (f64, one constraint at a time), fast (f32,
     /// coloured, in SIMD lanes, on threads), newton (every substep's implicit Euler step solved
-    /// exactly: the answer XPBD approximates; slow, for small scenes) or auto (reference below
-    /// 1000 tets, fast from there) [default: auto; bench: fast].
+    /// exactly: the answer XPBD approximates; slow, for small scenes), gpu (the fast engine's
+    /// model in compute shaders, where a GPU adapter is found) or auto (reference below 1000
+    /// tets, fast from there) [default: auto; bench: fast].
     #[arg(long, value_parser = EngineChoice::parse)]
     pub engine: Option<EngineChoice>,
     /// Threads for the fast engine (1..=256; the results are the same for any count) [default:
@@ -194,6 +195,14 @@ impl NamedValue {
     }
 }
 
+/// Ok where `engine` can run here; otherwise the usage error naming `--engine` (the GPU engine
+/// without an adapter: "--engine gpu: no GPU adapter (…)").
+pub fn available(engine: EngineChoice) -> Result<(), UsageError> {
+    engine
+        .available()
+        .map_err(|why| UsageError(format!("--engine {}: {why}", engine.name())))
+}
+
 impl SolverArgs {
     /// The solver settings these options ask for: the constraint files loaded and their
     /// families added to the table and to the active ones, then every family name looked up.
@@ -230,6 +239,9 @@ impl SolverArgs {
                  is a family on contacts: run it on the reference or the fast engine",
                 families.name(family)
             )));
+        }
+        if let Some(engine) = self.engine {
+            available(engine)?;
         }
         Ok((settings, families))
     }

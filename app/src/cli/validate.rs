@@ -76,7 +76,10 @@ pub fn main(args: &Args, out: &mut impl Write) -> Result<Outcome, UsageError> {
     let engines = match args.engine.as_str() {
         "both" => EngineChoice::position_based().collect(),
         other => match EngineChoice::parse(other) {
-            Ok(engine) if engine != EngineChoice::Auto => vec![engine],
+            Ok(engine) if engine != EngineChoice::Auto => {
+                super::simulation_args::available(engine)?;
+                vec![engine]
+            }
             _ => {
                 let names: Vec<&str> = EngineChoice::engines().map(|e| e.name()).collect();
                 return Err(UsageError(format!(

@@ -263,7 +263,14 @@ impl Link {
                         .map_err(wrong)?
                 }
                 "method" => s.method = Method::parse(&value).map_err(wrong)?,
-                "engine" => s.engine = EngineChoice::parse(&value).map_err(wrong)?,
+                "engine" => {
+                    let engine = EngineChoice::parse(&value).map_err(wrong)?;
+                    // A link made where the GPU engine runs, opened where it cannot.
+                    engine
+                        .available()
+                        .map_err(|why| wrong(format!("'{value}': {why}")))?;
+                    s.engine = engine;
+                }
                 "substeps" => s.substeps = count(&value)?,
                 "iterations" => s.iterations = count(&value)?,
                 "dt" => s.dt = number(&value)?,

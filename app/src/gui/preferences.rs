@@ -3,7 +3,7 @@
 
 use super::geometry::ViewOptions;
 use super::panels::controls::SceneChoice;
-use tetlab_core::simulation::Settings;
+use tetlab_core::simulation::{EngineChoice, Settings};
 
 /// What the workbench remembers between runs (eframe storage).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -20,11 +20,17 @@ pub struct Preferences {
 impl Preferences {
     /// The preferences `storage` keeps (as JSON, the same on the desktop and in a page, which
     /// then needs no RON), or the defaults when it keeps none or ones it cannot read.
+    /// An engine kept that cannot run here (the GPU engine, remembered from a machine with a
+    /// GPU or a run with one) is `auto` again.
     pub fn load(storage: &dyn eframe::Storage) -> Preferences {
-        storage
+        let mut preferences: Preferences = storage
             .get_string(STORAGE_KEY)
             .and_then(|text| serde_json::from_str(&text).ok())
-            .unwrap_or_default()
+            .unwrap_or_default();
+        if preferences.settings.engine.available().is_err() {
+            preferences.settings.engine = EngineChoice::Auto;
+        }
+        preferences
     }
 
     /// Keeps them in `storage`.

@@ -11,4 +11,5 @@ pub mod finite_difference;
 pub mod lanes;
 pub mod random;
 pub mod svd3;
+pub mod traced;
 pub mod vector;

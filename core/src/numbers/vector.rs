@@ -92,6 +92,15 @@ pub trait Real:
     fn acos(self) -> Self;
     /// The real cube root.
     fn cbrt(self) -> Self;
+    /// The number exactly as it was rounded, kept from a compiler's algebra: itself, on the
+    /// CPU. A shader compiler may rewrite (x + s) − x as s (WGSL has no `precise`), which
+    /// turns a compensated sum's residual into 0; a traced number passes through this opaque
+    /// to it ([`crate::numbers::traced`]). Where a sum's rounding is the point, each rounded
+    /// value goes through this.
+    #[inline(always)]
+    fn rounded(self) -> Self {
+        self
+    }
     /// The number with nothing of a derivative: a dual number's slopes dropped (at every level),
     /// the number itself otherwise. What holds a value fixed while others are differentiated.
     #[inline]
@@ -271,6 +280,12 @@ macro_rules! impl_vector3 {
 impl_vector3!(glam::Vec3, f32);
 impl_vector3!(glam::Vec3A, f32);
 impl_vector3!(glam::DVec3, f64);
+
+/// `v` with each component [`Real::rounded`]: itself, on the CPU.
+#[inline(always)]
+pub(crate) fn rounded<V: Vector3>(v: V) -> V {
+    V::from_array(v.to_array().map(Real::rounded))
+}
 
 /// Whether `a` and `b` span no plane at working precision: |a×b| ≤ ε·|a|·|b|, compared squared
 /// (no square roots; the squares overflow only for coordinates beyond about 10¹⁹ in f32).

@@ -19,6 +19,10 @@ pub enum EngineChoice {
     /// discrete problem XPBD approximates ([`super::newton`]). Slow: for validation and small
     /// scenes.
     Newton,
+    /// The fast engine's model on a GPU, in WGSL compute shaders on wgpu
+    /// ([`super::gpu`], with the feature `gpu`): where a GPU can be had
+    /// ([`EngineChoice::available`]).
+    Gpu,
 }
 
 /// The size from which [`EngineChoice::Auto`] picks the fast engine. The reference engine's
@@ -31,11 +35,12 @@ pub const FAST_FROM_TETS: usize = 1000;
 
 impl EngineChoice {
     /// Every choice, in the order the front ends list them.
-    pub const ALL: [EngineChoice; 4] = [
+    pub const ALL: [EngineChoice; 5] = [
         EngineChoice::Auto,
         EngineChoice::Reference,
         EngineChoice::Fast,
         EngineChoice::Newton,
+        EngineChoice::Gpu,
     ];
 
     /// The engines themselves, every choice but [`EngineChoice::Auto`].
@@ -45,9 +50,10 @@ impl EngineChoice {
             .filter(|&e| e != EngineChoice::Auto)
     }
 
-    /// The position-based engines, those that project constraints (every engine but the Newton
-    /// reference, which solves the step they approximate): what `validate --engine both` and an
-    /// ensemble run, and what the engines' contract binds.
+    /// The CPU engines that project constraints (every engine but the Newton reference, which
+    /// solves the step they approximate, and the GPU engine): what `validate --engine both` and
+    /// an ensemble run. The engines' contract binds the GPU engine too, whose model is the fast
+    /// engine's; it runs where it is named (`--engine gpu`), since it needs an adapter.
     ///
     /// ```
     /// use tetlab_core::simulation::EngineChoice;
@@ -55,16 +61,55 @@ impl EngineChoice {
     /// assert_eq!(both, [EngineChoice::Reference, EngineChoice::Fast]);
     /// ```
     pub fn position_based() -> impl Iterator<Item = EngineChoice> {
-        EngineChoice::engines().filter(|&e| e != EngineChoice::Newton)
+        EngineChoice::engines().filter(|&e| !matches!(e, EngineChoice::Newton | EngineChoice::Gpu))
     }
 
-    /// Its name on the command line, in files and links: `auto`, `reference` or `fast`.
+    /// Whether this choice can run here: every engine but the GPU's always can; that one needs
+    /// the feature `gpu` and an adapter (a software one, such as Mesa's lavapipe, will do).
+    /// The error says why not, in a line.
+    pub fn available(self) -> Result<(), String> {
+        match self {
+            #[cfg(feature = "gpu")]
+            EngineChoice::Gpu => super::gpu::gpu().map(|_| ()),
+            #[cfg(not(feature = "gpu"))]
+            EngineChoice::Gpu => Err("this build of tetlab has no GPU engine".to_owned()),
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether a test of this engine can run here ([`EngineChoice::available`]); where it
+    /// cannot, the test returns early, and this says why on stderr (past the test harness's
+    /// capture).
+    ///
+    /// # Panics
+    /// Under CI (`CI=true`), which installs Mesa's software Vulkan, when it cannot.
+    pub fn for_test(self) -> bool {
+        use std::io::Write;
+        let Err(why) = self.available() else {
+            return true;
+        };
+        assert!(
+            !crate::input::shared_meshes::in_ci(),
+            "CI=true, and the {} engine's tests must run, but it cannot here: {why}",
+            self.name()
+        );
+        let _ = writeln!(
+            std::io::stderr(),
+            "skipped: the {} engine cannot run here ({why})",
+            self.name()
+        );
+        false
+    }
+
+    /// Its name on the command line, in files and links: `auto`, `reference`, `fast`,
+    /// `newton` or `gpu`.
     pub fn name(self) -> &'static str {
         match self {
             EngineChoice::Auto => "auto",
             EngineChoice::Reference => "reference",
             EngineChoice::Fast => "fast",
             EngineChoice::Newton => "newton",
+            EngineChoice::Gpu => "gpu",
         }
     }
 
@@ -82,6 +127,10 @@ impl EngineChoice {
                 "f64, every substep's implicit step solved exactly: the reference XPBD approaches"
                     .into()
             }
+            EngineChoice::Gpu => {
+                "f32, the fast engine's colours as compute shaders, one thread per constraint"
+                    .into()
+            }
         }
     }
 
@@ -90,7 +139,8 @@ impl EngineChoice {
     /// ```
     /// use tetlab_core::simulation::EngineChoice;
     /// assert_eq!(EngineChoice::parse("fast"), Ok(EngineChoice::Fast));
-    /// assert!(EngineChoice::parse("gpu").unwrap_err().contains("auto, reference, fast or newton"));
+    /// assert_eq!(EngineChoice::parse("gpu"), Ok(EngineChoice::Gpu));
+    /// assert!(EngineChoice::parse("cuda").unwrap_err().contains("auto, reference, fast, newton or gpu"));
     /// ```
     pub fn parse(text: &str) -> Result<EngineChoice, String> {
         let text = text.trim();
@@ -134,6 +184,13 @@ impl EngineChoice {
             }
             EngineChoice::Auto | EngineChoice::Reference => "reference (f64)".to_owned(),
             EngineChoice::Newton => "newton (f64, implicit Euler to 1e-10)".to_owned(),
+            #[cfg(feature = "gpu")]
+            EngineChoice::Gpu => match super::gpu::gpu() {
+                Ok(gpu) => format!("gpu (f32, {})", gpu.describe()),
+                Err(_) => "gpu (f32, no GPU here)".to_owned(),
+            },
+            #[cfg(not(feature = "gpu"))]
+            EngineChoice::Gpu => "gpu (f32)".to_owned(),
         }
     }
 }

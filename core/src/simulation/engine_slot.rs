@@ -15,6 +15,12 @@ pub(super) fn build(choice: EngineChoice) -> Build {
         EngineChoice::Auto | EngineChoice::Reference => |_| Box::new(ReferenceEngine),
         EngineChoice::Fast => |start| Box::new(FastSimulation::new(start)),
         EngineChoice::Newton => |_| Box::new(NewtonEngine::default()),
+        #[cfg(feature = "gpu")]
+        EngineChoice::Gpu => |start| Box::new(super::gpu::GpuEngine::new(start)),
+        // A build without the GPU engine (the page) runs the fast one, whose model it is; the
+        // front ends offer the choice only where it is available.
+        #[cfg(not(feature = "gpu"))]
+        EngineChoice::Gpu => |start| Box::new(FastSimulation::new(start)),
     }
 }
 

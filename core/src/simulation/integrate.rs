@@ -1,7 +1,7 @@
 //! The time integration around the constraint projections, written once for any precision: the
 //! f64 solver ([`crate::simulation`]) and the fast f32 solver ([`crate::simulation::fast`]) both use it.
 
-use crate::numbers::vector::{Real, Vector3};
+use crate::numbers::vector::{Mask, Real, Vector3, rounded};
 
 /// The sub-ulp parts of the positions, for an engine whose positions are too coarse to hold a
 /// substep's motion (the fast engine's f32): the position meant is x + r, with x the stored
@@ -58,61 +58,115 @@ pub(crate) fn predict<V: Vector3>(
     substep: Substep,
     mut residuals: Option<Residuals<'_, V>>,
     pushes: &mut [V],
-) where
-    V::Real: PartialOrd,
-{
-    let Substep {
-        gravity,
-        h,
-        ground,
-        plane_strain,
-    } = substep;
-    let pull = V::from_f64s(0.0, -gravity, 0.0) * V::Real::from_f64(h);
-    let h = V::Real::from_f64(h);
-    let floor = ground.map(V::Real::from_f64);
-    let zero = V::from_f64s(0.0, 0.0, 0.0);
+) {
+    let motion = Motion::of(substep);
     for i in 0..positions.len() {
         previous[i] = positions[i];
-        pushes[i] = zero;
         if let Some(r) = &mut residuals {
             r.previous[i] = r.now[i];
         }
-        if inverse_masses[i] == V::Real::ZERO {
-            continue;
-        }
-        velocities[i] += pull;
-        if let Some(&force) = forces.get(i) {
-            velocities[i] += force * (inverse_masses[i] * h);
-        }
-        if plane_strain {
-            let [x, y, _] = velocities[i].to_array();
-            velocities[i] = V::from_array([x, y, V::Real::ZERO]);
-        }
-        let step = velocities[i] * h;
-        match &mut residuals {
-            None => positions[i] += step,
-            Some(r) => {
-                let step = step + r.now[i];
-                let x = positions[i] + step;
-                r.now[i] = step - (x - positions[i]);
-                positions[i] = x;
-            }
-        }
-        if let Some(floor) = floor
-            && positions[i].y() < floor
-        {
-            let predicted = positions[i];
-            positions[i] = previous[i];
-            positions[i].set_y(floor);
-            pushes[i] = positions[i] - predicted;
-            if let Some(r) = &mut residuals {
-                let predicted = r.now[i];
-                r.now[i] = r.previous[i];
-                r.now[i].set_y(V::Real::ZERO);
-                pushes[i] += r.now[i] - predicted;
-            }
+        let residual = residuals.as_ref().map(|r| r.now[i]);
+        let force = forces.get(i).copied();
+        let (x, v, r, push) = predict_particle(
+            (positions[i], velocities[i], residual),
+            inverse_masses[i],
+            force,
+            &motion,
+        );
+        positions[i] = x;
+        velocities[i] = v;
+        pushes[i] = push;
+        if let (Some(residuals), Some(r)) = (&mut residuals, r) {
+            residuals.now[i] = r;
         }
     }
+}
+
+/// A substep's prediction in the numbers of an engine ([`Substep`] converted once).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Motion<V: Vector3> {
+    /// g h, along −y.
+    pub pull: V,
+    /// h.
+    pub h: V::Real,
+    /// The ground's height, if there is a ground.
+    pub floor: Option<V::Real>,
+    /// Whether every particle keeps its z.
+    pub plane_strain: bool,
+}
+
+impl<V: Vector3> Motion<V> {
+    /// `substep` in the numbers of `V`.
+    pub(crate) fn of(substep: Substep) -> Motion<V> {
+        Motion {
+            pull: V::from_f64s(0.0, -substep.gravity, 0.0) * V::Real::from_f64(substep.h),
+            h: V::Real::from_f64(substep.h),
+            floor: substep.ground.map(V::Real::from_f64),
+            plane_strain: substep.plane_strain,
+        }
+    }
+}
+
+/// One particle's prediction ([`predict`]), without a branch on a value (the GPU engine runs
+/// it too): from its position x, velocity v and residual r (where kept) at the start of the
+/// substep, its inverse mass `w` and the external force on it, the predicted x, v and r and the
+/// ground's push. A held particle (w = 0) keeps x, v and r, and is not pushed.
+#[inline(always)]
+pub(crate) fn predict_particle<V: Vector3>(
+    (x, v, r): (V, V, Option<V>),
+    w: V::Real,
+    force: Option<V>,
+    motion: &Motion<V>,
+) -> (V, V, Option<V>, V) {
+    let free = w.gt(V::Real::ZERO);
+    if !free.any() {
+        return (x, v, r, V::ZERO);
+    }
+    let h = motion.h;
+    let mut velocity = v + motion.pull;
+    if let Some(force) = force {
+        velocity += force * (w * h);
+    }
+    if motion.plane_strain {
+        let [vx, vy, _] = velocity.to_array();
+        velocity = V::from_array([vx, vy, V::Real::ZERO]);
+    }
+    let step = velocity * h;
+    let (mut moved, mut residual) = match r {
+        None => (x + step, None),
+        Some(r) => {
+            // Each rounding kept as it is, so that no compiler cancels x out (`rounded`).
+            let step = rounded(step + r);
+            let moved = rounded(x + step);
+            (moved, Some(step - rounded(moved - x)))
+        }
+    };
+    let mut push = V::ZERO;
+    if let Some(floor) = motion.floor {
+        let below = floor.gt(moved.y());
+        if below.any() {
+            let predicted = moved;
+            let mut grounded = x;
+            grounded.set_y(floor);
+            let mut pushed = grounded - predicted;
+            if let (Some(now), Some(start)) = (residual, r) {
+                let mut back = start;
+                back.set_y(V::Real::ZERO);
+                pushed += back - now;
+                residual = Some(V::select(below, back, now));
+            }
+            moved = V::select(below, grounded, moved);
+            push = V::select(below, pushed, push);
+        }
+    }
+    (
+        V::select(free, moved, x),
+        V::select(free, velocity, v),
+        residual
+            .zip(r)
+            .map(|(now, start)| V::select(free, now, start)),
+        V::select(free, push, V::ZERO),
+    )
 }
 
 /// The ground as a constraint: y ≥ `ground` for every free particle, each move added to the
@@ -122,16 +176,25 @@ pub(crate) fn project_ground<V: Vector3>(
     inverse_masses: &[V::Real],
     ground: f64,
     pushes: &mut [V],
-) where
-    V::Real: PartialOrd,
-{
+) {
     let floor = V::Real::from_f64(ground);
     for ((p, &w), push) in positions.iter_mut().zip(inverse_masses).zip(pushes) {
-        if w > V::Real::ZERO && p.y() < floor {
-            *push += V::from_array([V::Real::ZERO, floor - p.y(), V::Real::ZERO]);
-            p.set_y(floor);
-        }
+        (*p, *push) = ground_particle(*p, w, floor, *push);
     }
+}
+
+/// One particle of [`project_ground`]: its position and push after y ≥ `floor`, if it is free.
+#[inline(always)]
+pub(crate) fn ground_particle<V: Vector3>(p: V, w: V::Real, floor: V::Real, push: V) -> (V, V) {
+    let under = w.gt(V::Real::ZERO) & floor.gt(p.y());
+    if !under.any() {
+        return (p, push);
+    }
+    let zero = V::Real::ZERO;
+    let pushed = push + V::from_array([zero, floor - p.y(), zero]);
+    let mut lifted = p;
+    lifted.set_y(floor);
+    (V::select(under, lifted, p), V::select(under, pushed, push))
 }
 
 /// Plane strain: every particle back at the z it had at the start of the substep (`previous`),
@@ -139,9 +202,15 @@ pub(crate) fn project_ground<V: Vector3>(
 /// its starting z for the whole run: the extruded panel of a plane problem held in z.
 pub(crate) fn hold_plane<V: Vector3>(positions: &mut [V], previous: &[V]) {
     for (p, q) in positions.iter_mut().zip(previous) {
-        let [x, y, _] = p.to_array();
-        *p = V::from_array([x, y, q.to_array()[2]]);
+        *p = plane_particle(*p, *q);
     }
+}
+
+/// One particle of [`hold_plane`]: `p` with the z of `start`.
+#[inline(always)]
+pub(crate) fn plane_particle<V: Vector3>(p: V, start: V) -> V {
+    let [x, y, _] = p.to_array();
+    V::from_array([x, y, start.to_array()[2]])
 }
 
 /// What the velocity update books of each particle's energy: what the ground, damping and the
@@ -186,51 +255,103 @@ pub(crate) fn update_velocities<V: Vector3>(
     cap: bool,
     residuals: Option<&Residuals<'_, V>>,
     book: Book<'_, V>,
-) where
-    V::Real: PartialOrd,
-{
-    let keep = V::Real::from_f64((1.0 - damping * h).max(0.0));
-    let damped = damping > 0.0;
-    let lost = V::Real::ONE - keep * keep;
-    let half = V::Real::from_f64(0.5);
-    let pull = V::from_f64s(0.0, -book.gravity * h, 0.0);
-    let h = V::Real::from_f64(h);
+) {
+    let ending = Ending::of(h, damping, cap, book.gravity);
     for i in 0..positions.len() {
         let moved = match residuals {
             None => positions[i] - previous[i],
             Some(r) => (positions[i] - previous[i]) + (r.now[i] - r.previous[i]),
         };
-        let end = moved / h;
-        let mut velocity = end;
-        if cap {
-            let limit = velocities[i].length();
-            let squared = velocity.length_squared();
-            if squared > limit * limit {
-                velocity = (velocity / squared.sqrt()) * limit;
-            }
-        }
+        let force = book.forces.get(i).copied();
         let w = book.inverse_masses[i];
-        let push = book.pushes[i];
-        let pushed = push.length_squared() > V::Real::ZERO;
-        // Most particles, most substeps, have nothing to book: no ground under them, no
-        // damping, no cap. They pay one test.
-        if w > V::Real::ZERO && (pushed || damped || cap) {
-            let half_mass = half / w;
-            let ground = if pushed {
-                let mut added = pull;
-                if let Some(&force) = book.forces.get(i) {
-                    added += force * (w * h);
-                }
-                // velocities[i] is still the predicted velocity, v₀ + (g + w f) h.
-                let start = velocities[i] - added;
-                -(half_mass / h) * push.dot(start + velocity)
-            } else {
-                V::Real::ZERO
-            };
-            let kept = velocity.length_squared();
-            let capped = half_mass * (end.length_squared() - kept);
-            book.taken[i] += V::from_array([ground, half_mass * kept * lost, capped]);
-        }
-        velocities[i] = velocity * keep;
+        (velocities[i], book.taken[i]) = end_particle(
+            (moved, velocities[i]),
+            (w, force, book.pushes[i]),
+            book.taken[i],
+            &ending,
+        );
     }
+}
+
+/// The end of a substep in the numbers of an engine: what [`end_particle`] needs.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Ending<V: Vector3> {
+    /// h.
+    pub h: V::Real,
+    /// What damping keeps of a velocity: max(0, 1 − damping h).
+    pub keep: V::Real,
+    /// Whether there is damping.
+    pub damped: bool,
+    /// Whether |v| is capped (an edit settles).
+    pub cap: bool,
+    /// g h, along −y.
+    pub pull: V,
+}
+
+impl<V: Vector3> Ending<V> {
+    /// The end of a substep of length `h`, with `damping` per second, capped or not, under
+    /// `gravity`.
+    pub(crate) fn of(h: f64, damping: f64, cap: bool, gravity: f64) -> Ending<V> {
+        Ending {
+            h: V::Real::from_f64(h),
+            keep: V::Real::from_f64((1.0 - damping * h).max(0.0)),
+            damped: damping > 0.0,
+            cap,
+            pull: V::from_f64s(0.0, -gravity * h, 0.0),
+        }
+    }
+}
+
+/// One particle of [`update_velocities`], without a branch on a value (the GPU engine runs it
+/// too): from how far it `moved` over the substep and its predicted velocity, its inverse mass,
+/// the external force on it and the ground's push, its new velocity and what was taken from it
+/// (`taken`, added to: x the ground's, y damping's, z the cap's; see [`Book`]).
+#[inline(always)]
+pub(crate) fn end_particle<V: Vector3>(
+    (moved, predicted): (V, V),
+    (w, force, push): (V::Real, Option<V>, V),
+    taken: V,
+    ending: &Ending<V>,
+) -> (V, V) {
+    let zero = V::Real::ZERO;
+    let h = ending.h;
+    let end = moved / h;
+    let mut velocity = end;
+    if ending.cap {
+        let limit = predicted.length();
+        let squared = velocity.length_squared();
+        let over = squared.gt(limit * limit);
+        if over.any() {
+            velocity = V::select(over, (velocity / squared.sqrt()) * limit, velocity);
+        }
+    }
+    let pushed = push.length_squared().gt(zero);
+    let mut booked = pushed;
+    if ending.damped || ending.cap {
+        booked = booked | !booked;
+    }
+    let booked = w.gt(zero) & booked;
+    // Most particles, most substeps, have nothing to book: no ground under them, no damping,
+    // no cap. They pay one test.
+    let mut taken = taken;
+    if booked.any() {
+        let half_mass = V::Real::from_f64(0.5) / w;
+        let ground = if pushed.any() {
+            let mut added = ending.pull;
+            if let Some(force) = force {
+                added += force * (w * h);
+            }
+            // `predicted` is v₀ + (g + w f) h.
+            let start = predicted - added;
+            V::Real::select(pushed, -(half_mass / h) * push.dot(start + velocity), zero)
+        } else {
+            zero
+        };
+        let kept = velocity.length_squared();
+        let capped = half_mass * (end.length_squared() - kept);
+        let lost = V::Real::ONE - ending.keep * ending.keep;
+        let add = V::from_array([ground, half_mass * kept * lost, capped]);
+        taken = V::select(booked, taken + add, taken);
+    }
+    (velocity * ending.keep, taken)
 }

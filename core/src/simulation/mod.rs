@@ -24,6 +24,8 @@ mod engine;
 mod engine_choice;
 mod engine_slot;
 pub mod fast;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 mod inspection;
 mod integrate;
 mod masses;

@@ -121,6 +121,12 @@ impl Simulation {
     pub fn describe_engine(&self) -> String {
         match (&self.engine.built, self.engine.given) {
             (Some((_, engine)), Some(_)) => engine.describe(),
+            // The GPU engine says what it found: its adapter, or why a frame ran on the CPU.
+            (Some((Some(super::EngineChoice::Gpu), engine)), None)
+                if self.settings.engine == super::EngineChoice::Gpu =>
+            {
+                engine.describe()
+            }
             (None, Some((_, name))) => name.to_owned(),
             _ => self.engine().describe(self.threads),
         }

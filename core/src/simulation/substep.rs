@@ -22,10 +22,10 @@
 use super::contact::ContactPlan;
 use super::engine::Frame;
 pub use super::integrate::Substep as Motion;
-use super::projection::{Rule, correction};
+use super::projection::{Rule, correct};
 use super::resolved::Resolved;
 use crate::constraints::{Families, MAX_FAMILIES, PerFamily, Unit, distance};
-use crate::numbers::vector::{Real, Vector3};
+use crate::numbers::vector::{Mask, Real, Vector3};
 use arrayvec::ArrayVec;
 use glam::DVec3;
 
@@ -228,6 +228,17 @@ pub trait Substeps {
     /// The position of `particle`, its inverse mass, and the compliant grab's multiplier, to
     /// be projected towards a target (`project_soft_grab`).
     fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_>;
+    /// The compliant grab: `particle` pulled towards `target` (in the scene's frame) by a
+    /// zero-length XPBD constraint of compliance `compliance`, in a substep of length `h`; by
+    /// default on the particle [`Substeps::grabbed`] gives (`project_soft_grab`). An engine whose
+    /// particles are elsewhere (the GPU's) records it there.
+    fn soft_grab(&mut self, particle: usize, target: DVec3, compliance: f64, h: f64)
+    where
+        Self: Sized,
+    {
+        let target = self.target(target);
+        project_soft_grab(self.grabbed(particle), target, compliance, h);
+    }
     /// Where `target` (in the scene's frame) is in the engine's coordinates.
     fn target(&self, target: DVec3) -> DVec3 {
         target
@@ -294,8 +305,7 @@ pub fn end_sweep(engine: &mut impl Substeps, plan: &Plan) {
 /// (step-by-step mode projects the contacts one at a time before it).
 pub fn close_sweep(engine: &mut impl Substeps, plan: &Plan) {
     if let Some((particle, target, compliance)) = plan.soft_grab {
-        let target = engine.target(target);
-        project_soft_grab(engine.grabbed(particle), target, compliance, plan.h);
+        engine.soft_grab(particle, target, compliance, plan.h);
     }
     engine.ground_and_plane(plan);
 }
@@ -327,16 +337,28 @@ fn project_soft_grab(grabbed: GrabbedParticle<'_>, target: DVec3, compliance: f6
     }
 }
 
-/// One XPBD projection of |p − target| = 0 moving p alone (the target is fixed).
-fn pull<V: Vector3>(position: &mut V, w: V::Real, lambda: &mut V::Real, target: V, alpha: V::Real)
-where
-    V::Real: Real<Mask = bool>,
-{
+/// One XPBD projection of |p − target| = 0 moving p alone (the target is fixed), without a
+/// branch on a value (the GPU engine runs it too): a skipped projection moves nothing.
+pub(crate) fn pull<V: Vector3>(
+    position: &mut V,
+    w: V::Real,
+    lambda: &mut V::Real,
+    target: V,
+    alpha: V::Real,
+) {
     let evaluation = distance::evaluate(&[*position, target], V::Real::ZERO);
     let rule = Rule::Xpbd { alpha_tilde: alpha };
     let unbounded = V::Real::from_f64(f64::INFINITY);
-    if let Some(c) = correction(evaluation, [w, V::Real::ZERO], *lambda, rule, unbounded) {
-        *lambda += c.delta_lambda[0];
-        *position += c.delta_x[0];
+    let c = correct(
+        [evaluation],
+        [w, V::Real::ZERO],
+        [*lambda],
+        [rule],
+        unbounded,
+    );
+    let made = !c.skipped[0].all;
+    if made.any() {
+        *lambda = V::Real::select(made, *lambda + c.delta_lambda[0], *lambda);
+        *position = V::select(made, *position + c.delta_x[0], *position);
     }
 }

@@ -54,19 +54,25 @@ fn edit(ui: &mut egui::Ui, families: &Families, current: &Settings) -> Option<Se
     let contact = tetlab_core::simulation::contact::contact_families(families, &current.active)
         .next()
         .is_some();
-    ui.horizontal(|ui| {
+    // Wrapped: five choices are wider than the panel.
+    ui.horizontal_wrapped(|ui| {
         ui.label("engine");
         for engine in EngineChoice::ALL {
-            // The Newton reference solves a substep without contact.
+            // The Newton reference solves a substep without contact; the GPU engine needs an
+            // adapter (the first ask for one waits for it, once).
             let without = contact && engine == EngineChoice::Newton;
+            let why = match engine.available() {
+                Err(why) => format!("No GPU engine here: {why}"),
+                Ok(()) if without => "The Newton reference solves a substep without contact: \
+                                      switch contact off to use it"
+                    .to_owned(),
+                Ok(()) => String::new(),
+            };
             let radio = egui::RadioButton::new(settings.engine == engine, engine.name());
             let response = ui
-                .add_enabled(!without, radio)
+                .add_enabled(why.is_empty(), radio)
                 .on_hover_text(engine.summary())
-                .on_disabled_hover_text(
-                    "The Newton reference solves a substep without contact: switch contact off \
-                     to use it",
-                );
+                .on_disabled_hover_text(why);
             if response.clicked() {
                 settings.engine = engine;
             }

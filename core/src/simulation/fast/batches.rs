@@ -85,7 +85,7 @@ pub(super) fn level_and_group(lo: usize, hi: usize) -> (usize, usize) {
 
 /// Where group `group` of level `level` is among the groups of a body of `regions` regions:
 /// the R regions first, then level 1's R / 2 groups, and so on.
-pub(super) fn group_index(regions: usize, level: usize, group: usize) -> usize {
+pub(in crate::simulation) fn group_index(regions: usize, level: usize, group: usize) -> usize {
     2 * regions - 2 * (regions >> level) + group
 }
 
@@ -366,6 +366,12 @@ impl Layout {
         start..self.colours[last * c + c - 1].batches.end
     }
 
+    /// Its rows as the GPU engine uploads them: each batch's particles and their inverse masses
+    /// (rows b·N + i, lane by lane, N its arity) and each batch's sizes (row b).
+    pub(in crate::simulation) fn rows(&self) -> (&[[u32; LANES]], &[F32x8], &[F32x8]) {
+        (&self.particles, &self.weights, &self.size)
+    }
+
     /// The layout with its arity `N` known.
     ///
     /// # Panics
@@ -614,6 +620,13 @@ impl Batches {
             },
             &mut self.lambda,
         )
+    }
+
+    /// Its rows as the GPU engine uploads them: the rest values (a row per batch), what the
+    /// elements store (`stored_len` rows per batch), that length, and the own α̃ (a row per
+    /// batch, NaN: the family's; empty where none has one).
+    pub(in crate::simulation) fn uploaded(&self) -> (&[F32x8], &[F32x8], usize, &[F32x8]) {
+        (&self.rest, &self.stored, self.stored_len, &self.own_tilde)
     }
 
     /// What the element at (batch, lane) stores.

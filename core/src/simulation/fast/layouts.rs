@@ -14,7 +14,7 @@ use glam::Vec3A;
 /// particles), or one that some bodies of the scene do not take
 /// ([`crate::scene::SceneBody::constraints`]); each such has its own.
 #[derive(Default)]
-pub(super) struct Layouts {
+pub(in crate::simulation) struct Layouts {
     edges: Layout,
     tets: Layout,
     tet_vertices: Layout,
@@ -100,7 +100,7 @@ impl Layouts {
     ///
     /// # Panics
     /// For a family on single particles that was not active when the layouts were built.
-    pub(super) fn of(&self, families: &Families, family: Family) -> &Layout {
+    pub(in crate::simulation) fn of(&self, families: &Families, family: Family) -> &Layout {
         if let Some((_, own)) = self.own.iter().find(|(f, _)| *f == family) {
             return own;
         }

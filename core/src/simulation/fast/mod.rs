@@ -35,10 +35,10 @@
 //! of what it was built for (the active families, the material, the threads), then writes
 //! positions, velocities and Δp back ([`FastSimulation::store`]).
 
-mod batches;
+pub(in crate::simulation) mod batches;
 mod family_batches;
 mod kernel;
-mod layouts;
+pub(in crate::simulation) mod layouts;
 mod morton;
 mod particles;
 mod readers;
@@ -113,60 +113,60 @@ pub struct FastSimulation {
     /// `origin + positions[i]`. It follows a body that travels far (thrown, falling), so that
     /// its f32 coordinates stay about its own size, and their precision its size's
     /// ([`FastSimulation::recentre`]).
-    origin: DVec3,
-    positions: Vec<Vec3A>,
-    previous: Vec<Vec3A>,
+    pub(in crate::simulation) origin: DVec3,
+    pub(in crate::simulation) positions: Vec<Vec3A>,
+    pub(in crate::simulation) previous: Vec<Vec3A>,
     /// What each position's f32 rounding left out: the particle is at `origin + positions[i] +
     /// residuals[i]`, and velocities come from that sum ([`integrate::Residuals`]).
-    residuals: Vec<Vec3A>,
+    pub(in crate::simulation) residuals: Vec<Vec3A>,
     /// [`FastSimulation::residuals`] at the start of the substep.
-    previous_residuals: Vec<Vec3A>,
-    velocities: Vec<Vec3A>,
+    pub(in crate::simulation) previous_residuals: Vec<Vec3A>,
+    pub(in crate::simulation) velocities: Vec<Vec3A>,
     /// The rest positions, for families whose formula reads the rest shape.
-    rest_positions: Vec<Vec3A>,
-    inverse_masses: Vec<f32>,
+    pub(in crate::simulation) rest_positions: Vec<Vec3A>,
+    pub(in crate::simulation) inverse_masses: Vec<f32>,
     /// The scene's number of each particle, by new number.
     original: Vec<u32>,
     /// The new number of each particle, by the scene's number.
-    renumber: Vec<u32>,
+    pub(in crate::simulation) renumber: Vec<u32>,
     /// The elements the active families bind to, coloured and in batches.
-    layouts: Layouts,
+    pub(in crate::simulation) layouts: Layouts,
     /// The rest values and multipliers of each active family (the others are left empty).
-    sets: PerFamily<Batches>,
+    pub(in crate::simulation) sets: PerFamily<Batches>,
     /// The order each family's colours are projected in: empty for the layout's order,
     /// otherwise a permutation drawn from [`crate::simulation::Settings::order_seed`].
-    colour_orders: PerFamily<Vec<u32>>,
+    pub(in crate::simulation) colour_orders: PerFamily<Vec<u32>>,
     tets: usize,
     jacobi: Option<Jacobi>,
     /// The threads large colours are shared with, kept for the simulation's life (none: one).
     team: Option<Team>,
     timings: Timings,
     /// Projections skipped for a counted reason since the last [`Engine::step`].
-    skipped: PerFamily<SkipCounts>,
-    frame: u64,
+    pub(in crate::simulation) skipped: PerFamily<SkipCounts>,
+    pub(in crate::simulation) frame: u64,
     /// Δp of the last substep and its sum over the frame, when a frame asks for them; the
     /// predicted positions they are measured from. Empty until then.
-    corrections: Corrections,
+    pub(in crate::simulation) corrections: Corrections,
     /// The external forces in N by new number ([`crate::simulation::Simulation::set_forces`]);
     /// empty: none.
-    forces: Vec<Vec3A>,
+    pub(in crate::simulation) forces: Vec<Vec3A>,
     /// Whether every particle keeps its z ([`crate::simulation::Simulation::set_plane_strain`]).
-    plane_strain: bool,
+    pub(in crate::simulation) plane_strain: bool,
     /// The ground's moves of each particle within the substep (`integrate::Book`).
     pushes: Vec<Vec3A>,
     /// Per particle, what the ground, damping and the settling cap took within the frame (J),
     /// summed in order once a frame ([`crate::simulation::Taken`]), so for any thread count.
-    taken: Vec<Vec3A>,
+    pub(in crate::simulation) taken: Vec<Vec3A>,
     /// The frame's contact pairs in the new numbering, and their multipliers.
     contacts: (Vec<[u32; 4]>, Vec<f32>),
 }
 
 /// Δp per particle (new numbering), kept on request.
 #[derive(Clone, Debug, Default)]
-struct Corrections {
-    predicted: Vec<Vec3A>,
-    last: Vec<Vec3A>,
-    frame: Vec<Vec3A>,
+pub(in crate::simulation) struct Corrections {
+    pub(in crate::simulation) predicted: Vec<Vec3A>,
+    pub(in crate::simulation) last: Vec<Vec3A>,
+    pub(in crate::simulation) frame: Vec<Vec3A>,
 }
 
 impl FastSimulation {
@@ -272,7 +272,7 @@ impl FastSimulation {
     /// Brings the engine up to `frame`: built again when the body or what it was built for
     /// changed, the state taken up again when it was edited, and the settings of the frame in
     /// force (a new order seed puts the colours in its order).
-    fn prepare(&mut self, frame: &Frame<'_>) {
+    pub(in crate::simulation) fn prepare(&mut self, frame: &Frame<'_>) {
         let wanted = BuiltFor {
             body: frame.revision.body,
             active: frame.resolved.active,
@@ -420,7 +420,7 @@ impl FastSimulation {
     /// ground, at y = −origin.y in these coordinates, stays exact in f32 up to 2¹⁴ body sizes
     /// away. A body within its own size of the origin (every body at rest near the scene's
     /// origin) is never moved, and its bits never change.
-    fn recentre(&mut self) {
+    pub(in crate::simulation) fn recentre(&mut self) {
         let (low, high) = self.positions.iter().fold(
             (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
             |(low, high), p| (low.min(*p), high.max(*p)),
