@@ -544,7 +544,7 @@ fn the_engine_is_chosen_and_always_named() {
     ]);
     let text = stdout(&output);
     assert!(text.contains("engine fast (f32, 2 threads)"), "{text}");
-    assert_usage_error(&tetlab(&["run", "--engine", "gpu"]), "--engine");
+    assert_usage_error(&tetlab(&["run", "--engine", "cuda"]), "--engine");
     assert_usage_error(&tetlab(&["run", "--threads", "0"]), "--threads");
 }
 
