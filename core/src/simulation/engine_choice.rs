@@ -20,7 +20,7 @@ pub enum EngineChoice {
     /// scenes.
     Newton,
     /// The fast engine's model on a GPU, in WGSL compute shaders on wgpu
-    /// ([`super::gpu`], with the feature `gpu`): where a GPU can be had
+    /// (`simulation::gpu`, with the feature `gpu`): where a GPU can be had
     /// ([`EngineChoice::available`]).
     Gpu,
 }
@@ -62,43 +62,6 @@ impl EngineChoice {
     /// ```
     pub fn position_based() -> impl Iterator<Item = EngineChoice> {
         EngineChoice::engines().filter(|&e| !matches!(e, EngineChoice::Newton | EngineChoice::Gpu))
-    }
-
-    /// Whether this choice can run here: every engine but the GPU's always can; that one needs
-    /// the feature `gpu` and an adapter (a software one, such as Mesa's lavapipe, will do).
-    /// The error says why not, in a line.
-    pub fn available(self) -> Result<(), String> {
-        match self {
-            #[cfg(feature = "gpu")]
-            EngineChoice::Gpu => super::gpu::gpu().map(|_| ()),
-            #[cfg(not(feature = "gpu"))]
-            EngineChoice::Gpu => Err("this build of tetlab has no GPU engine".to_owned()),
-            _ => Ok(()),
-        }
-    }
-
-    /// Whether a test of this engine can run here ([`EngineChoice::available`]); where it
-    /// cannot, the test returns early, and this says why on stderr (past the test harness's
-    /// capture).
-    ///
-    /// # Panics
-    /// Under CI (`CI=true`), which installs Mesa's software Vulkan, when it cannot.
-    pub fn for_test(self) -> bool {
-        use std::io::Write;
-        let Err(why) = self.available() else {
-            return true;
-        };
-        assert!(
-            !crate::input::shared_meshes::in_ci(),
-            "CI=true, and the {} engine's tests must run, but it cannot here: {why}",
-            self.name()
-        );
-        let _ = writeln!(
-            std::io::stderr(),
-            "skipped: the {} engine cannot run here ({why})",
-            self.name()
-        );
-        false
     }
 
     /// Its name on the command line, in files and links: `auto`, `reference`, `fast`,
@@ -184,12 +147,6 @@ impl EngineChoice {
             }
             EngineChoice::Auto | EngineChoice::Reference => "reference (f64)".to_owned(),
             EngineChoice::Newton => "newton (f64, implicit Euler to 1e-10)".to_owned(),
-            #[cfg(feature = "gpu")]
-            EngineChoice::Gpu => match super::gpu::gpu() {
-                Ok(gpu) => format!("gpu (f32, {})", gpu.describe()),
-                Err(_) => "gpu (f32, no GPU here)".to_owned(),
-            },
-            #[cfg(not(feature = "gpu"))]
             EngineChoice::Gpu => "gpu (f32)".to_owned(),
         }
     }

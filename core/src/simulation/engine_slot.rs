@@ -1,12 +1,67 @@
 //! How a simulation holds its engine ([`EngineSlot`]): built on the first frame from the settings'
 //! choice (or from an engine given by code), built again when the choice changes, and not copied
-//! with the simulation. [`build`] is the one place a choice becomes an engine.
+//! with the simulation. [`build`] is the one place a choice becomes an engine, and
+//! [`EngineChoice::available`] the one place that asks whether it can run here.
 
 use super::EngineChoice;
 use super::engine::{Build, Engine, Start};
 use super::fast::FastSimulation;
 use super::newton::NewtonEngine;
 use super::reference::ReferenceEngine;
+
+/// Whether a choice can run here: asked of the engines themselves, so that the list of
+/// choices (`engine_choice.rs`, which the settings hold) depends on none of them.
+impl EngineChoice {
+    /// Whether this choice can run here: every engine but the GPU's always can; that one needs
+    /// the feature `gpu` and an adapter (a software one, such as Mesa's lavapipe, will do).
+    /// The error says why not, in a line.
+    pub fn available(self) -> Result<(), String> {
+        match self {
+            #[cfg(feature = "gpu")]
+            EngineChoice::Gpu => super::gpu::gpu().map(|_| ()),
+            #[cfg(not(feature = "gpu"))]
+            EngineChoice::Gpu => Err("this build of tetlab has no GPU engine".to_owned()),
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether a test of this engine can run here ([`EngineChoice::available`]); where it
+    /// cannot, the test returns early, and this says why on stderr (past the test harness's
+    /// capture).
+    ///
+    /// # Panics
+    /// Under CI (`CI=true`), which installs Mesa's software Vulkan, when it cannot.
+    pub fn for_test(self) -> bool {
+        use std::io::Write;
+        let Err(why) = self.available() else {
+            return true;
+        };
+        assert!(
+            !crate::input::shared_meshes::in_ci(),
+            "CI=true, and the {} engine's tests must run, but it cannot here: {why}",
+            self.name()
+        );
+        let _ = writeln!(
+            std::io::stderr(),
+            "skipped: the {} engine cannot run here ({why})",
+            self.name()
+        );
+        false
+    }
+}
+
+/// What the front ends show of `choice`'s engine on `threads` threads before it is built
+/// ([`EngineChoice::describe`]), the GPU engine's with its adapter.
+pub(super) fn describe(choice: EngineChoice, threads: usize) -> String {
+    match choice {
+        #[cfg(feature = "gpu")]
+        EngineChoice::Gpu => match super::gpu::gpu() {
+            Ok(gpu) => format!("gpu (f32, {})", gpu.describe()),
+            Err(_) => "gpu (f32, no GPU here)".to_owned(),
+        },
+        _ => choice.describe(threads),
+    }
+}
 
 /// How the engine of `choice` is made; [`EngineChoice::Auto`] is resolved by the size of the
 /// scene first ([`EngineChoice::resolve`]).

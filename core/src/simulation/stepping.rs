@@ -128,7 +128,7 @@ impl Simulation {
                 engine.describe()
             }
             (None, Some((_, name))) => name.to_owned(),
-            _ => self.engine().describe(self.threads),
+            _ => super::engine_slot::describe(self.engine(), self.threads),
         }
     }
 
