@@ -368,6 +368,7 @@ impl Layout {
 
     /// Its rows as the GPU engine uploads them: each batch's particles and their inverse masses
     /// (rows b·N + i, lane by lane, N its arity) and each batch's sizes (row b).
+    #[cfg(feature = "gpu")]
     pub(in crate::simulation) fn rows(&self) -> (&[[u32; LANES]], &[F32x8], &[F32x8]) {
         (&self.particles, &self.weights, &self.size)
     }
@@ -625,6 +626,7 @@ impl Batches {
     /// Its rows as the GPU engine uploads them: the rest values (a row per batch), what the
     /// elements store (`stored_len` rows per batch), that length, and the own α̃ (a row per
     /// batch, NaN: the family's; empty where none has one).
+    #[cfg(feature = "gpu")]
     pub(in crate::simulation) fn uploaded(&self) -> (&[F32x8], &[F32x8], usize, &[F32x8]) {
         (&self.rest, &self.stored, self.stored_len, &self.own_tilde)
     }
