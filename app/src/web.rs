@@ -28,7 +28,10 @@ pub fn start() {
         let started = eframe::WebRunner::new()
             .start(
                 canvas,
-                eframe::WebOptions::default(),
+                eframe::WebOptions {
+                    wgpu_options: crate::gui::shared_device::wgpu_options(),
+                    ..eframe::WebOptions::default()
+                },
                 Box::new(|cc| {
                     Ok(Box::new(TetlabApp::new(cc, Box::new(Page))?) as Box<dyn eframe::App>)
                 }),

@@ -22,9 +22,12 @@
 //! on both engines in `core/tests/lessons.rs`. The scenes on `../shared/meshes` skip without it
 //! (and fail under CI).
 
+#[path = "support/contract.rs"]
+mod contract;
 #[path = "support/reversed_engine.rs"]
 mod reversed_engine;
 
+use contract::{UNIT_ROUNDOFF, frame_bound, largest_gap};
 use glam::DVec3;
 use reversed_engine::Reversed;
 use tetlab_core::constraints::{Family, PerFamily};
@@ -229,26 +232,6 @@ impl Claim {
         }
         simulation
     }
-}
-
-fn largest_gap(a: &[DVec3], b: &[DVec3]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (*x - *y).length())
-        .fold(0.0, f64::max)
-}
-
-/// f32's unit roundoff, 2⁻²⁴.
-const UNIT_ROUNDOFF: f64 = 1.0 / 16_777_216.0;
-
-/// How far apart the engines' positions may be after one frame of `substeps` substeps, for a
-/// body of size `size` (docs/performance.md, "The engines' contract"): each substep's f32
-/// projections leave a rounding error of about u·L in a position, which becomes an error of
-/// u·L / h in the velocity taken from it, carried through the substeps that remain. With every
-/// substep's error in one direction, that sums to u·L·S²/2 over a frame of S substeps.
-fn frame_bound(size: f64, substeps: u32) -> f64 {
-    let s = substeps.max(1) as f64;
-    UNIT_ROUNDOFF * size * s * s / 2.0
 }
 
 /// The bounds a position bound `b` sets on the metrics: an edge's strain changes by at most

@@ -12,9 +12,16 @@
 //!   engine, in the table's order and under an order seed.
 //! - **The same bits run to run**, and the skips counted as the fast engine counts them.
 //! - **A frame with contact** runs on the CPU, says so, and gives the fast engine's bits.
+//! - **The page's engine**, which never waits for the GPU (a frame started in one call and
+//!   finished in a later one), gives the same bits as the desktop's, an edit made while a frame
+//!   is under way included.
 //!
 //! Without an adapter these tests skip, saying so; under `CI=true` they must run.
 
+#[path = "support/contract.rs"]
+mod contract;
+
+use contract::{frame_bound, largest_gap};
 use glam::DVec3;
 use std::path::Path;
 use tetlab_core::constraint_file::ConstraintFile;
@@ -23,23 +30,6 @@ use tetlab_core::measures::metrics::Metrics;
 use tetlab_core::measures::outcome::Outcome;
 use tetlab_core::scene::{Builtin, Perturbation, Scene};
 use tetlab_core::simulation::{EngineChoice, Method, Settings, Simulation};
-
-/// f32's unit roundoff, 2⁻²⁴.
-const UNIT_ROUNDOFF: f64 = 1.0 / 16_777_216.0;
-
-/// The engines' contract: after one frame of `substeps` substeps, positions within u·L·S²/2 of
-/// each other for a body of size L (core/tests/engine_matrix.rs derives it).
-fn frame_bound(size: f64, substeps: u32) -> f64 {
-    let s = f64::from(substeps.max(1));
-    UNIT_ROUNDOFF * size * s * s / 2.0
-}
-
-fn largest_gap(a: &[DVec3], b: &[DVec3]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (*x - *y).length())
-        .fold(0.0, f64::max)
-}
 
 fn cube() -> Scene {
     Scene::builtin(Builtin::Cube, 4).unwrap()
@@ -353,4 +343,63 @@ fn a_frame_with_contact_runs_on_the_cpu_and_says_so() {
     let ((fast, _), (gpu, described)) = (run(EngineChoice::Fast), run(EngineChoice::Gpu));
     assert!(described.contains("contact runs on the CPU"), "{described}");
     assert_eq!(fast, gpu);
+}
+
+/// The page's GPU engine returns from a step once the frame is submitted; the frame finishes
+/// in a later step. Its frames are the desktop's to the bit, and an edit made while one is under
+/// way (here the mirror perturbation, during frame 3) is the state the frame is stepped from, as
+/// an edit made before it is on the desktop.
+#[cfg(feature = "gpu")]
+#[test]
+fn the_engine_that_never_waits_gives_the_same_bits() {
+    use tetlab_core::simulation::gpu::GpuEngine;
+    if !EngineChoice::Gpu.for_test() {
+        return;
+    }
+    let scene = cube();
+    let new = |build: tetlab_core::simulation::Build| {
+        let mut simulation =
+            Simulation::new(&scene, settings("edges,height,volume", EngineChoice::Fast));
+        simulation.use_engine(build, "gpu");
+        simulation
+    };
+    let mut desktop = new(|start| Box::new(GpuEngine::new(start)));
+    let mut page = new(|start| Box::new(GpuEngine::asynchronous(start)));
+    let mut calls_pending = 0;
+    for frame in 0..4u64 {
+        let edit: fn(&mut Simulation) = match frame {
+            2 => |s| s.perturb(Perturbation::Mirror),
+            _ => untouched,
+        };
+        let before = page.positions().to_vec();
+        page.step();
+        assert!(page.pending(), "frame {frame}: the page's engine waited");
+        assert_eq!(
+            page.positions(),
+            before,
+            "a pending frame changed the state"
+        );
+        edit(&mut page);
+        while page.pending() || page.frame() == frame {
+            assert!(calls_pending < 1_000_000, "the frame never finished");
+            calls_pending += 1;
+            page.step();
+        }
+        edit(&mut desktop);
+        desktop.step();
+        assert!(!desktop.pending());
+        assert_eq!(page.frame(), desktop.frame());
+        assert_eq!(page.positions(), desktop.positions(), "after frame {frame}");
+        assert_eq!(
+            page.velocities(),
+            desktop.velocities(),
+            "after frame {frame}"
+        );
+    }
+    println!("{calls_pending} calls found a frame under way");
+    assert!(
+        page.describe_engine().starts_with("gpu (f32"),
+        "{}",
+        page.describe_engine()
+    );
 }

@@ -8,7 +8,8 @@
 // Modes window of that tet), Space (it recovers), M (every tet inverted), drop a lesson file and
 // go to its next step (its checks are read), drop a Gmsh mesh (it loads), drop a broken mesh (the page shows the error); each
 // exercise graded (a wrong answer dropped, then a right one); lesson 6 on the bunny the page
-// fetched; a shipped scene with contact on played (the upper cube rests on the lower); then every built-in lesson's steps done and their checks read (TETLAB_WEB_LESSONS=0
+// fetched, then on the GPU engine (a second browser, with WebGPU) and on its fallback (a link
+// asking for it without WebGPU); a shipped scene with contact on played (the upper cube rests on the lower); then every built-in lesson's steps done and their checks read (TETLAB_WEB_LESSONS=0
 // leaves that part out).
 
 import puppeteer from "puppeteer-core";
@@ -23,21 +24,36 @@ if (!url || !shots) {
 }
 fs.mkdirSync(shots, { recursive: true });
 
-const browser = await puppeteer.launch({
-  executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
-  headless: true,
-  userDataDir: fs.mkdtempSync(path.join(os.tmpdir(), "tetlab-chromium-")),
-  defaultViewport: { width: 1280, height: 800 },
-  args: [
-    "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--disable-quic",
-    "--enable-unsafe-swiftshader", "--window-size=1280,800",
-  ],
-});
-const page = await browser.newPage();
+// Chromium without a GPU: no WebGPU, and eframe draws with WebGL2 (ANGLE on SwiftShader).
+const NO_WEBGPU = ["--disable-gpu"];
+// Chromium's WebGPU on SwiftShader, through Vulkan: the page draws with WebGPU and the GPU engine
+// runs on that device. (With only --use-webgpu-adapter=swiftshader the device is lost as soon as
+// a frame is presented on the canvas, headless.)
+const WEBGPU = ["--enable-unsafe-webgpu", "--use-angle=vulkan", "--enable-features=Vulkan",
+  "--use-vulkan=swiftshader", "--use-webgpu-adapter=swiftshader"];
+const browsers = [];
 const consoleLines = [];
-page.on("console", (message) => consoleLines.push(message.text()));
-page.on("pageerror", (error) => consoleLines.push(`page error: ${error.message}`));
+
+/// A headless Chromium with `flags`, and a page in it whose console is kept.
+async function open(flags) {
+  const browser = await puppeteer.launch({
+    executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
+    headless: true,
+    userDataDir: fs.mkdtempSync(path.join(os.tmpdir(), "tetlab-chromium-")),
+    defaultViewport: { width: 1280, height: 800 },
+    args: [
+      "--no-sandbox", "--no-first-run", "--disable-background-networking",
+      "--disable-component-update", "--disable-sync", "--disable-quic",
+      "--enable-unsafe-swiftshader", "--window-size=1280,800", ...flags,
+    ],
+  });
+  browsers.push(browser);
+  const page = await browser.newPage();
+  page.on("console", (message) => consoleLines.push(message.text()));
+  page.on("pageerror", (error) => consoleLines.push(`page error: ${error.message}`));
+  return page;
+}
+let page = await open(NO_WEBGPU);
 
 let failed = false;
 let shot = 0;
@@ -98,9 +114,28 @@ const EXERCISES = [
     wrong: (text) => (text + GRADIENT).replace('p3 = "cross(e1, e2) / (6 * rest)"', 'p3 = "cross(e1, e2) / 6"') },
 ];
 
+/// Plays the lesson opened (Space) and returns the median of the step times (the readouts' "step
+/// time") of `frames` frames.
+async function medianStep(frames) {
+  await page.keyboard.press("Space");
+  const times = [];
+  let last = -1;
+  const deadline = Date.now() + 120000;
+  while (times.length < frames && Date.now() < deadline) {
+    const s = await state();
+    if (s && s.playing && s.frame !== last && s.step_ms > 0) {
+      times.push(s.step_ms);
+      last = s.frame;
+    }
+    await new Promise((resolve) => setTimeout(resolve, 20));
+  }
+  times.sort((a, b) => a - b);
+  return { median: times[Math.floor(times.length / 2)], frames: times.length };
+}
+
 /// Does the lesson's current step (Enter) and waits until its frames are played; every check
 /// must then hold.
-async function doStep(name) {
+async function doStep(name, seconds = 180) {
   await page.keyboard.press("Enter");
   const deadline = Date.now() + 3000;
   while (Date.now() < deadline) {
@@ -109,7 +144,7 @@ async function doStep(name) {
     await new Promise((resolve) => setTimeout(resolve, 50));
   }
   const done = await expect(`${name}-done`,
-    (s) => s.lesson.frames_left === 0 && s.lesson.checks.every((c) => c.holds), 180);
+    (s) => s.lesson.frames_left === 0 && s.lesson.checks.every((c) => c.holds), seconds);
   for (const check of done?.lesson?.checks ?? []) {
     console.log(`     ${check.holds ? "holds" : "FAILS"}: ${check.expect}`);
   }
@@ -241,23 +276,43 @@ try {
       await page.goto("about:blank");
       await page.goto(`${url}${build}#lesson=6`);
       await expect(`lesson-6${build}-opened`, (s) => s.lesson && s.tets === 1351, 60);
-      await page.keyboard.press("Space");
-      const times = [];
-      let last = -1;
-      const deadline = Date.now() + 60000;
-      while (times.length < 30 && Date.now() < deadline) {
-        const s = await state();
-        if (s && s.playing && s.frame !== last && s.step_ms > 0) {
-          times.push(s.step_ms);
-          last = s.frame;
-        }
-        await new Promise((resolve) => setTimeout(resolve, 20));
-      }
-      times.sort((a, b) => a - b);
-      const median = times[Math.floor(times.length / 2)];
+      const { median, frames } = await medianStep(30);
       console.log(`     lesson 6 (the bunny), ${build ? "without SIMD" : "with SIMD"}: ` +
-        `${median?.toFixed(2)} ms a step, median of ${times.length} frames`);
+        `${median?.toFixed(2)} ms a step, median of ${frames} frames`);
     }
+
+    // The GPU engine. Without WebGPU (this browser) a link that asks for it opens on the CPU's
+    // engine and says so; the lesson's first step passes its checks there.
+    await page.goto("about:blank");
+    await page.goto(`${url}#lesson=6&engine=gpu`);
+    const fallback = await expect("lesson-6-gpu-link-without-webgpu", (s) => s.lesson &&
+      s.tets === 1351 && s.engine.startsWith("fast") && s.notice?.includes("cannot run here"), 60);
+    console.log(`     engine: ${fallback?.engine}; notice: ${fallback?.notice}`);
+    await doStep("lesson-6-step-1-on-the-cpu-fallback");
+    // With WebGPU (a second browser) the page draws with it and the GPU engine runs on the same
+    // device: the lesson's first step, 150 frames, passes its checks on it.
+    const withoutWebGpu = page;
+    page = await open(WEBGPU);
+    await page.goto(`${url}#lesson=6&engine=gpu`);
+    const onGpu = await expect("lesson-6-on-webgpu", (s) => s.lesson && s.tets === 1351 &&
+      s.engine.startsWith("gpu (f32, WebGPU"), 60);
+    console.log(`     engine: ${onGpu?.engine}`);
+    await doStep("lesson-6-step-1-on-the-gpu-engine", 600);
+    const after = await state();
+    if (!after?.engine?.startsWith("gpu (f32, WebGPU")) {
+      console.log(`FAIL lesson 6 left the GPU engine: ${after?.engine}`);
+      failed = true;
+    }
+    // Its step time on WebGPU against the CPU engine's in the same browser, for docs/web.md.
+    for (const engine of ["gpu", "fast"]) {
+      await page.goto("about:blank");
+      await page.goto(`${url}#lesson=6&engine=${engine}`);
+      await expect(`lesson-6-on-webgpu-${engine}-opened`, (s) => s.lesson && s.tets === 1351, 60);
+      const { median, frames } = await medianStep(20);
+      console.log(`     lesson 6 in a page on WebGPU (SwiftShader), ${engine} engine: ` +
+        `${median?.toFixed(2)} ms a step, median of ${frames} frames`);
+    }
+    page = withoutWebGpu;
   } else if (process.env.CI === "true") {
     console.log("FAIL lesson 6: ../shared/meshes/bunny.node is not beside the repository, and CI must have it");
     failed = true;
@@ -302,7 +357,7 @@ try {
   console.log(`FAIL ${error.stack ?? error}`);
   failed = true;
 } finally {
-  await browser.close();
+  for (const browser of browsers) await browser.close();
 }
 if (failed) {
   console.log("the page's console:");

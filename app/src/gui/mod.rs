@@ -18,6 +18,7 @@ pub mod preferences;
 pub mod render;
 pub mod report;
 pub mod request;
+pub mod shared_device;
 pub mod shortcuts;
 pub mod vertices;
 pub mod viewport;
@@ -41,6 +42,7 @@ pub fn run_native() -> Result<(), String> {
             .with_inner_size([1280.0, 800.0])
             .with_drag_and_drop(true),
         renderer: eframe::Renderer::Wgpu,
+        wgpu_options: shared_device::wgpu_options(),
         ..Default::default()
     };
     eframe::run_native(

@@ -24,6 +24,8 @@ pub struct Report {
     pub playing: bool,
     /// The error shown, if any.
     pub error: Option<String>,
+    /// The notice shown, if any (a link's engine that cannot run here, and what runs instead).
+    pub notice: Option<String>,
     /// The lesson open, if any.
     pub lesson: Option<LessonReport>,
     /// The selected tet's selected corner and the centre of its opposite face, in the page's
@@ -165,6 +167,7 @@ impl TetlabApp {
             frame: bench.simulation.frame(),
             playing: bench.playing,
             error: self.error.clone(),
+            notice: self.notice.clone(),
             lesson,
             drag: self.drag_report(),
             modes: self.modes_report(),

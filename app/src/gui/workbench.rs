@@ -233,12 +233,18 @@ impl Workbench {
         true
     }
 
-    /// Advances one frame.
+    /// Advances one frame. On the page's GPU engine a call may only start the frame
+    /// ([`Simulation::pending`](tetlab_core::simulation::Simulation::pending)): nothing changes
+    /// until a later call finishes it, and the watches read the state the frame started from
+    /// then (it is the same, or the edit made since, from which the frame is stepped again).
     pub fn step_frame(&mut self) {
         self.leave_step_mode();
         let before = self.exact_step.then(|| self.simulation.clone());
         self.energy_watch.before_frame(&self.simulation);
         self.simulation.step();
+        if self.simulation.pending() {
+            return;
+        }
         self.energy_warning = self.energy_watch.after_frame(&self.simulation);
         self.exact_step_gap = before.map(|before| ExactStepGap::measure(&before, &self.simulation));
         // The engine that just stepped is ready: asking for it builds nothing.

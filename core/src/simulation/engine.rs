@@ -26,6 +26,16 @@ pub trait Engine: Send {
     /// ([`crate::simulation::projection::Skipped`]).
     fn step(&mut self, frame: Frame<'_>) -> PerFamily<SkipCounts>;
 
+    /// Whether the frame the last [`Engine::step`] began is still under way. An engine that
+    /// cannot wait for its results (the GPU engine in a page: a browser hands a GPU's results
+    /// over only between two of the page's frames) returns from `step` once the frame is
+    /// started, with the state as it was, and finishes it in a later `step` of the same frame;
+    /// [`super::Simulation::step`] counts the frame only then. Every other engine finishes a
+    /// frame in the call that began it.
+    fn pending(&self) -> bool {
+        false
+    }
+
     /// What the front ends show: "reference (f64)", "fast (f32, 2 threads)".
     fn describe(&self) -> String;
 

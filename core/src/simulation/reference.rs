@@ -8,7 +8,7 @@ use super::engine::{Engine, Frame};
 use super::integrate;
 use super::projection::{Correction, Rule, SkipCounts, correct_in_reach};
 use super::state::{Body, State};
-use super::substep::{self, GrabbedParticle, Plan, Substeps};
+use super::substep::{self, Plan, Substeps};
 use crate::constraints::{
     Evaluation, Families, Family, PerFamily, Projected, SubstepStart, Unit, VisitProjected,
 };
@@ -161,11 +161,18 @@ impl Substeps for OnState<'_> {
         self.project_which(unit, Which::All, plan);
     }
 
-    fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_> {
+    fn soft_grab(&mut self, particle: usize, target: DVec3, compliance: f64, h: f64) {
         let s = &mut *self.state;
         let grab = s.grab.as_mut().expect("a grab is held");
         let w = s.inverse_masses[particle];
-        GrabbedParticle::F64(&mut s.positions[particle], w, &mut grab.lambda)
+        let alpha = compliance / (h * h);
+        substep::pull(
+            &mut s.positions[particle],
+            w,
+            &mut grab.lambda,
+            target,
+            alpha,
+        );
     }
 
     fn ground_and_plane(&mut self, plan: &Plan) {

@@ -14,6 +14,10 @@ use glam::DVec3;
 impl Simulation {
     /// Advances one frame: `substeps` substeps of Δt / substeps, on the engine of
     /// [`Simulation::engine`].
+    ///
+    /// On an engine that does not wait for the GPU (the GPU engine in a page), a call may only
+    /// start the frame: then [`Simulation::pending`] is true, nothing has changed, and a later
+    /// call finishes it ([`Engine::pending`]).
     pub fn step(&mut self) {
         self.refresh_inverse_masses();
         self.state.frame_corrections.fill(DVec3::ZERO);
@@ -38,7 +42,11 @@ impl Simulation {
             threads: self.threads,
             settling,
         });
+        let pending = engine.pending();
         self.engine = slot;
+        if pending {
+            return;
+        }
         for family in self.families.all() {
             self.skipped[family] = self.skipped[family] + skipped[family];
         }
@@ -55,6 +63,12 @@ impl Simulation {
         }
         self.frame += 1;
         self.time += self.settings.dt;
+    }
+
+    /// Whether a frame [`Simulation::step`] started is still under way (the GPU engine in a
+    /// page): the state is the one before it until a later `step` finishes it.
+    pub fn pending(&self) -> bool {
+        (self.engine.built.as_ref()).is_some_and(|(_, engine)| engine.pending())
     }
 
     /// The contact pairs of the coming frame, from where the particles are and how fast they

@@ -129,7 +129,7 @@ impl Plan {
 /// ```text
 /// impl Substeps for Backwards<'_> {
 ///     tetlab_core::forward_stages!(on: predict, hold, keep_predicted, reset_multipliers,
-///         grabbed, ground_and_plane, keep_corrections, update_velocities);
+///         soft_grab, ground_and_plane, keep_corrections, update_velocities);
 ///     fn project(&mut self, unit: Unit, plan: &Plan) { /* its own order */ }
 /// }
 /// ```
@@ -172,9 +172,9 @@ macro_rules! forward_stages {
             self.$on.contacts(plan);
         }
     };
-    (@stage $on:ident grabbed) => {
-        fn grabbed(&mut self, particle: usize) -> $crate::simulation::substep::GrabbedParticle<'_> {
-            self.$on.grabbed(particle)
+    (@stage $on:ident soft_grab) => {
+        fn soft_grab(&mut self, particle: usize, target: ::glam::DVec3, compliance: f64, h: f64) {
+            self.$on.soft_grab(particle, target, compliance, h);
         }
     };
     (@stage $on:ident ground_and_plane) => {
@@ -225,38 +225,16 @@ pub trait Substeps {
     /// Projects every pair of [`Plan::contact`] by each family that binds to contacts, with
     /// friction (`contact::project`); called only when there is a contact plan.
     fn contacts(&mut self, plan: &Plan);
-    /// The position of `particle`, its inverse mass, and the compliant grab's multiplier, to
-    /// be projected towards a target (`project_soft_grab`).
-    fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_>;
     /// The compliant grab: `particle` pulled towards `target` (in the scene's frame) by a
-    /// zero-length XPBD constraint of compliance `compliance`, in a substep of length `h`; by
-    /// default on the particle [`Substeps::grabbed`] gives (`project_soft_grab`). An engine whose
-    /// particles are elsewhere (the GPU's) records it there.
-    fn soft_grab(&mut self, particle: usize, target: DVec3, compliance: f64, h: f64)
-    where
-        Self: Sized,
-    {
-        let target = self.target(target);
-        project_soft_grab(self.grabbed(particle), target, compliance, h);
-    }
-    /// Where `target` (in the scene's frame) is in the engine's coordinates.
-    fn target(&self, target: DVec3) -> DVec3 {
-        target
-    }
+    /// zero-length XPBD constraint of compliance `compliance`, in a substep of length `h`
+    /// (`pull`, in the engine's precision and coordinates; the GPU engine records it).
+    fn soft_grab(&mut self, particle: usize, target: DVec3, compliance: f64, h: f64);
     /// y ≥ 0 for every free particle, then the plane-strain hold on x.
     fn ground_and_plane(&mut self, plan: &Plan);
     /// Δp = x − predicted x, and its sum over the frame.
     fn keep_corrections(&mut self);
     /// v = (x − x_prev) / h, damped, and capped while an edit settles.
     fn update_velocities(&mut self, plan: &Plan);
-}
-
-/// A grabbed particle as an engine holds it, in its own precision.
-pub enum GrabbedParticle<'a> {
-    /// In f64 (the reference engine).
-    F64(&'a mut DVec3, f64, &'a mut f64),
-    /// In f32 (the fast engine).
-    F32(&'a mut glam::Vec3A, f32, &'a mut f32),
 }
 
 /// One frame: `substeps` substeps, each [`begin_substep`], the sweeps ([`Substeps::sweeps`]:
@@ -316,25 +294,6 @@ pub fn end_substep(engine: &mut impl Substeps, plan: &Plan, tracked: bool) {
         engine.keep_corrections();
     }
     engine.update_velocities(plan);
-}
-
-/// The compliant grab: a zero-length XPBD constraint between the particle and the target, with
-/// the grab's compliance, in the engine's precision.
-fn project_soft_grab(grabbed: GrabbedParticle<'_>, target: DVec3, compliance: f64, h: f64) {
-    match grabbed {
-        GrabbedParticle::F64(position, w, lambda) => {
-            pull(position, w, lambda, target, compliance / (h * h));
-        }
-        GrabbedParticle::F32(position, w, lambda) => {
-            pull(
-                position,
-                w,
-                lambda,
-                target.as_vec3a(),
-                (compliance / (h * h)) as f32,
-            );
-        }
-    }
 }
 
 /// One XPBD projection of |p − target| = 0 moving p alone (the target is fixed), without a

@@ -103,7 +103,7 @@ impl Rebuilding<'_> {
 
 impl Substeps for Rebuilding<'_> {
     tetlab_core::forward_stages!(on:
-        keep_predicted, reset_multipliers, contacts, project, grabbed, ground_and_plane, keep_corrections,
+        keep_predicted, reset_multipliers, contacts, project, soft_grab, ground_and_plane, keep_corrections,
         update_velocities);
 
     fn predict(&mut self, plan: &Plan) {

@@ -61,7 +61,7 @@ struct Backwards<'a> {
 
 impl Substeps for Backwards<'_> {
     tetlab_core::forward_stages!(on:
-        predict, hold, keep_predicted, reset_multipliers, contacts, grabbed, ground_and_plane,
+        predict, hold, keep_predicted, reset_multipliers, contacts, soft_grab, ground_and_plane,
         keep_corrections, update_velocities);
 
     fn project(&mut self, unit: Unit, plan: &Plan) {

@@ -55,20 +55,33 @@ impl TetlabApp {
     }
 
     /// Plays a frame of each simulation while playing, and counts down a lesson step's frames.
+    /// A frame under way (the page's GPU engine, whose results come back between two of the
+    /// page's frames) is carried on whether playing or not, and counts when it is done; its
+    /// step time runs from its start to then.
     fn advance(&mut self, ctx: &egui::Context) {
-        if !self.bench.playing {
+        let under_way = self.bench.simulation.pending();
+        if !self.bench.playing && !under_way {
             return;
         }
-        let started = Instant::now();
-        self.bench.step_frame();
-        self.step_time = started.elapsed();
-        if self.bench.pause_if_slow(self.step_time) {
-            self.set_playing(false);
+        if !under_way {
+            self.frame_started = Instant::now();
         }
+        let frame = self.bench.simulation.frame();
+        self.bench.step_frame();
+        // The right side starts a frame with the left one, and carries on one under way.
         if let Some(comparison) = &mut self.comparison
-            && comparison.bench.playing
+            && (comparison.bench.simulation.pending() || (comparison.bench.playing && !under_way))
         {
             comparison.bench.step_frame();
+        }
+        ctx.request_repaint();
+        if self.bench.simulation.frame() == frame {
+            return;
+        }
+
+        self.step_time = self.frame_started.elapsed();
+        if self.bench.pause_if_slow(self.step_time) {
+            self.set_playing(false);
         }
         if let Some(state) = &mut self.lesson
             && state.frames_left > 0
@@ -78,7 +91,6 @@ impl TetlabApp {
                 self.set_playing(false);
             }
         }
-        ctx.request_repaint();
     }
 
     /// A simulation that diverged (and went back to rest) is reported where errors are.

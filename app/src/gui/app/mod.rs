@@ -32,6 +32,7 @@ use super::{files, render};
 use std::time::Duration;
 use tetlab_core::constraints::PerFamily;
 use tetlab_core::scene::{Builtin, Perturbation, Scene, ShippedScene};
+use tetlab_core::simulation::EngineChoice;
 use tetlab_core::simulation::Settings;
 use tetlab_core::teaching::lesson::{Action as LessonAction, Lesson};
 use web_time::Instant;
@@ -54,6 +55,8 @@ pub struct TetlabApp {
     /// The last error to show (a mesh that did not load, …).
     pub error: Option<String>,
     pub(crate) step_time: Duration,
+    /// When the frame under way (or the last one) started.
+    frame_started: Instant,
     /// The time between the last two frames drawn, smoothed.
     frame_time: Duration,
     /// When the last frame was drawn.
@@ -130,6 +133,8 @@ impl TetlabApp {
             "tetlab: drawing with {:?}",
             render_state.adapter.get_info().backend
         ));
+        // Before anything asks whether the GPU engine can run.
+        platform.log(&super::shared_device::share_with_the_engine(render_state));
         install_fonts(&cc.egui_ctx);
         let preferences = cc.storage.map(Preferences::load).unwrap_or_default();
         // A page opened by a link shows the link's state, from the defaults.
@@ -140,6 +145,9 @@ impl TetlabApp {
             match &app.error {
                 Some(error) => platform.log(&format!("tetlab: link not opened: {error}")),
                 None => platform.log("tetlab: link opened"),
+            }
+            if let Some(notice) = &app.notice {
+                platform.log(&format!("tetlab: {notice}"));
             }
             app.platform = platform;
             return Ok(app);
@@ -170,6 +178,7 @@ impl TetlabApp {
                 format!("the remembered solver settings were refused ({why}); using the defaults")
             }),
             step_time: Duration::ZERO,
+            frame_started: Instant::now(),
             frame_time: Duration::ZERO,
             last_frame: None,
             frozen_timings: None,
@@ -448,7 +457,16 @@ impl TetlabApp {
                 None => {}
             }
         }
-        self.set_settings(link.settings);
+        let mut settings = link.settings;
+        if let Err(why) = settings.engine.available() {
+            // A link made where the GPU engine runs, opened where it cannot.
+            self.notice = Some(format!(
+                "the link's engine '{}' cannot run here ({why}): the CPU engines run instead",
+                settings.engine.name()
+            ));
+            settings.engine = EngineChoice::Auto;
+        }
+        self.set_settings(settings);
         for edit in link.edits {
             if let Err(why) = self.bench.apply_edit(edit) {
                 self.error = Some(format!("the link's edits: {why}; the later ones left out"));

@@ -8,7 +8,7 @@ use super::{Corrections, FastSimulation, Team, schedule};
 use crate::constraints::{Family, PerFamily, Projected, Unit, VisitProjected};
 use crate::simulation::integrate;
 use crate::simulation::projection::{Rule, SkipCounts};
-use crate::simulation::substep::{GrabbedParticle, Plan, Substeps};
+use crate::simulation::substep::{Plan, Substeps};
 use glam::{DVec3, Vec3A};
 use web_time::Instant;
 
@@ -150,18 +150,13 @@ impl Substeps for OnArrays<'_> {
         }
     }
 
-    fn grabbed(&mut self, particle: usize) -> GrabbedParticle<'_> {
+    fn soft_grab(&mut self, particle: usize, target: DVec3, compliance: f64, h: f64) {
+        let target = (target - self.simulation.origin).as_vec3a();
+        let alpha = (compliance / (h * h)) as f32;
         let s = &mut *self.simulation;
         let i = s.renumber[particle] as usize;
-        GrabbedParticle::F32(
-            &mut s.positions[i],
-            s.inverse_masses[i],
-            &mut self.grab_lambda,
-        )
-    }
-
-    fn target(&self, target: DVec3) -> DVec3 {
-        target - self.simulation.origin
+        let (w, lambda) = (s.inverse_masses[i], &mut self.grab_lambda);
+        crate::simulation::substep::pull(&mut s.positions[i], w, lambda, target, alpha);
     }
 
     fn ground_and_plane(&mut self, plan: &Plan) {

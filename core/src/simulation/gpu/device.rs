@@ -21,7 +21,12 @@ impl Gpu {
     /// What the front ends show of it, short enough for a readout: "NVIDIA H100 80GB HBM3",
     /// "llvmpipe, software" (the adapter's name up to its first parenthesis).
     pub fn describe(&self) -> String {
-        let name = self.info.name.split(" (").next().unwrap_or_default();
+        let name = match self.info.name.split(" (").next().unwrap_or_default() {
+            // A browser may keep the adapter's name to itself.
+            "" if self.info.backend == wgpu::Backend::BrowserWebGpu => "WebGPU",
+            "" => "unnamed adapter",
+            name => name,
+        };
         let software = if self.is_software() { ", software" } else { "" };
         format!("{name}{software}")
     }
@@ -90,14 +95,7 @@ fn request() -> Result<Gpu, String> {
         trace: wgpu::Trace::Off,
     }))
     .map_err(|e| format!("the GPU adapter {} gave no device: {e}", info.name))?;
-    // wgpu's default answer to an error is a panic: the engine keeps it, and gives its frames
-    // to the CPU instead ([`take_error`]).
-    device.on_uncaptured_error(Arc::new(|error| {
-        let mut kept = ERROR
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        kept.get_or_insert_with(|| error.to_string());
-    }));
+    keep_errors(&device);
     Ok(Gpu {
         device,
         queue,
@@ -105,7 +103,38 @@ fn request() -> Result<Gpu, String> {
     })
 }
 
+/// In a page the engine runs on the renderer's device where the browser gives it WebGPU
+/// ([`adopt`]), and there is no other to ask for: a page cannot wait for an adapter.
 #[cfg(target_arch = "wasm32")]
 fn request() -> Result<Gpu, String> {
-    Err("the GPU engine does not run in the page yet".to_owned())
+    Err("this browser gives the page no WebGPU (it draws with WebGL2)".to_owned())
+}
+
+/// wgpu's default answer to an error is a panic: the engine keeps the error instead, and gives
+/// its frames to the CPU ([`take_error`]).
+fn keep_errors(device: &wgpu::Device) {
+    device.on_uncaptured_error(Arc::new(|error| {
+        let mut kept = ERROR
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        kept.get_or_insert_with(|| error.to_string());
+    }));
+}
+
+/// Makes a window's or a page's device (the one its renderer draws with) the process's GPU,
+/// when none was asked for yet, so that the engine and the renderer share one device; returns
+/// whether it did. A GL device is not taken (its compute shaders are not the engine's
+/// target): [`gpu`] asks for a device of its own then, as it does without a window.
+pub fn adopt(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue) -> bool {
+    let info = adapter.get_info();
+    if info.backend == wgpu::Backend::Gl || GPU.get().is_some() {
+        return false;
+    }
+    keep_errors(device);
+    let gpu = Gpu {
+        device: device.clone(),
+        queue: queue.clone(),
+        info,
+    };
+    GPU.set(Ok(Arc::new(gpu))).is_ok()
 }

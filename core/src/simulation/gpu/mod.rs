@@ -25,7 +25,7 @@ mod memory;
 mod recorder;
 mod resident;
 
-pub use device::{Gpu, gpu};
+pub use device::{Gpu, adopt, gpu};
 
 use crate::constraints::material::Material;
 use crate::constraints::{Families, PerFamily, Unit};
@@ -33,12 +33,13 @@ use crate::simulation::engine::{Engine, Frame, Start};
 use crate::simulation::fast::FastSimulation;
 use crate::simulation::integrate::{Ending, Motion};
 use crate::simulation::projection::{Rule, SkipCounts};
+use crate::simulation::state::{Revision, State};
 use crate::simulation::substep::{self, Plan};
 use crate::simulation::{Divergence, Taken};
 use glam::Vec3A;
 use kernels::{Shape, slot};
 use recorder::Recorder;
-use resident::{COUNTERS, Resident};
+use resident::Resident;
 
 /// What the GPU side was built for: when one of these changes, it is built again.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,6 +93,11 @@ pub struct GpuEngine {
     on_cpu: Option<&'static str>,
     /// Dispatches recorded by the last frame.
     dispatches: u64,
+    /// The frame submitted whose results are on their way back.
+    in_flight: Option<InFlight>,
+    /// Whether [`Engine::step`] returns once a frame is submitted, without waiting for its
+    /// results ([`GpuEngine::asynchronous`]).
+    asynchronous: bool,
 }
 
 impl GpuEngine {
@@ -111,6 +117,20 @@ impl GpuEngine {
             own_h: f64::NAN,
             on_cpu: None,
             dispatches: 0,
+            in_flight: None,
+            asynchronous: cfg!(target_arch = "wasm32"),
+        }
+    }
+
+    /// The GPU engine that never waits for the GPU: [`Engine::step`] submits a frame and
+    /// returns, [`Engine::pending`] says the frame is under way, and a later `step` of the same
+    /// frame takes its results once they arrived. The page's engine is this one (a browser
+    /// hands a GPU's results over only between two of the page's frames); on the desktop it is
+    /// for tests of that path, with the same results as [`GpuEngine::new`]'s.
+    pub fn asynchronous(start: Start<'_>) -> GpuEngine {
+        GpuEngine {
+            asynchronous: true,
+            ..GpuEngine::new(start)
         }
     }
 
@@ -166,8 +186,8 @@ impl GpuEngine {
 }
 
 impl GpuEngine {
-    /// One frame on the GPU: recorded, submitted, waited for and read back into the mirror.
-    fn on_the_gpu(&mut self, plan: &Plan) -> Result<[u32; COUNTERS], String> {
+    /// One frame on the GPU: recorded and submitted, its results asked for.
+    fn submit(&mut self, plan: &Plan, revision: Revision) -> Result<InFlight, String> {
         // The own α̃ follow h (the mirror works them out, the GPU takes them up).
         let mut own_changed = false;
         for family in self.families.all() {
@@ -217,44 +237,35 @@ impl GpuEngine {
                 pass,
                 shape,
                 dispatches: 0,
-                unused: (Vec3A::ZERO, 0.0),
             };
             substep::frame(&mut recorder, plan);
             recorder.dispatches
         };
         resident.copy_back(&mut encoder);
         resident.gpu.queue.submit([encoder.finish()]);
-        let counters = resident.read(&mut self.mirror)?;
-        self.dispatches = dispatches;
-        Ok(counters)
+        Ok(InFlight {
+            reading: resident.request_read(),
+            revision,
+            dispatches,
+        })
     }
-}
 
-impl Engine for GpuEngine {
-    fn step(&mut self, mut frame: Frame<'_>) -> PerFamily<SkipCounts> {
-        frame.threads = 1;
-        self.prepare(&frame);
-        let plan = Plan::of(&frame);
-        if plan.contact.is_some() {
-            return self.on_the_cpu(frame, "contact runs on the CPU");
-        }
-        if self.resident.is_err() {
-            return self.on_the_cpu(frame, "no GPU");
-        }
-        let counters = match self.on_the_gpu(&plan) {
-            Ok(counters) => counters,
-            Err(why) => {
-                // The GPU failed this frame (a lost device, a kernel that did not compile): the
-                // mirror still holds the state before it, and steps it.
-                self.resident = Err(why);
-                return self.on_the_cpu(frame, "the GPU failed");
-            }
+    /// Takes the arrived results of `flight` into the mirror, and from there into the state.
+    /// An error when the device failed the frame: the mirror still holds the state before it.
+    fn finish(
+        &mut self,
+        flight: InFlight,
+        state: &mut State,
+    ) -> Result<PerFamily<SkipCounts>, String> {
+        let counters = match &self.resident {
+            Ok(resident) => resident.take(&mut self.mirror)?,
+            Err(why) => return Err(why.clone()),
         };
+        self.dispatches = flight.dispatches;
         self.on_cpu = None;
         self.mirror.frame += 1;
         let mut taken = Taken::default();
         taken.add_and_clear(&mut self.mirror.taken);
-        let state = frame.state;
         state.taken.ground += taken.ground;
         state.taken.damping += taken.damping;
         state.taken.settling += taken.settling;
@@ -264,10 +275,97 @@ impl Engine for GpuEngine {
             &mut state.velocities,
             Some(corrections),
         );
-        self.families.per_family(|f| SkipCounts {
+        Ok(self.families.per_family(|f| SkipCounts {
             degenerate: u64::from(counters[2 * f.index()]),
             too_long: u64::from(counters[2 * f.index() + 1]),
+        }))
+    }
+
+    /// A frame in flight whose results arrived, or `None` while they are on their way (the
+    /// frame is still pending).
+    fn landed(&mut self) -> Option<Result<InFlight, String>> {
+        let flight = self.in_flight.as_ref()?;
+        let arrived = match &self.resident {
+            Ok(resident) => resident.arrived(&flight.reading, !self.asynchronous),
+            Err(why) => Err(why.clone()),
+        };
+        match arrived {
+            Ok(false) => None,
+            Ok(true) => self.in_flight.take().map(Ok),
+            Err(why) => {
+                self.in_flight = None;
+                Some(Err(why))
+            }
+        }
+    }
+}
+
+/// A frame submitted whose results are on their way back.
+struct InFlight {
+    reading: resident::Reading,
+    /// The revision of the state it started from: an edit since makes its results stale.
+    revision: Revision,
+    dispatches: u64,
+}
+
+impl Engine for GpuEngine {
+    fn step(&mut self, mut frame: Frame<'_>) -> PerFamily<SkipCounts> {
+        frame.threads = 1;
+        let nothing = || frame.families.per_family(|_| SkipCounts::default());
+        // A frame begun by an earlier call (a page's, which cannot wait for it) finishes here
+        // once its results arrived, when the state was not edited since.
+        match self.landed() {
+            None if self.in_flight.is_some() => return nothing(),
+            None => {}
+            Some(Ok(flight)) if flight.revision == frame.revision => {
+                match self.finish(flight, frame.state) {
+                    Ok(skipped) => return skipped,
+                    // The frame runs again, on the CPU (below).
+                    Err(why) => self.resident = Err(why),
+                }
+            }
+            Some(Ok(_)) => {
+                if let Ok(resident) = &self.resident {
+                    resident.discard();
+                }
+            }
+            Some(Err(why)) => self.resident = Err(why),
+        }
+        self.prepare(&frame);
+        let plan = Plan::of(&frame);
+        if plan.contact.is_some() {
+            return self.on_the_cpu(frame, "contact runs on the CPU");
+        }
+        if self.resident.is_err() {
+            return self.on_the_cpu(frame, "no GPU");
+        }
+        let flight = match self.submit(&plan, frame.revision) {
+            Ok(flight) => flight,
+            Err(why) => {
+                // A kernel that did not compile: the mirror still holds the state before the
+                // frame, and steps it.
+                self.resident = Err(why);
+                return self.on_the_cpu(frame, "the GPU failed");
+            }
+        };
+        self.in_flight = Some(flight);
+        if self.asynchronous {
+            return nothing();
+        }
+        // On the desktop the results are waited for: they have arrived, or the device failed.
+        let finished = match self.landed() {
+            Some(Ok(flight)) => self.finish(flight, frame.state),
+            Some(Err(why)) => Err(why),
+            None => Err("the GPU dropped the frame's results".to_owned()),
+        };
+        finished.unwrap_or_else(|why| {
+            self.resident = Err(why);
+            self.on_the_cpu(frame, "the GPU failed")
         })
+    }
+
+    fn pending(&self) -> bool {
+        self.in_flight.is_some()
     }
 
     fn describe(&self) -> String {

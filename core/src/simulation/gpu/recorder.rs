@@ -7,7 +7,7 @@
 use super::kernels::{Shape, WORKGROUP};
 use super::resident::{ENTRY, Resident, entry};
 use crate::constraints::Unit;
-use crate::simulation::substep::{GrabbedParticle, Plan, Substeps};
+use crate::simulation::substep::{Plan, Substeps};
 use glam::DVec3;
 
 /// The dispatches a frame records, and how many.
@@ -16,9 +16,6 @@ pub(super) struct Recorder<'a> {
     pub pass: wgpu::ComputePass<'a>,
     pub shape: Shape,
     pub dispatches: u64,
-    /// What [`Substeps::grabbed`] lends: never used, since the compliant grab is recorded
-    /// ([`Substeps::soft_grab`]).
-    pub unused: (glam::Vec3A, f32),
 }
 
 impl Recorder<'_> {
@@ -80,11 +77,6 @@ impl Substeps for Recorder<'_> {
 
     /// Never called: a frame with contact runs on the CPU (`super::GpuEngine`).
     fn contacts(&mut self, _: &Plan) {}
-
-    fn grabbed(&mut self, _: usize) -> GrabbedParticle<'_> {
-        let (position, lambda) = &mut self.unused;
-        GrabbedParticle::F32(position, 0.0, lambda)
-    }
 
     /// The particle is in the grab's dispatch entry; the target and α̃ in the frame's uniform.
     fn soft_grab(&mut self, _: usize, _: DVec3, _: f64, _: f64) {

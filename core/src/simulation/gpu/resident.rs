@@ -10,7 +10,7 @@ use crate::simulation::fast::FastSimulation;
 use crate::simulation::projection::Rule;
 use glam::Vec3A;
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
 
 /// Bytes between two dispatches' entries in the dispatch uniform (WebGPU's largest minimum
 /// uniform offset alignment).
@@ -61,6 +61,13 @@ pub(super) struct Resident {
     pub sweep_entries: Vec<u32>,
 }
 
+/// A frame's results on their way back: set when the read-back buffer is mapped, or could not be.
+#[derive(Default)]
+pub(super) struct Reading(Arc<(Mutex<Landing>, Condvar)>);
+
+/// What the map's callback said: nothing yet, mapped, or why not.
+type Landing = Option<Result<(), String>>;
+
 /// A storage or uniform binding of the layout.
 fn binding(index: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
@@ -95,6 +102,21 @@ impl Resident {
             })
         };
         let n = u64::from(memory.particles());
+        // A device shared with a window's renderer may allow less than the adapter could.
+        let limits = device.limits();
+        let allowed = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        let largest = (SECTIONS as u64 * n * 16)
+            .max(memory.numbers_len as u64 * 4)
+            .max(memory.indices.len() as u64 * 4);
+        if largest > allowed {
+            return Err(format!(
+                "the body needs {:.0} MiB in one GPU buffer, and this device allows {:.0} MiB",
+                largest as f64 / 1048576.0,
+                allowed as f64 / 1048576.0
+            ));
+        }
         let copy_src = wgpu::BufferUsages::COPY_SRC;
         let points = storage("points", SECTIONS as u64 * n * 16, copy_src);
         let numbers = storage("numbers", memory.numbers_len as u64 * 4, copy_src);
@@ -316,24 +338,72 @@ impl Resident {
         encoder.copy_buffer_to_buffer(&self.counters, 0, &self.read_back, at, COUNTERS as u64 * 4);
     }
 
-    /// Waits for the frame and reads it back into `mirror`'s arrays; returns the skip counters.
-    pub(super) fn read(&self, mirror: &mut FastSimulation) -> Result<[u32; COUNTERS], String> {
-        let slice = self.read_back.slice(..);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |result| {
-            let _ = sender.send(result);
-        });
-        self.gpu
-            .device
-            .poll(wgpu::PollType::Wait {
+    /// Asks for the read-back buffer once the frame submitted last is done with it: the
+    /// results' way back, which [`Resident::arrived`] watches.
+    pub(super) fn request_read(&self) -> Reading {
+        let reading = Reading::default();
+        let arrived = Arc::clone(&reading.0);
+        self.read_back
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |result| {
+                let (kept, landed) = &*arrived;
+                let mut kept = kept.lock().unwrap_or_else(PoisonError::into_inner);
+                *kept = Some(result.map_err(|e| e.to_string()));
+                landed.notify_all();
+            });
+        reading
+    }
+
+    /// Whether the results of `reading` have arrived: waited for with `wait` (the desktop), or
+    /// only looked at (a page, where the browser hands them over between two of its frames).
+    /// An error when the device failed the frame.
+    pub(super) fn arrived(&self, reading: &Reading, wait: bool) -> Result<bool, String> {
+        let poll = if wait {
+            wgpu::PollType::Wait {
                 submission_index: None,
                 timeout: None,
-            })
+            }
+        } else {
+            wgpu::PollType::Poll
+        };
+        self.gpu
+            .device
+            .poll(poll)
             .map_err(|e| format!("the GPU did not finish the frame: {e}"))?;
-        receiver
-            .recv()
-            .map_err(|_| "the GPU dropped the frame's results".to_owned())?
-            .map_err(|e| format!("the frame's results could not be read: {e}"))?;
+        let (kept, landed) = &*reading.0;
+        let mut kept = kept.lock().unwrap_or_else(PoisonError::into_inner);
+        if wait {
+            // The device is done with the frame; its callback may still be running on another
+            // thread that polled the same device (tests share one), and wgpu always calls it.
+            let minute = std::time::Duration::from_secs(60);
+            kept = (landed.wait_timeout_while(kept, minute, |k| k.is_none()))
+                .unwrap_or_else(PoisonError::into_inner)
+                .0;
+        }
+        match &*kept {
+            None if wait => Err("the GPU dropped the frame's results".to_owned()),
+            None => Ok(false),
+            Some(Err(e)) => {
+                // The device's own error, where it reported one, says more than the map's.
+                let reported = super::device::take_error().map(|error| format!(": {error}"));
+                let reported = reported.unwrap_or_default();
+                Err(format!(
+                    "the frame's results could not be read ({e}){reported}"
+                ))
+            }
+            Some(Ok(())) => Ok(true),
+        }
+    }
+
+    /// Lets go of the results of a frame that arrived but is not wanted (the state was edited
+    /// while it ran).
+    pub(super) fn discard(&self) {
+        self.read_back.unmap();
+    }
+
+    /// Reads the arrived results into `mirror`'s arrays; returns the skip counters.
+    pub(super) fn take(&self, mirror: &mut FastSimulation) -> Result<[u32; COUNTERS], String> {
+        let slice = self.read_back.slice(..);
         // An error the device reported during the frame leaves its results unread: the mirror
         // keeps the state before it.
         if let Some(error) = super::device::take_error() {

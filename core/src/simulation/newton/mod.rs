@@ -189,7 +189,7 @@ fn force_scale(heaviest: f64, gravity: f64, forces: &[DVec3]) -> f64 {
 
 impl Substeps for Implicit<'_> {
     crate::forward_stages!(on:
-        predict, hold, keep_predicted, reset_multipliers, contacts, grabbed, ground_and_plane,
+        predict, hold, keep_predicted, reset_multipliers, contacts, soft_grab, ground_and_plane,
         keep_corrections, update_velocities);
 
     /// Never called: [`Implicit::sweeps`] solves the whole substep.
