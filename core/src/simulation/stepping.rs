@@ -20,7 +20,10 @@ impl Simulation {
     /// call finishes it ([`Engine::pending`]).
     pub fn step(&mut self) {
         self.refresh_inverse_masses();
-        self.state.frame_corrections.fill(DVec3::ZERO);
+        // A frame under way keeps the last Δp on show until it lands (and writes its own).
+        if !self.pending() {
+            self.state.frame_corrections.fill(DVec3::ZERO);
+        }
         self.find_contacts();
         if self.frame == 0 && self.settling.is_none() && self.starts_inside_the_layer() {
             // Set down with a particle inside the thickness of a surface: contact moves it out

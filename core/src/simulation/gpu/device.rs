@@ -107,7 +107,7 @@ fn request() -> Result<Gpu, String> {
 /// ([`adopt`]), and there is no other to ask for: a page cannot wait for an adapter.
 #[cfg(target_arch = "wasm32")]
 fn request() -> Result<Gpu, String> {
-    Err("this browser gives the page no WebGPU (it draws with WebGL2)".to_owned())
+    Err("this browser gives the page no WebGPU; it draws with WebGL2".to_owned())
 }
 
 /// wgpu's default answer to an error is a panic: the engine keeps the error instead, and gives
